@@ -1,0 +1,67 @@
+// Readers and writers. This is the only part of the library that knows file formats; none of
+// their libraries appear in public headers.
+#pragma once
+
+#include <filesystem>
+#include <string_view>
+
+#include "radiosity/common.hpp"
+#include "radiosity/render.hpp"
+#include "radiosity/scene.hpp"
+#include "radiosity/solver.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+/// Loads a scene, choosing the reader by extension (.obj with its .mtl files).
+/// OBJ: `o`/`g` names become groups, `Kd` the diffuse reflectance, `Ke` emitted radiance (so
+/// E = pi * Ke); without materials everything is grey 0.5. Non-planar or non-convex faces are
+/// triangulated with a warning. Throws Error naming the file, line and problem for a missing
+/// file or MTL, a bad index, a NaN/infinite coordinate, a zero-area face or a reflectance >= 1.
+/// MTL details: `Ks` -> specular with `Ns` as Phong exponent; `illum` 3/5 with `Ks` -> ideal
+/// mirror; `illum` 4/6/7/9 with `Tf` -> transmittance, `Ni` -> ior; when Kd + Ks would reach 1,
+/// Ks is scaled down with a warning. Warnings in Scene::warnings() start with "file:line: ".
+/// Throws Error{invalid_argument} for an unsupported extension.
+/// Thread safety: may be called concurrently.
+RADIOSITY_API Scene load_scene(const std::filesystem::path& path);
+
+/// Writes linear float RGB (channels R, G, B) and each layer as LAYER.R/.G/.B. Throws
+/// Error{io_error} naming the path when the file cannot be written, Error{invalid_argument}
+/// for an empty image or pixel/layer sizes that do not match width x height.
+/// Thread safety: may be called concurrently for different paths.
+RADIOSITY_API void write_exr(const Image& image, const std::filesystem::path& path);
+
+/// Reads an EXR written by write_exr (or any RGB EXR) with its layers, in name order; channels
+/// missing from the file are 0. Throws Error{file_not_found} or Error{parse_error} (unreadable
+/// file, no R, G or B channel) naming the path. Thread safety: may be called concurrently.
+RADIOSITY_API Image read_exr(const std::filesystem::path& path);
+
+/// Options for the tone-mapped preview.
+struct PngOptions {
+  float exposure = 1.0f;  ///< linear scale applied before clamping and sRGB encoding
+};
+
+/// Writes an 8-bit sRGB preview: clamp(exposure * radiance) then the sRGB transfer curve.
+/// Throws Error{io_error} naming the path when the file cannot be written.
+RADIOSITY_API void write_png(const Image& image, const std::filesystem::path& path, const PngOptions& options = {});
+
+/// Writes the solution's leaf elements as a binary little-endian PLY with per-vertex position,
+/// float radiosity (r, g, b properties named radiosity_r/g/b) and 8-bit display colours
+/// (red/green/blue, sRGB of B/pi x exposure), so MeshLab and Blender show the solution.
+/// Only vertices used by leaves are written; faces are triangles (quads split in two).
+/// Throws Error{io_error} naming the path when the file cannot be written.
+RADIOSITY_API void write_ply(const Solution& solution, const std::filesystem::path& path,
+                             const PngOptions& options = {});
+
+/// Writes the statistics JSON of `radiosity solve --stats` (format in docs/CLI-stats.md):
+/// status, iterations, residual history, per-group mean radiosity and area, power balance,
+/// sizes, timings and warnings. Throws Error{io_error} naming the path when it cannot be written.
+RADIOSITY_API void write_stats_json(const Solution& solution, const std::filesystem::path& path);
+
+/// As above, and also records what the Solution itself does not know: the scene's name (left out
+/// when empty) and the options the solve ran with (method, form-factor method, tolerance, ...).
+RADIOSITY_API void write_stats_json(const Solution& solution, const std::filesystem::path& path,
+                                    const SolveOptions& options, std::string_view scene = {});
+
+}  // namespace v1
+}  // namespace radiosity

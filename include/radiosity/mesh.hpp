@@ -1,0 +1,126 @@
+// The patch hierarchy: polygons meshed into patches, each patch the root of a quadtree of
+// elements. Transport is computed from elements (leaves) to patches; radiosity is constant per
+// element and interpolated to shared vertices for display.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "radiosity/common.hpp"
+#include "radiosity/scene.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+/// Marks "no element / no vertex".
+inline constexpr std::uint32_t kNone = 0xffffffffu;
+
+/// How finely polygons are meshed. Areas are in scene units squared; 0 means "derive from the
+/// scene": max_patch_area = total area / 512 and max_element_area = max_patch_area / 4, which
+/// gives the default Cornell box a few hundred patches and a few thousand elements. A derived
+/// max_patch_area is raised to an explicit max_element_area that exceeds it.
+struct MeshOptions {
+  float max_patch_area = 0.0f;
+  float max_element_area = 0.0f;
+};
+
+/// A node of a patch's quadtree. Leaves carry the radiosity unknowns; an inner node's value is
+/// the area-weighted mean of its children. Triangles split into four similar triangles, quads
+/// into four quads through edge midpoints and the centre.
+struct Element {
+  std::array<std::uint32_t, 4> corners{kNone, kNone, kNone, kNone};  ///< vertex ids, CCW; [3] == kNone for triangles
+  std::uint32_t patch = kNone;
+  std::uint32_t parent = kNone;       ///< kNone for a patch's root element
+  std::uint32_t first_child = kNone;  ///< children are first_child .. first_child + 3; kNone for a leaf
+  glm::vec3 centroid{0.0f};
+  float area = 0.0f;
+  std::uint8_t depth = 0;             ///< 0 for a root
+
+  bool is_leaf() const { return first_child == kNone; }
+  int corner_count() const { return corners[3] == kNone ? 3 : 4; }
+};
+
+/// A patch: the unit that shoots and receives energy in transport (the "j" of F_ij).
+struct Patch {
+  PolygonId polygon = 0;
+  MaterialId material = 0;
+  GroupId group = 0;
+  glm::vec3 normal{0.0f};
+  glm::vec3 centroid{0.0f};
+  float area = 0.0f;
+  std::uint32_t root = kNone;  ///< its root element
+};
+
+/// Patches, their element quadtrees and the vertices the elements share. Vertices are shared
+/// between neighbouring elements of one polygon (including across patch borders); polygons do
+/// not share vertices, so interpolation never blends across a crease or a material change.
+/// Thread safety: const member functions may be called concurrently; subdivide() needs exclusive access.
+class RADIOSITY_API PatchHierarchy {
+ public:
+  PatchHierarchy() = default;
+  /// Meshes every polygon of `scene`. Throws Error{invalid_argument} if an area option is
+  /// negative or NaN, or if max_element_area > max_patch_area.
+  PatchHierarchy(const Scene& scene, const MeshOptions& options);
+
+  const std::vector<Patch>& patches() const { return patches_; }
+  /// Every node of every quadtree, inner nodes included; index = element id.
+  const std::vector<Element>& elements() const { return elements_; }
+  const Element& element(std::uint32_t id) const { return elements_[id]; }
+  /// Ids of the leaf elements, in a deterministic order (the radiosity unknowns).
+  const std::vector<std::uint32_t>& leaves() const { return leaves_; }
+  /// Position of a leaf element in leaves() (its unknown's index), or kNone for an inner node or
+  /// an id out of range.
+  std::uint32_t leaf_index(std::uint32_t element) const {
+    return element < leaf_slot_.size() ? leaf_slot_[element] : kNone;
+  }
+  const std::vector<glm::vec3>& vertices() const { return vertices_; }
+  /// The effective options (derived values filled in).
+  const MeshOptions& options() const { return options_; }
+  const glm::vec3& normal(std::uint32_t element) const { return patches_[elements_[element].patch].normal; }
+
+  /// Splits a leaf into four children and returns the id of the first. The children reuse
+  /// midpoints that a neighbour already created, so vertices stay shared. Throws
+  /// Error{invalid_argument} if `element` is not a leaf.
+  std::uint32_t subdivide(std::uint32_t element);
+
+  /// Point on an element for (u, v) in [0,1]^2, uniformly distributed over its area when (u, v)
+  /// is uniform (quads are split into two triangles in proportion to their areas).
+  glm::vec3 sample_point(std::uint32_t element, glm::vec2 uv) const;
+
+  /// Per-vertex values for smooth display from per-element values (indexed by element id; only
+  /// leaves are read): the area-weighted mean of the leaves around each vertex, then every
+  /// hanging (T-) vertex set to the linear interpolation along the coarser neighbour's edge, so
+  /// the interpolated field is continuous.
+  std::vector<Rgb> vertex_values(const std::vector<Rgb>& element_values) const;
+
+  /// Fills inner nodes with the area-weighted mean of their children (leaves are read).
+  void aggregate(std::vector<Rgb>& element_values) const;
+
+ private:
+  std::uint32_t add_element(const Element& e);
+  std::uint32_t add_vertex(const glm::vec3& position, std::uint32_t edge_a, std::uint32_t edge_b);
+  std::uint32_t midpoint(std::uint32_t a, std::uint32_t b);
+  void add_patch(PolygonId polygon_id, const Polygon& polygon, const std::array<std::uint32_t, 4>& corners);
+  void mesh_quad(PolygonId polygon_id, const Polygon& polygon);
+  void mesh_triangle(PolygonId polygon_id, const Polygon& polygon, const glm::vec3& p0, const glm::vec3& p1,
+                     const glm::vec3& p2);
+
+  MeshOptions options_;
+  std::vector<Patch> patches_;
+  std::vector<Element> elements_;
+  std::vector<std::uint32_t> leaves_;
+  std::vector<std::uint32_t> leaf_slot_;  ///< element id -> index in leaves_ (kNone if inner)
+  std::vector<glm::vec3> vertices_;
+  /// Edge (min vertex, max vertex) -> its midpoint vertex, for sharing and T-vertex handling.
+  std::unordered_map<std::uint64_t, std::uint32_t> midpoints_;
+  /// For a midpoint vertex, the edge it splits (kNone for lattice and centre vertices).
+  std::vector<std::array<std::uint32_t, 2>> vertex_edge_;
+};
+
+}  // namespace v1
+}  // namespace radiosity

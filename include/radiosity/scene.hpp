@@ -1,0 +1,130 @@
+// Scenes: planar polygons with materials, grouped by name, and a camera.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "radiosity/common.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+class Brdf;  // brdf.hpp; only the two-pass compositor evaluates it
+
+using MaterialId = std::uint32_t;
+using GroupId = std::uint32_t;
+using PolygonId = std::uint32_t;
+
+/// Surface description. The diffuse part (emission, reflectance, diffuse transmittance) drives
+/// radiosity; the specular parts are for the extended first pass and the ray-traced second pass.
+/// Every field has a default, so `Material{}` is a grey (0.5) non-emitting diffuse surface.
+struct Material {
+  std::string name;
+  Rgb emission{0.0f};               ///< emitted exitance E, W/m^2 (per scene unit^2), >= 0
+  Rgb reflectance{0.5f};            ///< diffuse reflectance rho, each channel in [0, 1)
+  Rgb specular{0.0f};               ///< specular reflectance, each channel in [0, 1]
+  float specular_exponent = 0.0f;   ///< Phong exponent of the specular lobe; 0 = ideal mirror
+  Rgb transmittance{0.0f};          ///< specular transmission tint (glass), each channel in [0, 1]
+  float ior = 1.5f;                 ///< index of refraction used when transmittance > 0
+  Rgb diffuse_transmittance{0.0f};  ///< translucency, each channel in [0, 1]
+  bool two_sided = false;           ///< reflects on both sides (otherwise the back is black)
+  /// Optional full reflection model for the second pass; null means "derive from the fields
+  /// above". Shared and immutable, so copying a Material is cheap.
+  std::shared_ptr<const Brdf> brdf;
+};
+
+/// A planar convex polygon as stored in a Scene (after validation and any triangulation).
+struct Polygon {
+  std::vector<glm::vec3> vertices;  ///< counter-clockwise seen from the front
+  glm::vec3 normal{0.0f};           ///< unit, right-hand rule of the vertex order
+  float area = 0.0f;
+  MaterialId material = 0;
+  GroupId group = 0;
+};
+
+/// Pinhole camera. `fov_deg` is the vertical field of view in degrees.
+struct Camera {
+  glm::vec3 eye{0.0f, 0.0f, 0.0f};
+  glm::vec3 look_at{0.0f, 0.0f, 1.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float fov_deg = 45.0f;
+};
+
+/// Axis-aligned box.
+struct Bounds {
+  glm::vec3 lower{0.0f};
+  glm::vec3 upper{0.0f};
+  float diagonal() const;
+};
+
+/// The polygons that one add_polygon() call produced: more than one when the input had to be
+/// triangulated.
+struct PolygonRange {
+  PolygonId first = 0;
+  std::uint32_t count = 0;
+};
+
+/// Polygons, materials, groups and a camera. Everything is validated on entry, so a Scene that
+/// exists is usable by every solver.
+/// Thread safety: const member functions may be called concurrently; mutation needs exclusive access.
+class RADIOSITY_API Scene {
+ public:
+  Scene();
+
+  /// Adds a material and returns its id. Throws Error{invalid_scene} naming the material and
+  /// field when a value is NaN/infinite, emission < 0, reflectance outside [0, 1) or another
+  /// coefficient outside [0, 1].
+  MaterialId add_material(const Material& material);
+
+  /// Adds a polygon (3 or more vertices, counter-clockwise seen from the side it faces).
+  /// Consecutive duplicate and collinear vertices are dropped. A non-planar or non-convex polygon
+  /// is triangulated (ear clipping in its best-fit plane) and a warning recorded.
+  /// `group` names the surface for per-group results; empty means "default".
+  /// Throws Error{invalid_scene} for a NaN or infinite coordinate, fewer than 3 distinct vertices,
+  /// a zero-area (degenerate) polygon, or Error{invalid_argument} for an unknown material id.
+  PolygonRange add_polygon(const std::vector<glm::vec3>& vertices, MaterialId material,
+                           std::string_view group = {});
+
+  const std::vector<Material>& materials() const { return materials_; }
+  const Material& material(MaterialId id) const { return materials_.at(id); }
+  const std::vector<Polygon>& polygons() const { return polygons_; }
+  /// Group names, indexed by GroupId, in order of first use.
+  const std::vector<std::string>& groups() const { return groups_; }
+  std::optional<GroupId> find_group(std::string_view name) const;
+
+  void set_camera(const Camera& camera);
+  bool has_camera() const { return camera_.has_value(); }
+  /// The camera set on the scene, or one that frames the scene's bounds from -z.
+  Camera camera() const;
+
+  Bounds bounds() const;
+  double total_area() const;
+  /// Non-fatal problems found while building (triangulated polygons, ...).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  void add_warning(std::string text) { warnings_.push_back(std::move(text)); }
+
+ private:
+  GroupId intern_group(std::string_view name);
+
+  std::vector<Material> materials_;
+  std::vector<Polygon> polygons_;
+  std::vector<std::string> groups_;
+  std::optional<Camera> camera_;
+  std::vector<std::string> warnings_;
+};
+
+/// The Cornell box as published by the Cornell Program of Computer Graphics: geometry in mm,
+/// camera at (278, 273, -800) looking +z with a 39.3077 degree vertical field of view, measured
+/// white/red/green reflectances, light radiance (17, 12, 4) (so E = pi * L) and light reflectance
+/// 0.78. Groups: floor, ceiling, back_wall, red_wall, green_wall, light, short_block, tall_block.
+/// The ceiling has a hole where the light sits, so no two surfaces overlap.
+RADIOSITY_API Scene cornell_box();
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,108 @@
+// Solvers and their result: matrix radiosity (Jacobi, Gauss-Seidel) and progressive refinement.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "radiosity/common.hpp"
+#include "radiosity/form_factors.hpp"
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+enum class SolverMethod {
+  jacobi,        ///< all F precomputed; B' = E + rho F B from the previous sweep
+  gauss_seidel,  ///< all F precomputed; each element uses the newest values
+  progressive,   ///< shooting, brightest unshot power first (Cohen et al. 1988)
+};
+
+/// Everything solve() needs; every field has a default.
+struct SolveOptions {
+  SolverMethod method = SolverMethod::gauss_seidel;
+  FormFactorOptions form_factors;
+  MeshOptions mesh;
+  /// Stop when the residual falls below this. The residual is the power not yet propagated
+  /// divided by the emitted power: for the matrix methods sum_e A_e |B_e(k) - B_e(k-1)| over
+  /// elements and channels, for progressive the unshot power sum_i A_i |dB_i|.
+  double tolerance = 1e-3;
+  /// Sweeps (matrix) or shooting steps (progressive) at most; 0 = 1000 sweeps / 100 x patches steps.
+  int max_iterations = 0;
+  unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
+  std::uint64_t seed = 1;        ///< overrides form_factors.seed
+  /// Largest form-factor matrix the matrix methods may allocate, in bytes; 0 = 4 GiB.
+  std::size_t memory_budget_bytes = 0;
+  ProgressFn on_progress;        ///< optional; return false to cancel
+};
+
+enum class SolveStatus { converged, iteration_cap, cancelled };
+
+/// Figures about a solve, for people and for `radiosity solve --stats`.
+struct SolveReport {
+  int iterations = 0;
+  double residual = 0.0;
+  std::vector<double> residual_history;  ///< after each sweep / step
+  std::vector<double> time_history;      ///< seconds since the solve phase began, same indexing
+  std::size_t patch_count = 0;
+  std::size_t element_count = 0;         ///< leaves
+  std::size_t form_factor_bytes = 0;     ///< memory held by form factors at the peak
+  Rgb emitted_power{0.0f};               ///< sum A E, W per channel
+  Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance
+  double seconds_meshing = 0.0;
+  double seconds_form_factors = 0.0;
+  double seconds_solving = 0.0;
+  std::vector<std::string> warnings;
+};
+
+/// The result of solve(): element radiosity on the hierarchy it was solved on.
+/// Move-only value; thread safety: const member functions may be called concurrently.
+class RADIOSITY_API Solution {
+ public:
+  Solution() = default;
+  Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
+           SolveStatus status, SolveReport report);
+  Solution(Solution&&) noexcept = default;
+  Solution& operator=(Solution&&) noexcept = default;
+  Solution(const Solution&) = delete;
+  Solution& operator=(const Solution&) = delete;
+
+  SolveStatus status() const { return status_; }
+  const SolveReport& report() const { return report_; }
+  const PatchHierarchy& hierarchy() const { return hierarchy_; }
+  /// Radiosity B (W/m^2) per element id; inner nodes hold the area-weighted mean of their children.
+  const std::vector<Rgb>& radiosity() const { return radiosity_; }
+  Rgb patch_radiosity(std::uint32_t patch) const;
+  /// Per-vertex radiosity for display (see PatchHierarchy::vertex_values).
+  std::vector<Rgb> vertex_radiosity() const;
+  /// Area-weighted mean radiosity over the patches of a group. Throws Error{invalid_argument}
+  /// naming the group when the scene has no such group.
+  Rgb group_radiosity(std::string_view group) const;
+  double group_area(std::string_view group) const;
+  const std::vector<std::string>& groups() const { return groups_; }
+
+ private:
+  GroupId group_id(std::string_view group) const;
+
+  PatchHierarchy hierarchy_;
+  std::vector<Rgb> radiosity_;
+  std::vector<std::string> groups_;
+  SolveStatus status_ = SolveStatus::converged;
+  SolveReport report_;
+};
+
+/// Checks options; throws Error{invalid_argument} naming the first bad field.
+RADIOSITY_API void validate(const SolveOptions& options);
+
+/// Meshes the scene, computes form factors and solves for radiosity. Throws Error for bad
+/// options or when the matrix methods would exceed memory_budget_bytes (the message gives the
+/// size and suggests progressive or a coarser mesh). A cancelled solve returns the last
+/// consistent estimate with status cancelled.
+/// Thread safety: concurrent calls are safe.
+RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,37 @@
+// Thread-count control shared by the modules: work runs in a oneTBB arena limited to the
+// requested number of threads, so concurrent calls with different settings do not interfere.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <thread>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace radiosity::detail {
+
+inline int thread_count(unsigned requested) {
+  if (requested > 0) return static_cast<int>(requested);
+  return std::max(1, static_cast<int>(tbb::this_task_arena::max_concurrency()));
+}
+
+/// Runs body(begin, end) over [0, count) in chunks of `grain`, on at most `threads` threads.
+/// Results must not depend on the chunking (each index computes its own values).
+template <typename Body>
+void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const Body& body) {
+  if (count == 0) return;
+  const int n = thread_count(threads);
+  if (n == 1) {
+    body(std::size_t{0}, count);
+    return;
+  }
+  tbb::task_arena arena(n);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, std::max<std::size_t>(grain, 1)),
+                      [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
+  });
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,43 @@
+// Choosing and configuring a form-factor estimator.
+#include <string>
+
+#include "formfactor/estimators.hpp"
+
+namespace radiosity::detail {
+
+FormFactorOptions resolve(const FormFactorOptions& options) {
+  FormFactorOptions o = options;
+  if (o.source_samples == 0) o.source_samples = o.method == FormFactorMethod::analytic ? 16 : 4;
+  if (o.visibility_rays == 0) o.visibility_rays = 4;
+  if (o.hemicube_resolution == 0) o.hemicube_resolution = 256;
+  if (o.source_samples > 64)
+    throw Error(ErrorCode::invalid_argument,
+                "form_factors.source_samples must be in [1, 64], got " + std::to_string(o.source_samples));
+  if (o.visibility_rays > 64)
+    throw Error(ErrorCode::invalid_argument,
+                "form_factors.visibility_rays must be in [1, 64], got " + std::to_string(o.visibility_rays));
+  return o;
+}
+
+}  // namespace radiosity::detail
+
+namespace radiosity {
+inline namespace v1 {
+
+std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
+                                                                const FormFactorOptions& options) {
+  const FormFactorOptions o = detail::resolve(options);
+  switch (o.method) {
+    case FormFactorMethod::ray_cast:
+      return detail::make_ray_cast_estimator(scene, hierarchy, o);
+    case FormFactorMethod::analytic:
+      return detail::make_analytic_estimator(scene, hierarchy, o);
+    case FormFactorMethod::hemicube:
+      break;
+  }
+  throw Error(ErrorCode::invalid_argument,
+              "form_factors.method: the hemicube estimator is not available in this version; use ray_cast or analytic");
+}
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,169 @@
+// Embree-backed ray queries.
+// Based on: Wald, Woop, Benthin, Johnson & Ernst, "Embree: A Kernel Framework for Efficient CPU
+// Ray Tracing", ACM TOG 33(4), 2014.
+#include "geometry/ray_scene.hpp"
+
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include <embree3/rtcore.h>
+
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+
+namespace radiosity::detail {
+
+namespace {
+
+RTCDevice as_device(void* p) { return static_cast<RTCDevice>(p); }
+RTCScene as_scene(void* p) { return static_cast<RTCScene>(p); }
+
+}  // namespace
+
+RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& triangles,
+                   std::vector<std::uint32_t> ids)
+    : ids_(std::move(ids)), indices_(triangles) {
+  // Embree must not start its own threads beyond what the caller's TBB arena allows; the
+  // default configuration uses TBB, which composes with ours.
+  RTCDevice device = rtcNewDevice(nullptr);
+  if (!device)
+    throw Error(ErrorCode::internal, "Embree: cannot create a device (error " +
+                                         std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
+  device_ = device;
+  RTCScene scene = rtcNewScene(device);
+  scene_ = scene;
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+
+  if (!indices_.empty()) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), positions.size()));
+    for (std::size_t i = 0; i < positions.size(); ++i) std::memcpy(vb + 3 * i, &positions[i], 3 * sizeof(float));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                              3 * sizeof(unsigned), indices_.size() / 3));
+    std::memcpy(ib, indices_.data(), indices_.size() * sizeof(unsigned));
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(scene);
+  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
+    release();
+    throw Error(ErrorCode::internal, "Embree: building the ray-query scene failed");
+  }
+}
+
+RayScene::RayScene(RayScene&& other) noexcept
+    : device_(other.device_), scene_(other.scene_), ids_(std::move(other.ids_)), indices_(std::move(other.indices_)) {
+  other.device_ = nullptr;
+  other.scene_ = nullptr;
+}
+
+RayScene& RayScene::operator=(RayScene&& other) noexcept {
+  if (this != &other) {
+    release();
+    device_ = other.device_;
+    scene_ = other.scene_;
+    ids_ = std::move(other.ids_);
+    indices_ = std::move(other.indices_);
+    other.device_ = nullptr;
+    other.scene_ = nullptr;
+  }
+  return *this;
+}
+
+RayScene::~RayScene() { release(); }
+
+void RayScene::release() noexcept {
+  if (scene_) rtcReleaseScene(as_scene(scene_));
+  if (device_) rtcReleaseDevice(as_device(device_));
+  scene_ = nullptr;
+  device_ = nullptr;
+}
+
+RayScene RayScene::from_polygons(const Scene& scene) {
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> triangles, ids;
+  const auto& polygons = scene.polygons();
+  for (std::size_t p = 0; p < polygons.size(); ++p) {
+    const auto& v = polygons[p].vertices;
+    auto base = static_cast<std::uint32_t>(positions.size());
+    positions.insert(positions.end(), v.begin(), v.end());
+    // Polygons are convex, so a fan covers them exactly.
+    for (std::uint32_t k = 1; k + 1 < v.size(); ++k) {
+      triangles.insert(triangles.end(), {base, base + k, base + k + 1});
+      ids.push_back(static_cast<std::uint32_t>(p));
+    }
+  }
+  return RayScene(positions, triangles, std::move(ids));
+}
+
+RayScene RayScene::from_leaves(const PatchHierarchy& hierarchy) {
+  std::vector<std::uint32_t> triangles, ids;
+  for (std::uint32_t e : hierarchy.leaves()) {
+    const Element& el = hierarchy.element(e);
+    triangles.insert(triangles.end(), {el.corners[0], el.corners[1], el.corners[2]});
+    ids.push_back(e);
+    if (el.corner_count() == 4) {
+      triangles.insert(triangles.end(), {el.corners[0], el.corners[2], el.corners[3]});
+      ids.push_back(e);
+    }
+  }
+  return RayScene(hierarchy.vertices(), triangles, std::move(ids));
+}
+
+bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray;
+  ray.org_x = origin.x;
+  ray.org_y = origin.y;
+  ray.org_z = origin.z;
+  ray.dir_x = dir.x;
+  ray.dir_y = dir.y;
+  ray.dir_z = dir.z;
+  ray.tnear = tnear;
+  ray.tfar = tfar;
+  ray.time = 0.0f;
+  ray.mask = 0xffffffffu;
+  ray.id = 0;
+  ray.flags = 0;
+  rtcOccluded1(as_scene(scene_), &context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear,
+                                                 float tfar) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = origin.x;
+  rh.ray.org_y = origin.y;
+  rh.ray.org_z = origin.z;
+  rh.ray.dir_x = dir.x;
+  rh.ray.dir_y = dir.y;
+  rh.ray.dir_z = dir.z;
+  rh.ray.tnear = tnear;
+  rh.ray.tfar = tfar;
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(as_scene(scene_), &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  Hit h;
+  h.t = rh.ray.tfar;
+  h.triangle = rh.hit.primID;
+  h.id = ids_[rh.hit.primID];
+  h.u = rh.hit.u;
+  h.v = rh.hit.v;
+  h.geometric_normal = glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+  return h;
+}
+
+}  // namespace radiosity::detail

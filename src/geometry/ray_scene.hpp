@@ -1,0 +1,66 @@
+// Ray queries against a set of triangles, backed by an Embree BVH. Private to the library: no
+// public header mentions Embree.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace radiosity {
+inline namespace v1 {
+class Scene;
+class PatchHierarchy;
+}  // namespace v1
+}  // namespace radiosity
+
+namespace radiosity::detail {
+
+/// A triangle mesh with a user id per triangle, committed once and then queried from any
+/// number of threads. Move-only.
+/// Thread safety: occluded() and intersect() may be called concurrently.
+class RayScene {
+ public:
+  struct Hit {
+    float t = 0.0f;
+    std::uint32_t id = 0;        ///< the user id of the triangle hit
+    std::uint32_t triangle = 0;  ///< index of the triangle hit
+    float u = 0.0f, v = 0.0f;    ///< barycentric coordinates of vertices 1 and 2
+    glm::vec3 geometric_normal{0.0f};  ///< unnormalised, right-hand rule of the triangle
+  };
+
+  /// `triangles` indexes `positions`; `ids` has one entry per triangle. Throws Error{internal}
+  /// if Embree cannot create a device.
+  RayScene(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& triangles,
+           std::vector<std::uint32_t> ids);
+  RayScene(RayScene&& other) noexcept;
+  RayScene& operator=(RayScene&& other) noexcept;
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+  ~RayScene();
+
+  /// The scene's polygons, fan-triangulated; ids are polygon ids.
+  static RayScene from_polygons(const Scene& scene);
+  /// The hierarchy's leaf elements (quads as two triangles); ids are element ids.
+  static RayScene from_leaves(const PatchHierarchy& hierarchy);
+
+  /// True when something lies on the segment origin + t*dir, t in (tnear, tfar).
+  bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
+  /// The nearest hit on the ray within (tnear, tfar).
+  std::optional<Hit> intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
+
+  const std::vector<std::uint32_t>& triangle_ids() const { return ids_; }
+  /// Vertex indices of a triangle (three entries).
+  const std::uint32_t* triangle(std::uint32_t index) const { return &indices_[3 * index]; }
+
+ private:
+  void release() noexcept;
+
+  void* device_ = nullptr;  // RTCDevice
+  void* scene_ = nullptr;   // RTCScene
+  std::vector<std::uint32_t> ids_;
+  std::vector<std::uint32_t> indices_;
+};
+
+}  // namespace radiosity::detail

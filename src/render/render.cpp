@@ -1,0 +1,107 @@
+// Ray-cast display of a radiosity solution: the view pass of the method in its simplest form.
+// Each pixel averages stratified camera rays; a ray that hits a leaf element shows the
+// element's vertex radiosity interpolated at the hit point, divided by pi (a Lambertian
+// surface's radiance).
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+#include <glm/trigonometric.hpp>
+#include <limits>
+
+#include "detail/parallel.hpp"
+#include "detail/rng.hpp"
+#include "geometry/ray_scene.hpp"
+#include "radiosity/render.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+struct PinholeCamera {
+  glm::vec3 eye, forward, right, up;
+  float tan_half_fov, aspect;
+
+  PinholeCamera(const Camera& c, int width, int height)
+      : eye(c.eye),
+        forward(glm::normalize(c.look_at - c.eye)),
+        right(glm::normalize(glm::cross(forward, c.up))),
+        up(glm::cross(right, forward)),
+        tan_half_fov(std::tan(glm::radians(0.5f * c.fov_deg))),
+        aspect(static_cast<float>(width) / static_cast<float>(height)) {}
+
+  /// Direction through image position (sx, sy) in [0,1]^2, (0,0) the top-left corner.
+  glm::vec3 direction(float sx, float sy) const {
+    float px = (2.0f * sx - 1.0f) * tan_half_fov * aspect;
+    float py = (1.0f - 2.0f * sy) * tan_half_fov;
+    return glm::normalize(forward + px * right + py * up);
+  }
+};
+
+}  // namespace
+
+Image render(const Scene& scene, const Solution& solution, const RenderOptions& options) {
+  if (options.width <= 0 || options.height <= 0)
+    throw Error(ErrorCode::invalid_argument, "render: width and height must be > 0, got " +
+                                                 std::to_string(options.width) + "x" + std::to_string(options.height));
+  if (options.spp <= 0)
+    throw Error(ErrorCode::invalid_argument, "render: spp must be > 0, got " + std::to_string(options.spp));
+  const PatchHierarchy& hierarchy = solution.hierarchy();
+  for (const Patch& p : hierarchy.patches())
+    if (p.polygon >= scene.polygons().size())
+      throw Error(ErrorCode::invalid_argument, "render: the solution was not made from this scene");
+
+  Camera camera_settings = options.camera ? *options.camera : scene.camera();
+  const PinholeCamera camera(camera_settings, options.width, options.height);
+  const detail::RayScene rays = detail::RayScene::from_leaves(hierarchy);
+  const std::vector<Rgb> vertex_B = solution.vertex_radiosity();
+
+  // spp rounded up to a square for a jittered g x g grid per pixel.
+  const int g = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9));
+  const float inv_pi = 1.0f / glm::pi<float>();
+  Image image(options.width, options.height);
+
+  auto shade = [&](const glm::vec3& dir) -> Rgb {
+    auto hit = rays.intersect(camera.eye, dir, 0.0f, std::numeric_limits<float>::infinity());
+    if (!hit) return Rgb(0.0f);
+    // One-sided surfaces: the back of a polygon reflects nothing.
+    if (glm::dot(hierarchy.normal(hit->id), dir) >= 0.0f) return Rgb(0.0f);
+    const std::uint32_t* tri = rays.triangle(hit->triangle);
+    Rgb b = (1.0f - hit->u - hit->v) * vertex_B[tri[0]] + hit->u * vertex_B[tri[1]] + hit->v * vertex_B[tri[2]];
+    return b * inv_pi;
+  };
+
+  // Bands of rows: parallel inside a band, progress and cancel between bands, so the callback
+  // runs on this thread. Each pixel has its own random stream: thread count does not matter.
+  const int band = 16;
+  for (int y0 = 0; y0 < options.height; y0 += band) {
+    const int y1 = std::min(options.height, y0 + band);
+    const std::size_t count = static_cast<std::size_t>(y1 - y0) * options.width;
+    detail::parallel_for(options.threads, count, 64, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const int x = static_cast<int>(k % options.width), y = y0 + static_cast<int>(k / options.width);
+        detail::Rng rng(options.seed, static_cast<std::uint64_t>(y) * options.width + x, 0x7e11);
+        Rgb sum(0.0f);
+        for (int i = 0; i < g; ++i)
+          for (int j = 0; j < g; ++j) {
+            glm::vec2 u = rng.uniform2();
+            float sx = (static_cast<float>(x) + (static_cast<float>(i) + u.x) / g) / options.width;
+            float sy = (static_cast<float>(y) + (static_cast<float>(j) + u.y) / g) / options.height;
+            sum += shade(camera.direction(sx, sy));
+          }
+        image.at(x, y) = sum / static_cast<float>(g * g);
+      }
+    });
+    if (options.on_progress) {
+      Progress p{Phase::rendering, static_cast<double>(y1) / options.height, 0, 0.0};
+      if (!options.on_progress(p)) break;
+    }
+  }
+  return image;
+}
+
+}  // namespace v1
+}  // namespace radiosity

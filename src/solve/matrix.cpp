@@ -1,0 +1,130 @@
+// Matrix radiosity: all element-to-patch form factors computed once, then Jacobi or
+// Gauss-Seidel sweeps of B = E + rho F B.
+// Based on: Goral, Torrance, Greenberg & Battaile, SIGGRAPH 1984; Cohen & Greenberg, "The
+// hemi-cube", SIGGRAPH 1985 (Gauss-Seidel); Cohen, Greenberg, Immel & Brock, "An efficient
+// radiosity approach for realistic image synthesis", IEEE CG&A 1986 (element-to-patch
+// substructuring: m x n factors, never element to element).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "detail/parallel.hpp"
+#include "solve/system.hpp"
+
+namespace radiosity::detail {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z); }
+
+}  // namespace
+
+SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
+  const RadiositySystem& sys = ctx.system;
+  const std::size_t m = sys.unknowns(), n = sys.patches();
+  SolverResult result;
+  result.B = sys.emission;
+  result.H.assign(m, Rgb(0.0f));
+
+  const std::size_t bytes = m * n * sizeof(float);
+  if (bytes > ctx.options.memory_budget_bytes) {
+    std::ostringstream s;
+    s << "the form-factor matrix of " << m << " elements x " << n << " patches needs " << bytes / (1024.0 * 1024.0)
+      << " MiB, more than the memory budget of " << ctx.options.memory_budget_bytes / (1024.0 * 1024.0)
+      << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive or a coarser mesh";
+    throw Error(ErrorCode::memory_budget, s.str());
+  }
+  result.form_factor_bytes = bytes;
+
+  // Form factors, in chunks so that progress is reported and cancel is honoured.
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<float> F(m * n);
+  const std::size_t chunk = std::max<std::size_t>(64, m / 200);
+  std::vector<std::uint32_t> rows;
+  for (std::size_t begin = 0; begin < m; begin += chunk) {
+    std::size_t end = std::min(m, begin + chunk);
+    rows.assign(sys.leaves.begin() + static_cast<std::ptrdiff_t>(begin),
+                sys.leaves.begin() + static_cast<std::ptrdiff_t>(end));
+    ctx.estimator.element_rows(rows, F.data() + begin * n);
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = static_cast<double>(end) / static_cast<double>(m);
+    if (!ctx.progress.report(p, end == m)) {
+      result.status = SolveStatus::cancelled;
+      result.seconds_form_factors = seconds_since(t0);
+      return result;  // B = E is consistent: nothing has been propagated yet
+    }
+  }
+  result.seconds_form_factors = seconds_since(t0);
+
+  // Sweeps. Residual: power that the last sweep changed, over the emitted power.
+  auto t1 = std::chrono::steady_clock::now();
+  std::vector<Rgb> patch_B, next(m);
+  const int max_iterations = ctx.options.max_iterations;
+  result.status = SolveStatus::iteration_cap;
+  for (int it = 1; it <= max_iterations; ++it) {
+    sys.patch_means(result.B, patch_B);
+    double change = 0.0;
+    if (!gauss_seidel) {
+      // Jacobi: every element from the previous sweep's patch radiosity; rows are independent.
+      parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const float* row = F.data() + i * n;
+          Rgb gathered(0.0f);
+          for (std::size_t j = 0; j < n; ++j) gathered += row[j] * patch_B[j];
+          next[i] = sys.emission[i] + sys.reflectance[i] * gathered;
+        }
+      });
+      for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * l1(next[i] - result.B[i]);
+      result.B.swap(next);
+    } else {
+      // Gauss-Seidel: each element sees the patch means already updated by earlier elements.
+      for (std::size_t i = 0; i < m; ++i) {
+        const float* row = F.data() + i * n;
+        Rgb gathered(0.0f);
+        for (std::size_t j = 0; j < n; ++j) gathered += row[j] * patch_B[j];
+        Rgb b = sys.emission[i] + sys.reflectance[i] * gathered;
+        Rgb d = b - result.B[i];
+        change += sys.area[i] * l1(d);
+        patch_B[sys.patch[i]] += (sys.area[i] / sys.patch_area[sys.patch[i]]) * d;
+        result.B[i] = b;
+      }
+    }
+    result.iterations = it;
+    result.residual = change / sys.emitted;
+    result.residual_history.push_back(result.residual);
+    result.time_history.push_back(seconds_since(t1));
+    const bool done = result.residual < ctx.options.tolerance;
+    Progress p;
+    p.phase = Phase::solving;
+    p.iteration = it;
+    p.residual = result.residual;
+    p.fraction = done ? 1.0
+                      : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
+    if (done) result.status = SolveStatus::converged;
+    if (!ctx.progress.report(p, done)) {
+      result.status = SolveStatus::cancelled;
+      break;
+    }
+    if (done) break;
+  }
+
+  // Irradiance for the energy balance: H_e = sum_j F_ej B_j with the final radiosity.
+  sys.patch_means(result.B, patch_B);
+  parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const float* row = F.data() + i * n;
+      Rgb h(0.0f);
+      for (std::size_t j = 0; j < n; ++j) h += row[j] * patch_B[j];
+      result.H[i] = h;
+    }
+  });
+  return result;
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,55 @@
+#include "radiosity/solver.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+Solution::Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
+                   SolveStatus status, SolveReport report)
+    : hierarchy_(std::move(hierarchy)),
+      radiosity_(std::move(radiosity)),
+      groups_(std::move(groups)),
+      status_(status),
+      report_(std::move(report)) {
+  if (radiosity_.size() != hierarchy_.elements().size())
+    throw Error(ErrorCode::invalid_argument, "Solution: " + std::to_string(radiosity_.size()) +
+                                                 " radiosity values for " +
+                                                 std::to_string(hierarchy_.elements().size()) + " elements");
+}
+
+Rgb Solution::patch_radiosity(std::uint32_t patch) const {
+  return radiosity_.at(hierarchy_.patches().at(patch).root);
+}
+
+std::vector<Rgb> Solution::vertex_radiosity() const { return hierarchy_.vertex_values(radiosity_); }
+
+GroupId Solution::group_id(std::string_view group) const {
+  for (std::size_t i = 0; i < groups_.size(); ++i)
+    if (groups_[i] == group) return static_cast<GroupId>(i);
+  std::string known;
+  for (const std::string& g : groups_) known += (known.empty() ? "" : ", ") + g;
+  throw Error(ErrorCode::invalid_argument,
+              "no group named '" + std::string(group) + "' in the scene (groups: " + known + ")");
+}
+
+Rgb Solution::group_radiosity(std::string_view group) const {
+  const GroupId g = group_id(group);
+  glm::dvec3 sum(0.0);
+  double area = 0.0;
+  for (const Patch& p : hierarchy_.patches())
+    if (p.group == g) {
+      sum += static_cast<double>(p.area) * glm::dvec3(radiosity_[p.root]);
+      area += p.area;
+    }
+  return area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
+}
+
+double Solution::group_area(std::string_view group) const {
+  const GroupId g = group_id(group);
+  double area = 0.0;
+  for (const Patch& p : hierarchy_.patches())
+    if (p.group == g) area += p.area;
+  return area;
+}
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,44 @@
+#include "solve/system.hpp"
+
+namespace radiosity::detail {
+
+RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy) : leaves(hierarchy.leaves()) {
+  const std::size_t m = leaves.size();
+  area.resize(m);
+  emission.resize(m);
+  reflectance.resize(m);
+  patch.resize(m);
+  // Patch areas as the sum of their leaves, so a patch mean of a constant field is exact.
+  patch_area.assign(hierarchy.patches().size(), 0.0f);
+  for (std::size_t i = 0; i < m; ++i) {
+    const Element& e = hierarchy.element(leaves[i]);
+    const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
+    area[i] = e.area;
+    emission[i] = mat.emission;
+    reflectance[i] = mat.reflectance;
+    patch[i] = e.patch;
+    patch_area[e.patch] += e.area;
+    emitted += static_cast<double>(e.area) * (mat.emission.x + mat.emission.y + mat.emission.z);
+  }
+}
+
+void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const {
+  std::vector<glm::dvec3> sum(patch_area.size(), glm::dvec3(0.0));
+  for (std::size_t i = 0; i < B.size(); ++i) sum[patch[i]] += static_cast<double>(area[i]) * glm::dvec3(B[i]);
+  patch_B.resize(patch_area.size());
+  for (std::size_t j = 0; j < sum.size(); ++j) patch_B[j] = Rgb(sum[j] / static_cast<double>(patch_area[j]));
+}
+
+bool ProgressGate::report(const Progress& p, bool force) {
+  if (!fn_) return true;
+  auto now = std::chrono::steady_clock::now();
+  // Phase boundaries always get through; within a phase at most one call per 100 ms.
+  const bool new_phase = first_ || p.phase != phase_;
+  if (!force && !new_phase && now - last_ < std::chrono::milliseconds(100)) return true;
+  first_ = false;
+  phase_ = p.phase;
+  last_ = now;
+  return fn_(p);
+}
+
+}  // namespace radiosity::detail

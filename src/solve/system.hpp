@@ -1,0 +1,71 @@
+// The discrete radiosity system shared by the solvers: per-leaf data in the hierarchy's leaf
+// order, plus the bookkeeping every solver does (progress with cancel, residual history).
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "radiosity/form_factors.hpp"
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+#include "radiosity/solver.hpp"
+
+namespace radiosity::detail {
+
+/// B_e = E_e + rho_e sum_j F_ej B_j over the leaves e and patches j, B_j the area-weighted
+/// mean of patch j's leaves.
+struct RadiositySystem {
+  std::vector<std::uint32_t> leaves;  ///< element ids, index = unknown
+  std::vector<float> area;            ///< per unknown
+  std::vector<Rgb> emission, reflectance;
+  std::vector<std::uint32_t> patch;   ///< per unknown
+  std::vector<float> patch_area;
+  double emitted = 0.0;               ///< sum_e A_e (E_r + E_g + E_b), the residual's denominator
+
+  RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy);
+  std::size_t unknowns() const { return leaves.size(); }
+  std::size_t patches() const { return patch_area.size(); }
+  /// Patch radiosity from leaf radiosity.
+  void patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const;
+};
+
+/// What a solver hands back to solve().
+struct SolverResult {
+  std::vector<Rgb> B;          ///< per unknown
+  std::vector<Rgb> H;          ///< irradiance per unknown (for the absorbed power)
+  SolveStatus status = SolveStatus::converged;
+  int iterations = 0;
+  double residual = 0.0;
+  std::vector<double> residual_history, time_history;
+  std::size_t form_factor_bytes = 0;
+  double seconds_form_factors = 0.0;
+};
+
+/// Rate-limited progress reporting on the calling thread. report() returns false when the
+/// callback asked to cancel.
+class ProgressGate {
+ public:
+  explicit ProgressGate(const ProgressFn& fn) : fn_(fn) {}
+  bool report(const Progress& p, bool force = false);
+
+ private:
+  const ProgressFn& fn_;
+  std::chrono::steady_clock::time_point last_{};
+  Phase phase_ = Phase::meshing;
+  bool first_ = true;
+};
+
+struct SolverContext {
+  const Scene& scene;
+  const PatchHierarchy& hierarchy;
+  const RadiositySystem& system;
+  const FormFactorEstimator& estimator;
+  const SolveOptions& options;  ///< with max_iterations and memory_budget_bytes resolved
+  ProgressGate& progress;
+};
+
+SolverResult solve_matrix(const SolverContext& context, bool gauss_seidel);
+SolverResult solve_progressive(const SolverContext& context);
+
+}  // namespace radiosity::detail

@@ -1,0 +1,406 @@
+// Tests for PatchHierarchy: area bookkeeping, option handling, shared vertices, crack-free vertex
+// values, aggregation and area-uniform sampling.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <glm/geometric.hpp>
+
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+
+using namespace radiosity;
+
+namespace {
+
+Scene one_polygon(const std::vector<glm::vec3>& vertices) {
+  Scene scene;
+  const MaterialId m = scene.add_material(Material{});
+  scene.add_polygon(vertices, m, "p");
+  return scene;
+}
+
+// A triangle, a trapezoid (not a parallelogram, so its grid cells differ in size) and a regular
+// pentagon, in different planes and orientations.
+Scene mixed_scene() {
+  Scene scene;
+  const MaterialId m = scene.add_material(Material{});
+  scene.add_polygon({{0, 0, 0}, {3, 0, 0}, {0, 2, 0}}, m, "triangle");
+  scene.add_polygon({{0, 0, 5}, {4, 0, 5}, {3, 2, 5}, {1, 2, 5}}, m, "trapezoid");
+  std::vector<glm::vec3> pentagon;
+  for (int i = 0; i < 5; ++i) {
+    const float a = 2.0f * 3.14159265f * static_cast<float>(i) / 5.0f;
+    pentagon.emplace_back(10.0f, 1.5f * std::cos(a), 1.5f * std::sin(a));  // faces +x
+  }
+  scene.add_polygon(pentagon, m, "pentagon");
+  return scene;
+}
+
+double signed_area_along(const PatchHierarchy& h, std::uint32_t id) {
+  const Element& e = h.element(id);
+  const auto& v = h.vertices();
+  glm::vec3 twice(0.0f);
+  for (int k = 0; k < e.corner_count(); ++k)
+    twice += glm::cross(v[e.corners[k]], v[e.corners[(k + 1) % e.corner_count()]]);
+  return 0.5 * static_cast<double>(glm::dot(twice, h.normal(id)));
+}
+
+// Point-in-convex-element test in the element's plane, with an absolute slack.
+bool inside(const PatchHierarchy& h, std::uint32_t id, const glm::vec3& p, float slack) {
+  const Element& e = h.element(id);
+  const auto& v = h.vertices();
+  const glm::vec3 n = h.normal(id);
+  for (int k = 0; k < e.corner_count(); ++k) {
+    const glm::vec3 a = v[e.corners[k]], b = v[e.corners[(k + 1) % e.corner_count()]];
+    const glm::vec3 inward = glm::normalize(glm::cross(n, b - a));
+    if (glm::dot(p - a, inward) < -slack) return false;
+  }
+  return std::fabs(glm::dot(p - v[e.corners[0]], n)) <= slack;
+}
+
+// Deterministic uniform floats in [0, 1) (std distributions are not portable across libraries).
+struct Uniform {
+  std::mt19937 engine{12345u};
+  float operator()() { return static_cast<float>(engine() >> 8) * (1.0f / 16777216.0f); }
+};
+
+// Every vertex lying strictly inside a leaf's edge must carry the linear interpolation of the
+// edge's end values; then the piecewise-linear field on the finer side equals the coarse side's
+// linear one, i.e. there is no crack. Returns the largest deviation found.
+float largest_crack(const PatchHierarchy& h, const std::vector<Rgb>& vv) {
+  const auto& v = h.vertices();
+  float worst = 0.0f;
+  for (const std::uint32_t id : h.leaves()) {
+    const Element& e = h.element(id);
+    for (int k = 0; k < e.corner_count(); ++k) {
+      const std::uint32_t a = e.corners[k], b = e.corners[(k + 1) % e.corner_count()];
+      const glm::vec3 ab = v[b] - v[a];
+      const float len2 = glm::dot(ab, ab);
+      for (std::uint32_t m = 0; m < v.size(); ++m) {
+        if (m == a || m == b) continue;
+        const float t = glm::dot(v[m] - v[a], ab) / len2;
+        if (t <= 1e-4f || t >= 1.0f - 1e-4f) continue;
+        if (glm::length(v[a] + t * ab - v[m]) > 1e-5f * std::sqrt(len2)) continue;
+        const Rgb expected = (1.0f - t) * vv[a] + t * vv[b];
+        const Rgb d = glm::abs(expected - vv[m]);
+        worst = std::max({worst, d.x, d.y, d.z});
+      }
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_SUITE("mesh") {
+
+TEST_CASE("leaf and patch areas sum to each polygon's area (relative 1e-5)") {
+  const Scene scene = mixed_scene();
+  const PatchHierarchy h(scene, MeshOptions{0.3f, 0.05f});
+  std::vector<double> patch_sum(scene.polygons().size(), 0.0), leaf_sum(scene.polygons().size(), 0.0);
+  for (const Patch& p : h.patches()) patch_sum[p.polygon] += p.area;
+  for (const std::uint32_t id : h.leaves()) leaf_sum[h.patches()[h.element(id).patch].polygon] += h.element(id).area;
+  for (std::size_t i = 0; i < scene.polygons().size(); ++i) {
+    const double a = scene.polygons()[i].area;
+    CHECK(patch_sum[i] == doctest::Approx(a).epsilon(1e-5));
+    CHECK(leaf_sum[i] == doctest::Approx(a).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("every leaf fits max_element_area and every patch fits max_patch_area (relative 1e-5)") {
+  const Scene scene = mixed_scene();
+  for (const MeshOptions& options : {MeshOptions{0.3f, 0.05f}, MeshOptions{1.0f, 0.01f}, MeshOptions{}}) {
+    const PatchHierarchy h(scene, options);
+    const float max_patch = h.options().max_patch_area, max_element = h.options().max_element_area;
+    for (const Patch& p : h.patches()) CHECK(p.area <= max_patch * (1.0f + 1e-5f));
+    for (const std::uint32_t id : h.leaves()) CHECK(h.element(id).area <= max_element * (1.0f + 1e-5f));
+  }
+}
+
+TEST_CASE("triangles, quads and a pentagon mesh into counter-clockwise cells of the polygon") {
+  SUBCASE("a unit square with max_patch_area 0.25 is a 2x2 grid sharing 9 vertices") {
+    const PatchHierarchy h(one_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}), MeshOptions{0.25f, 0.25f});
+    CHECK(h.patches().size() == 4);
+    CHECK(h.vertices().size() == 9);
+    CHECK(h.leaves().size() == 4);
+    for (const Patch& p : h.patches()) CHECK(p.area == doctest::Approx(0.25).epsilon(1e-6));
+  }
+  SUBCASE("a triangle of area 1 with max_patch_area 1/9 is a 3x3 lattice of 9 similar triangles") {
+    const PatchHierarchy h(one_polygon({{0, 0, 0}, {2, 0, 0}, {0, 1, 0}}), MeshOptions{1.0f / 9.0f, 1.0f / 9.0f});
+    CHECK(h.patches().size() == 9);
+    CHECK(h.vertices().size() == 10);
+    for (const Patch& p : h.patches()) CHECK(p.area == doctest::Approx(1.0 / 9.0).epsilon(1e-5));
+  }
+  SUBCASE("a pentagon is a fan of three triangles, each meshed on its own") {
+    std::vector<glm::vec3> pentagon;
+    for (int i = 0; i < 5; ++i) {
+      const float a = 2.0f * 3.14159265f * static_cast<float>(i) / 5.0f;
+      pentagon.emplace_back(std::cos(a), std::sin(a), 0.0f);
+    }
+    const PatchHierarchy h(one_polygon(pentagon), MeshOptions{100.0f, 100.0f});
+    CHECK(h.patches().size() == 3);
+    CHECK(h.vertices().size() == 9);  // vertices are not shared across the fan diagonals
+  }
+  SUBCASE("every cell of a mixed scene is counter-clockwise about its polygon's normal") {
+    const Scene scene = mixed_scene();
+    const PatchHierarchy h(scene, MeshOptions{0.3f, 0.05f});
+    for (std::uint32_t id = 0; id < h.elements().size(); ++id) {
+      const Element& e = h.element(id);
+      CHECK(signed_area_along(h, id) == doctest::Approx(e.area).epsilon(1e-4));
+      CHECK(inside(h, id, e.centroid, 1e-4f));
+    }
+    for (const Patch& p : h.patches()) {
+      CHECK(p.normal == scene.polygons()[p.polygon].normal);
+      CHECK(p.group == scene.polygons()[p.polygon].group);
+      CHECK(p.centroid == h.element(p.root).centroid);
+      CHECK(h.element(p.root).parent == kNone);
+      CHECK(h.element(p.root).depth == 0);
+    }
+  }
+}
+
+TEST_CASE("effective options are derived from the scene's total area") {
+  const Scene scene = one_polygon({{0, 0, 0}, {32, 0, 0}, {32, 32, 0}, {0, 32, 0}});
+  const PatchHierarchy derived(scene, MeshOptions{});
+  CHECK(derived.options().max_patch_area == doctest::Approx(1024.0 / 512.0));
+  CHECK(derived.options().max_element_area == doctest::Approx(1024.0 / 512.0 / 4.0));
+  // Cells of side <= sqrt(2): a 23 x 23 grid, each patch split once.
+  CHECK(derived.patches().size() == 23 * 23);
+  CHECK(derived.leaves().size() == 4 * 23 * 23);
+
+  const PatchHierarchy element_only(scene, MeshOptions{0.0f, 8.0f});
+  CHECK(element_only.options().max_patch_area == 8.0f);  // raised to the explicit element limit
+  CHECK(element_only.options().max_element_area == 8.0f);
+
+  const PatchHierarchy patch_only(scene, MeshOptions{16.0f, 0.0f});
+  CHECK(patch_only.options().max_element_area == 4.0f);
+}
+
+TEST_CASE("bad options throw Error{invalid_argument} naming the field") {
+  const Scene scene = one_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto message = [&](const MeshOptions& o) -> std::string {
+    try {
+      PatchHierarchy h(scene, o);
+    } catch (const Error& e) {
+      CHECK(e.code() == ErrorCode::invalid_argument);
+      return e.what();
+    }
+    return "(no throw)";
+  };
+  CHECK(message(MeshOptions{-1.0f, 0.0f}).find("max_patch_area") != std::string::npos);
+  CHECK(message(MeshOptions{nan, 0.0f}).find("max_patch_area") != std::string::npos);
+  CHECK(message(MeshOptions{0.0f, -0.5f}).find("max_element_area") != std::string::npos);
+  CHECK(message(MeshOptions{0.0f, nan}).find("max_element_area") != std::string::npos);
+  const std::string too_big = message(MeshOptions{0.1f, 0.2f});
+  CHECK(too_big.find("max_element_area") != std::string::npos);
+  CHECK(too_big.find("max_patch_area") != std::string::npos);
+  CHECK(message(MeshOptions{1e-12f, 1e-12f}).find("max_element_area") != std::string::npos);  // absurd size
+}
+
+TEST_CASE("neighbours subdividing the same edge share its midpoint") {
+  SUBCASE("quads") {
+    // Two unit patches side by side share the edge x = 1: 6 grid vertices.
+    PatchHierarchy h(one_polygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}}), MeshOptions{1.0f, 1.0f});
+    REQUIRE(h.patches().size() == 2);
+    REQUIRE(h.vertices().size() == 6);
+    h.subdivide(h.patches()[0].root);
+    CHECK(h.vertices().size() == 6 + 4 + 1);  // 4 edge midpoints + centre
+    h.subdivide(h.patches()[1].root);
+    CHECK(h.vertices().size() == 11 + 3 + 1);  // the shared edge's midpoint is reused
+    CHECK(h.leaves().size() == 8);
+    std::size_t at_shared_midpoint = 0;
+    for (const std::uint32_t id : h.leaves())
+      for (const std::uint32_t c : h.element(id).corners)
+        if (c != kNone && h.vertices()[c] == glm::vec3(1.0f, 0.5f, 0.0f)) ++at_shared_midpoint;
+    CHECK(at_shared_midpoint == 4);  // two children on each side touch the one shared vertex
+  }
+  SUBCASE("triangles") {
+    // k = 2: three "up" and one "down" triangle on 6 lattice vertices.
+    PatchHierarchy h(one_polygon({{0, 0, 0}, {2, 0, 0}, {0, 2, 0}}), MeshOptions{0.5f, 0.5f});
+    REQUIRE(h.patches().size() == 4);
+    REQUIRE(h.vertices().size() == 6);
+    std::size_t added = 0;
+    for (const Patch& p : h.patches()) {
+      const std::size_t before = h.vertices().size();
+      h.subdivide(p.root);
+      added += h.vertices().size() - before;
+    }
+    CHECK(added == 9);  // the 9 edges of the 4 triangles each get exactly one midpoint
+    CHECK(h.vertices().size() == 15);  // = the vertex count of a k = 4 lattice
+  }
+}
+
+TEST_CASE("subdivide keeps leaves() ordered and rejects inner nodes and bad ids") {
+  PatchHierarchy h(one_polygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}}), MeshOptions{1.0f, 1.0f});
+  const std::uint32_t root0 = h.patches()[0].root, root1 = h.patches()[1].root;
+  const std::uint32_t first = h.subdivide(root0);
+  CHECK(h.leaves() == std::vector<std::uint32_t>{first, root1, first + 1, first + 2, first + 3});
+  for (std::uint32_t i = 0; i < h.leaves().size(); ++i) CHECK(h.leaf_index(h.leaves()[i]) == i);
+  CHECK(h.leaf_index(root0) == kNone);
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    CHECK(h.element(first + k).parent == root0);
+    CHECK(h.element(first + k).depth == 1);
+    CHECK(h.element(first + k).patch == 0);
+    CHECK(h.element(first + k).area == doctest::Approx(0.25).epsilon(1e-6));
+  }
+  CHECK_THROWS_AS(h.subdivide(root0), Error);
+  CHECK_THROWS_AS(h.subdivide(static_cast<std::uint32_t>(h.elements().size())), Error);
+}
+
+TEST_CASE("a constant field is reproduced exactly at every vertex") {
+  PatchHierarchy h(mixed_scene(), MeshOptions{0.3f, 0.05f});
+  // Irregular refinement, so that T-vertices exist.
+  for (std::uint32_t i = 0; i < 40; ++i) h.subdivide(h.leaves()[(i * 7919u) % h.leaves().size()]);
+  const Rgb c(0.1f, 0.7f, 3.3f);
+  const std::vector<Rgb> values(h.elements().size(), c);
+  for (const Rgb& v : h.vertex_values(values)) CHECK(v == c);
+}
+
+TEST_CASE("vertex values are continuous across T-vertices, nested ones included (abs 1e-5)") {
+  // Patch 1 of a 2x1 strip is refined twice along the shared edge x = 1, patch 0 not at all.
+  PatchHierarchy h(one_polygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}}), MeshOptions{1.0f, 1.0f});
+  const std::uint32_t first = h.subdivide(h.patches()[1].root);
+  h.subdivide(first);      // child at (c0, m01, ctr, m30): touches x = 1 on [0, 0.5]
+  h.subdivide(first + 3);  // child at (m30, ctr, m23, c3): touches x = 1 on [0.5, 1]
+  std::vector<Rgb> values(h.elements().size());
+  Uniform u;
+  for (Rgb& v : values) v = Rgb(u(), u(), u());
+  const std::vector<Rgb> vv = h.vertex_values(values);
+
+  // The coarse side interpolates linearly between (1, 0) and (1, 1); the fine side has vertices
+  // at y = 0.25, 0.5, 0.75 on that edge. Each must lie on the coarse side's line.
+  const auto& v = h.vertices();
+  auto vertex_at = [&](float y) {
+    for (std::uint32_t i = 0; i < v.size(); ++i)
+      if (v[i] == glm::vec3(1.0f, y, 0.0f)) return i;
+    return kNone;
+  };
+  const std::uint32_t a = vertex_at(0.0f), b = vertex_at(1.0f);
+  REQUIRE(a != kNone);
+  REQUIRE(b != kNone);
+  for (const float y : {0.25f, 0.5f, 0.75f}) {
+    const std::uint32_t m = vertex_at(y);
+    REQUIRE(m != kNone);
+    const Rgb expected = (1.0f - y) * vv[a] + y * vv[b];
+    CHECK(glm::length(vv[m] - expected) < 1e-5f);
+  }
+  CHECK(largest_crack(h, vv) < 1e-5f);
+}
+
+TEST_CASE("randomly refined meshes have no cracks in their vertex values (abs 1e-5)") {
+  // No fan-meshed polygon here: the vertices of neighbouring fan triangles coincide without being
+  // shared, so their values may legitimately differ.
+  Scene scene;
+  const MaterialId material = scene.add_material(Material{});
+  scene.add_polygon({{0, 0, 0}, {3, 0, 0}, {0, 2, 0}}, material, "triangle");
+  scene.add_polygon({{0, 0, 5}, {4, 0, 5}, {3, 2, 5}, {1, 2, 5}}, material, "trapezoid");
+  PatchHierarchy h(scene, MeshOptions{0.5f, 0.5f});
+  Uniform u;
+  for (int i = 0; i < 60; ++i) {
+    const auto& leaves = h.leaves();
+    h.subdivide(leaves[static_cast<std::size_t>(u() * static_cast<float>(leaves.size())) % leaves.size()]);
+  }
+  std::vector<Rgb> values(h.elements().size());
+  for (Rgb& v : values) v = Rgb(u(), u(), u());
+  const std::vector<Rgb> vv = h.vertex_values(values);
+  for (const Rgb& v : vv) CHECK(std::isfinite(v.x + v.y + v.z));
+  CHECK(largest_crack(h, vv) < 1e-5f);
+}
+
+TEST_CASE("aggregate gives inner nodes the area-weighted mean of their children (relative 1e-5)") {
+  PatchHierarchy h(mixed_scene(), MeshOptions{0.3f, 0.05f});
+  std::vector<Rgb> values(h.elements().size(), Rgb(-1.0f));  // inner nodes are overwritten
+  Uniform u;
+  for (const std::uint32_t id : h.leaves()) values[id] = Rgb(u(), u(), u());
+  const std::vector<Rgb> leaves_before = values;
+  h.aggregate(values);
+  for (const std::uint32_t id : h.leaves()) CHECK(values[id] == leaves_before[id]);
+  for (const Patch& p : h.patches()) {
+    // The root is the area-weighted mean of all leaves below it.
+    glm::dvec3 sum(0.0);
+    double area = 0.0;
+    for (const std::uint32_t id : h.leaves())
+      if (h.element(id).patch == h.element(p.root).patch) {
+        sum += static_cast<double>(h.element(id).area) * glm::dvec3(values[id]);
+        area += h.element(id).area;
+      }
+    const glm::dvec3 mean = sum / area;
+    CHECK(values[p.root].x == doctest::Approx(mean.x).epsilon(1e-5));
+    CHECK(values[p.root].y == doctest::Approx(mean.y).epsilon(1e-5));
+    CHECK(values[p.root].z == doctest::Approx(mean.z).epsilon(1e-5));
+  }
+  std::vector<Rgb> wrong_size(3);
+  CHECK_THROWS_AS(h.aggregate(wrong_size), Error);
+  CHECK_THROWS_AS(h.vertex_values(wrong_size), Error);
+}
+
+TEST_CASE("sample_point stays inside the element and is area-uniform (5 sigma)") {
+  // One trapezoid patch (cells of unequal triangles) and one triangle patch.
+  Scene scene;
+  const MaterialId m = scene.add_material(Material{});
+  scene.add_polygon({{0, 0, 0}, {4, 0, 0}, {3, 1, 0}, {1, 1, 0}}, m, "trapezoid");
+  scene.add_polygon({{0, 0, 2}, {0, 3, 2}, {1, 0, 2}}, m, "triangle");
+  PatchHierarchy h(scene, MeshOptions{100.0f, 100.0f});
+  REQUIRE(h.patches().size() == 2);
+  for (const Patch& p : h.patches()) {
+    const std::uint32_t root = p.root;
+    const std::uint32_t first = h.subdivide(root);  // children to count samples in
+    const int n = 40000;
+    Uniform u;
+    glm::dvec3 mean(0.0);
+    int in_child[4] = {0, 0, 0, 0};
+    bool all_inside = true;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 x = h.sample_point(root, glm::vec2(u(), u()));
+      all_inside = all_inside && inside(h, root, x, 1e-5f);
+      mean += glm::dvec3(x);
+      for (std::uint32_t k = 0; k < 4; ++k)
+        if (inside(h, first + k, x, 1e-6f)) {
+          ++in_child[k];
+          break;
+        }
+    }
+    CHECK(all_inside);
+    CHECK(in_child[0] + in_child[1] + in_child[2] + in_child[3] == n);
+    mean /= double(n);
+    // Coordinates span <= 4 units, so their standard deviation is < 2 and the mean's < 2/sqrt(n) = 0.01.
+    CHECK(glm::length(mean - glm::dvec3(h.element(root).centroid)) < 0.05);
+    for (std::uint32_t k = 0; k < 4; ++k) {
+      const double q = double(h.element(first + k).area) / double(h.element(root).area);
+      const double sigma = std::sqrt(n * q * (1.0 - q));
+      CHECK(std::fabs(in_child[k] - n * q) < 5.0 * sigma);
+    }
+  }
+}
+
+TEST_CASE("meshing is deterministic") {
+  const Scene scene = mixed_scene();
+  const PatchHierarchy a(scene, MeshOptions{0.3f, 0.05f}), b(scene, MeshOptions{0.3f, 0.05f});
+  REQUIRE(a.elements().size() == b.elements().size());
+  CHECK(a.leaves() == b.leaves());
+  CHECK(a.vertices() == b.vertices());
+  for (std::size_t i = 0; i < a.elements().size(); ++i) CHECK(a.elements()[i].corners == b.elements()[i].corners);
+}
+
+TEST_CASE("the default Cornell box meshes into a few hundred patches and a few thousand elements") {
+  const Scene scene = cornell_box();
+  const PatchHierarchy h(scene, MeshOptions{});
+  const std::size_t patches = h.patches().size(), leaves = h.leaves().size();
+  MESSAGE("Cornell box, default options: " << patches << " patches, " << leaves << " leaf elements, "
+                                           << h.elements().size() << " elements, " << h.vertices().size()
+                                           << " vertices");
+  CHECK(patches >= 200);
+  CHECK(patches <= 1500);
+  CHECK(leaves >= 1000);
+  CHECK(leaves <= 10000);
+  double area = 0.0;
+  for (const std::uint32_t id : h.leaves()) area += h.element(id).area;
+  CHECK(area == doctest::Approx(scene.total_area()).epsilon(1e-5));
+}
+
+}  // TEST_SUITE("mesh")

@@ -1,0 +1,173 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <vector>
+
+#include <radiosity/radiosity.hpp>
+
+#include "support/scenes.hpp"
+
+namespace rad = radiosity;
+
+namespace {
+
+rad::Material furnace_material() {
+  rad::Material m;
+  m.name = "furnace";
+  m.emission = rad::Rgb(1.0f, 2.0f, 0.5f);
+  m.reflectance = rad::Rgb(0.5f, 0.8f, 0.2f);
+  return m;
+}
+
+rad::SolveOptions coarse(rad::SolverMethod method) {
+  rad::SolveOptions o;
+  o.method = method;
+  o.mesh.max_patch_area = 0.26f;  // 4 patches per unit face
+  o.mesh.max_element_area = 0.07f;
+  o.tolerance = 1e-6;
+  return o;
+}
+
+}  // namespace
+
+TEST_SUITE("solve") {
+  TEST_CASE("furnace: a closed box with uniform E and rho gives B = E/(1-rho) within 0.1% for every method") {
+    const rad::Material m = furnace_material();
+    const rad::Scene scene = test::closed_box(m);
+    const rad::Rgb expected = m.emission / (rad::Rgb(1.0f) - m.reflectance);
+    for (rad::SolverMethod method :
+         {rad::SolverMethod::jacobi, rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      rad::Solution sol = rad::solve(scene, coarse(method));
+      CHECK(sol.status() == rad::SolveStatus::converged);
+      const auto& h = sol.hierarchy();
+      for (std::uint32_t e : h.leaves())
+        for (int c = 0; c < 3; ++c) CHECK(sol.radiosity()[e][c] == doctest::Approx(expected[c]).epsilon(1e-3));
+      // Closed: everything emitted is absorbed.
+      const rad::SolveReport& r = sol.report();
+      for (int c = 0; c < 3; ++c)
+        CHECK(r.absorbed_power[c] == doctest::Approx(r.emitted_power[c]).epsilon(1e-3));
+    }
+  }
+
+  TEST_CASE("Jacobi, Gauss-Seidel and progressive agree on the Cornell box within 0.5%") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 12000.0f;
+    o.mesh.max_element_area = 6000.0f;
+    o.tolerance = 1e-5;
+    o.method = rad::SolverMethod::gauss_seidel;
+    rad::Solution gs = rad::solve(scene, o);
+    o.method = rad::SolverMethod::jacobi;
+    rad::Solution jacobi = rad::solve(scene, o);
+    o.method = rad::SolverMethod::progressive;
+    rad::Solution progressive = rad::solve(scene, o);
+    REQUIRE(gs.status() == rad::SolveStatus::converged);
+    REQUIRE(jacobi.status() == rad::SolveStatus::converged);
+    REQUIRE(progressive.status() == rad::SolveStatus::converged);
+    // Gauss-Seidel needs fewer sweeps than Jacobi.
+    CHECK(gs.report().iterations < jacobi.report().iterations);
+    for (const std::string& g : scene.groups()) {
+      CAPTURE(g);
+      rad::Rgb a = gs.group_radiosity(g), b = jacobi.group_radiosity(g), c = progressive.group_radiosity(g);
+      for (int k = 0; k < 3; ++k) {
+        CHECK(b[k] == doctest::Approx(a[k]).epsilon(5e-3));
+        CHECK(c[k] == doctest::Approx(a[k]).epsilon(5e-3));
+      }
+    }
+  }
+
+  TEST_CASE("open Cornell box: emitted power = absorbed + escaped, with escape through the open front") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 20000.0f;
+    o.mesh.max_element_area = 20000.0f;
+    o.tolerance = 1e-6;
+    rad::Solution sol = rad::solve(scene, o);
+    const rad::SolveReport& r = sol.report();
+    for (int c = 0; c < 3; ++c) {
+      CHECK(r.absorbed_power[c] < r.emitted_power[c]);
+      CHECK(r.absorbed_power[c] > 0.5f * r.emitted_power[c]);
+    }
+    // The light is the brightest group and the red wall is red.
+    rad::Rgb red = sol.group_radiosity("red_wall");
+    CHECK(red.x > 3.0f * red.y);
+    rad::Rgb green = sol.group_radiosity("green_wall");
+    CHECK(green.y > 1.5f * green.x);
+  }
+
+  TEST_CASE("same seed gives bit-identical results at 1 and 2 threads") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 20000.0f;
+    o.mesh.max_element_area = 10000.0f;
+    o.threads = 1;
+    rad::Solution a = rad::solve(scene, o);
+    o.threads = 2;
+    rad::Solution b = rad::solve(scene, o);
+    REQUIRE(a.radiosity().size() == b.radiosity().size());
+    bool same = true;
+    for (std::size_t i = 0; i < a.radiosity().size(); ++i) same &= a.radiosity()[i] == b.radiosity()[i];
+    CHECK(same);
+  }
+
+  TEST_CASE("a progress callback that returns false cancels and leaves a consistent estimate") {
+    const rad::Scene scene = test::closed_box(furnace_material());
+    rad::SolveOptions o = coarse(rad::SolverMethod::progressive);
+    int calls = 0;
+    o.on_progress = [&](const rad::Progress& p) {
+      ++calls;
+      return p.phase != rad::Phase::solving;
+    };
+    rad::Solution sol = rad::solve(scene, o);
+    CHECK(sol.status() == rad::SolveStatus::cancelled);
+    CHECK(calls > 0);
+    // At least the emission is there, and nothing is more than the converged answer.
+    for (std::uint32_t e : sol.hierarchy().leaves()) {
+      CHECK(sol.radiosity()[e].x >= 1.0f);
+      CHECK(sol.radiosity()[e].x <= 2.0f + 1e-4f);
+    }
+  }
+
+  TEST_CASE("bad options are rejected naming the field") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.tolerance = 0.0;
+    CHECK_THROWS_WITH_AS(rad::solve(scene, o), doctest::Contains("tolerance"), rad::Error);
+    o = {};
+    o.mesh.max_element_area = -1.0f;
+    CHECK_THROWS_WITH_AS(rad::solve(scene, o), doctest::Contains("max_element_area"), rad::Error);
+    o = {};
+    o.max_iterations = -3;
+    CHECK_THROWS_WITH_AS(rad::solve(scene, o), doctest::Contains("max_iterations"), rad::Error);
+    CHECK_THROWS_AS(rad::solve(rad::Scene{}, rad::SolveOptions{}), rad::Error);
+  }
+
+  TEST_CASE("a matrix larger than the memory budget is refused with advice, not allocated") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.memory_budget_bytes = 1024;
+    try {
+      rad::solve(scene, o);
+      FAIL("expected a memory budget error");
+    } catch (const rad::Error& e) {
+      CHECK(e.code() == rad::ErrorCode::memory_budget);
+      CHECK(std::string(e.what()).find("progressive") != std::string::npos);
+    }
+  }
+
+  TEST_CASE("group_radiosity of an unknown group names it") {
+    const rad::Scene scene = test::closed_box(furnace_material());
+    rad::Solution sol = rad::solve(scene, coarse(rad::SolverMethod::gauss_seidel));
+    CHECK_THROWS_WITH_AS(sol.group_radiosity("nope"), doctest::Contains("nope"), rad::Error);
+    CHECK(sol.group_area("x0") == doctest::Approx(1.0));
+  }
+
+  TEST_CASE("a scene that emits nothing solves to zero with a warning") {
+    rad::Material m;
+    m.reflectance = rad::Rgb(0.5f);
+    rad::Solution sol = rad::solve(test::closed_box(m), coarse(rad::SolverMethod::jacobi));
+    CHECK(sol.group_radiosity("x0") == rad::Rgb(0.0f));
+    CHECK_FALSE(sol.report().warnings.empty());
+  }
+}

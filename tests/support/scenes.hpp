@@ -1,0 +1,58 @@
+// Small scenes and closed-form references shared by the tests.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <radiosity/radiosity.hpp>
+
+namespace test {
+
+namespace rad = radiosity;
+
+/// An axis-aligned box [0,sx]x[0,sy]x[0,sz] of six inward-facing quads, one material, groups
+/// "x0","x1","y0","y1","z0","z1".
+inline rad::Scene closed_box(const rad::Material& m, glm::vec3 s = glm::vec3(1.0f)) {
+  rad::Scene scene;
+  rad::MaterialId id = scene.add_material(m);
+  const float X = s.x, Y = s.y, Z = s.z;
+  const glm::vec3 centre = 0.5f * s;
+  // Each face is listed once and turned to face the centre.
+  auto add = [&](std::vector<glm::vec3> q, const char* group) {
+    glm::vec3 n = glm::cross(q[1] - q[0], q[2] - q[0]);
+    if (glm::dot(n, centre - q[0]) < 0.0f) std::reverse(q.begin(), q.end());
+    scene.add_polygon(q, id, group);
+  };
+  add({{0, 0, 0}, {0, 0, Z}, {0, Y, Z}, {0, Y, 0}}, "x0");
+  add({{X, 0, 0}, {X, Y, 0}, {X, Y, Z}, {X, 0, Z}}, "x1");
+  add({{0, 0, 0}, {X, 0, 0}, {X, 0, Z}, {0, 0, Z}}, "y0");
+  add({{0, Y, 0}, {0, Y, Z}, {X, Y, Z}, {X, Y, 0}}, "y1");
+  add({{0, 0, 0}, {0, Y, 0}, {X, Y, 0}, {X, 0, 0}}, "z0");
+  add({{0, 0, Z}, {X, 0, Z}, {X, Y, Z}, {0, Y, Z}}, "z1");
+  return scene;
+}
+
+/// Howell C-11: parallel, directly opposed rectangles a x b at distance c.
+inline double parallel_rectangles(double a, double b, double c) {
+  const double X = a / c, Y = b / c, pi = 3.14159265358979323846;
+  const double x1 = std::sqrt(1 + X * X), y1 = std::sqrt(1 + Y * Y);
+  return 2.0 / (pi * X * Y) *
+         (std::log(x1 * y1 / std::sqrt(1 + X * X + Y * Y)) + X * y1 * std::atan(X / y1) + Y * x1 * std::atan(Y / x1) -
+          X * std::atan(X) - Y * std::atan(Y));
+}
+
+/// Howell C-14: rectangles at 90 degrees sharing an edge of length l; source width w, receiver height h.
+inline double perpendicular_rectangles(double l, double w, double h) {
+  const double H = h / l, W = w / l, pi = 3.14159265358979323846;
+  const double H2 = H * H, W2 = W * W, S = std::sqrt(H2 + W2);
+  const double a = (1 + W2) * (1 + H2) / (1 + W2 + H2);
+  const double b = W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2));
+  const double c = H2 * (1 + H2 + W2) / ((1 + H2) * (H2 + W2));
+  return 1.0 / (pi * W) *
+         (W * std::atan(1 / W) + H * std::atan(1 / H) - S * std::atan(1 / S) +
+          0.25 * (std::log(a) + W2 * std::log(b) + H2 * std::log(c)));
+}
+
+}  // namespace test
