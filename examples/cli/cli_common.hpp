@@ -1,0 +1,167 @@
+// Pieces shared by the subcommands of the `radiosity` CLI.
+#pragma once
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "radiosity/radiosity.hpp"
+
+namespace cli {
+
+namespace rad = radiosity;
+
+/// A one-line progress bar with rate and ETA on a terminal; silent when stderr is not a tty.
+class ProgressBar {
+ public:
+  ProgressBar() : enabled_(isatty(STDERR_FILENO) != 0) {}
+  ~ProgressBar() { finish(); }
+
+  bool update(const rad::Progress& p) {
+    if (!enabled_) return true;
+    auto now = std::chrono::steady_clock::now();
+    if (p.phase != phase_ || !started_) {
+      finish();
+      phase_ = p.phase;
+      started_ = true;
+      start_ = now;
+    }
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double f = std::clamp(p.fraction, 0.0, 1.0);
+    const int width = 30, filled = static_cast<int>(f * width);
+    std::string bar(static_cast<std::size_t>(filled), '#');
+    bar.resize(width, '.');
+    char line[200];
+    if (p.phase == rad::Phase::solving) {
+      std::snprintf(line, sizeof line, "\r%-13s [%s] %3.0f%%  it %d  residual %.2e  %.1f it/s ", name(p.phase),
+                    bar.c_str(), 100 * f, p.iteration, p.residual, elapsed > 0 ? p.iteration / elapsed : 0.0);
+    } else {
+      const double eta = f > 0 ? elapsed * (1 - f) / f : 0.0;
+      std::snprintf(line, sizeof line, "\r%-13s [%s] %3.0f%%  %.1f%%/s  ETA %.0fs ", name(p.phase), bar.c_str(),
+                    100 * f, elapsed > 0 ? 100 * f / elapsed : 0.0, eta);
+    }
+    std::fputs(line, stderr);
+    dirty_ = true;
+    return true;
+  }
+
+  void finish() {
+    if (dirty_) std::fputs("\n", stderr);
+    dirty_ = false;
+  }
+
+ private:
+  static const char* name(rad::Phase p) {
+    switch (p) {
+      case rad::Phase::meshing: return "meshing";
+      case rad::Phase::form_factors: return "form factors";
+      case rad::Phase::solving: return "solving";
+      case rad::Phase::refining: return "refining";
+      case rad::Phase::rendering: return "rendering";
+    }
+    return "";
+  }
+
+  bool enabled_;
+  bool started_ = false;
+  bool dirty_ = false;
+  rad::Phase phase_ = rad::Phase::meshing;
+  std::chrono::steady_clock::time_point start_;
+};
+
+struct SolveArgs {
+  std::string scene;
+  std::string method = "gauss-seidel";
+  std::string form_factors = "ray-cast";
+  float max_patch_area = 0.0f;
+  float max_element_area = 0.0f;
+  double tolerance = 1e-3;
+  unsigned threads = 0;
+  std::uint64_t seed = 1;
+  int max_iterations = 0;
+};
+
+inline void add_solve_options(CLI::App& cmd, SolveArgs& a) {
+  cmd.add_option("--method", a.method, "Solver")
+      ->check(CLI::IsMember({"jacobi", "gauss-seidel", "progressive"}))
+      ->capture_default_str();
+  cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
+      ->check(CLI::IsMember({"ray-cast", "analytic"}))
+      ->capture_default_str();
+  cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--tolerance", a.tolerance, "Stop when unshot/emitted power falls below this")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd.add_option("--max-iterations", a.max_iterations, "Sweeps or shooting steps at most (0 = default)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)");
+  cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
+      ->capture_default_str();
+}
+
+inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
+  rad::SolveOptions o;
+  o.method = a.method == "jacobi"        ? rad::SolverMethod::jacobi
+             : a.method == "progressive" ? rad::SolverMethod::progressive
+                                         : rad::SolverMethod::gauss_seidel;
+  o.form_factors.method =
+      a.form_factors == "analytic" ? rad::FormFactorMethod::analytic : rad::FormFactorMethod::ray_cast;
+  o.mesh.max_patch_area = a.max_patch_area;
+  o.mesh.max_element_area = a.max_element_area;
+  o.tolerance = a.tolerance;
+  o.max_iterations = a.max_iterations;
+  o.threads = a.threads;
+  o.seed = a.seed;
+  o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+  return o;
+}
+
+inline rad::Scene load(const std::string& path) {
+  if (path.empty() || path == "cornell-box") return rad::cornell_box();
+  return rad::load_scene(path);
+}
+
+inline void print_warnings(const std::vector<std::string>& warnings) {
+  for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
+inline void print_summary(const rad::Solution& sol) {
+  const rad::SolveReport& r = sol.report();
+  const char* status = sol.status() == rad::SolveStatus::converged       ? "converged"
+                       : sol.status() == rad::SolveStatus::iteration_cap ? "iteration cap"
+                                                                         : "cancelled";
+  std::printf("solved: %zu patches, %zu elements, %d iterations, residual %.3g (%s)\n", r.patch_count,
+              r.element_count, r.iterations, r.residual, status);
+  std::printf("time: meshing %.3f s, form factors %.3f s, solving %.3f s\n", r.seconds_meshing,
+              r.seconds_form_factors, r.seconds_solving);
+}
+
+inline glm::vec3 parse_vec3(const std::string& s, const char* name) {
+  glm::vec3 v;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(s);
+  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !in.eof())
+    throw CLI::ValidationError(name, "expected x,y,z, got '" + s + "'");
+  return v;
+}
+
+/// A subcommand added by another file: `run` is called when the user chose it and returns the
+/// process exit code.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+}  // namespace cli

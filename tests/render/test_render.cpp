@@ -1,0 +1,76 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include <radiosity/radiosity.hpp>
+
+#include "support/scenes.hpp"
+
+namespace rad = radiosity;
+
+TEST_SUITE("render") {
+  TEST_CASE("inside a furnace every pixel shows B/pi = E/((1-rho) pi)") {
+    rad::Material m;
+    m.emission = rad::Rgb(1.0f, 2.0f, 3.0f);
+    m.reflectance = rad::Rgb(0.5f);
+    rad::Scene scene = test::closed_box(m);
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 0.26f;
+    o.mesh.max_element_area = 0.07f;
+    o.tolerance = 1e-6;
+    rad::Solution sol = rad::solve(scene, o);
+    rad::RenderOptions ro;
+    ro.width = 24;
+    ro.height = 16;
+    ro.spp = 4;
+    ro.camera = rad::Camera{{0.5f, 0.5f, 0.1f}, {0.5f, 0.6f, 1.0f}, {0, 1, 0}, 90.0f};
+    rad::Image img = rad::render(scene, sol, ro);
+    REQUIRE(img.width == 24);
+    REQUIRE(img.height == 16);
+    const float pi = 3.14159265f;
+    for (const rad::Rgb& p : img.pixels)
+      for (int c = 0; c < 3; ++c) CHECK(p[c] == doctest::Approx(2.0f * m.emission[c] / pi).epsilon(2e-3));
+  }
+
+  TEST_CASE("the Cornell box image is identical at 1 and 2 threads and shows the red wall on the left") {
+    rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 20000.0f;
+    o.mesh.max_element_area = 20000.0f;
+    rad::Solution sol = rad::solve(scene, o);
+    rad::RenderOptions ro;
+    ro.width = 32;
+    ro.height = 32;
+    ro.threads = 1;
+    rad::Image a = rad::render(scene, sol, ro);
+    ro.threads = 2;
+    rad::Image b = rad::render(scene, sol, ro);
+    CHECK(a.pixels == b.pixels);
+    // Published camera: +x (the red wall) appears on the left of the picture.
+    const rad::Rgb left = a.at(2, 16), right = a.at(29, 16);
+    CHECK(left.x > 2.0f * left.y);
+    CHECK(right.y > 1.5f * right.x);
+  }
+
+  TEST_CASE("bad render options are rejected") {
+    rad::Scene scene = test::closed_box(rad::Material{});
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 1.0f;
+    o.mesh.max_element_area = 1.0f;
+    rad::Solution sol = rad::solve(scene, o);
+    rad::RenderOptions ro;
+    ro.width = 0;
+    CHECK_THROWS_AS(rad::render(scene, sol, ro), rad::Error);
+    ro.width = 8;
+    ro.spp = 0;
+    CHECK_THROWS_AS(rad::render(scene, sol, ro), rad::Error);
+    // A solution of another scene.
+    rad::Scene cornell = rad::cornell_box();
+    rad::SolveOptions co;
+    co.mesh.max_patch_area = 40000.0f;
+    co.mesh.max_element_area = 40000.0f;
+    rad::Solution other = rad::solve(cornell, co);
+    ro.spp = 1;
+    CHECK_THROWS_AS(rad::render(scene, other, ro), rad::Error);
+  }
+}
