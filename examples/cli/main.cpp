@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
     } else if (*solve) {
       rad::Scene scene = load(solve_args.scene);
       print_warnings(scene.warnings());
-      rad::Solution sol = rad::solve(scene, to_options(solve_args, bar));
+      const rad::SolveOptions options = to_options(solve_args, bar);
+      rad::Solution sol = rad::solve(scene, options);
       bar.finish();
       print_summary(sol);
       for (const std::string& g : sol.groups()) {
@@ -99,7 +100,7 @@ int main(int argc, char** argv) {
         std::printf("  %-16s B = (%.5g, %.5g, %.5g)  area %.6g\n", g.c_str(), b.x, b.y, b.z, sol.group_area(g));
       }
       if (!stats.empty()) {
-        rad::write_stats_json(sol, stats);
+        rad::write_stats_json(sol, stats, options, solve_args.scene.empty() ? "cornell-box" : solve_args.scene);
         std::printf("wrote %s\n", stats.c_str());
       }
       if (!ply.empty()) {

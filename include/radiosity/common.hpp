@@ -44,6 +44,8 @@ class RADIOSITY_API Error : public std::runtime_error {
   ErrorCode code_;
 };
 
+class PatchHierarchy;  // mesh.hpp
+
 /// Stage of a long computation that a progress report refers to.
 enum class Phase { meshing, form_factors, solving, refining, rendering };
 
@@ -53,6 +55,14 @@ struct Progress {
   double fraction = 0.0;   ///< of the current phase, in [0, 1]; solvers estimate it from the residual
   int iteration = 0;       ///< sweeps (matrix methods) or shooting steps (progressive)
   double residual = 0.0;   ///< unshot / emitted power (see SolveOptions::tolerance)
+  /// While solving: the current estimate, so an application can display it incrementally.
+  /// `leaf_radiosity` has one value per leaf of `*hierarchy`, in hierarchy->leaves() order.
+  /// Both pointers are valid only during the call; null in other phases.
+  const PatchHierarchy* hierarchy = nullptr;
+  const Rgb* leaf_radiosity = nullptr;
+  /// Progressive refinement's ambient radiosity estimate (Cohen et al. 1988): add
+  /// reflectance x ambient to a leaf's radiosity for display. Zero for the matrix methods.
+  Rgb ambient{0.0f};
 };
 
 /// Called on the thread that started the computation, one call at a time, at phase

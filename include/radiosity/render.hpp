@@ -37,6 +37,9 @@ struct RenderOptions {
   std::optional<Camera> camera;  ///< default: the scene's camera
   unsigned threads = 0;          ///< 0 = all hardware threads
   std::uint64_t seed = 1;
+  /// Show radiosity plus reflectance x ambient (Solution::radiosity_with_ambient): the usual
+  /// display of an unfinished progressive solution.
+  bool ambient = false;
   ProgressFn on_progress;
 };
 

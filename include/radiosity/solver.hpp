@@ -63,8 +63,11 @@ struct SolveReport {
 class RADIOSITY_API Solution {
  public:
   Solution() = default;
+  /// `radiosity` and `ambient_radiosity` are indexed by element id (inner nodes included);
+  /// `ambient_radiosity` is reflectance x ambient per element, or empty for none.
   Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
-           SolveStatus status, SolveReport report);
+           SolveStatus status, SolveReport report, Rgb ambient = Rgb(0.0f),
+           std::vector<Rgb> ambient_radiosity = {});
   Solution(Solution&&) noexcept = default;
   Solution& operator=(Solution&&) noexcept = default;
   Solution(const Solution&) = delete;
@@ -76,8 +79,16 @@ class RADIOSITY_API Solution {
   /// Radiosity B (W/m^2) per element id; inner nodes hold the area-weighted mean of their children.
   const std::vector<Rgb>& radiosity() const { return radiosity_; }
   Rgb patch_radiosity(std::uint32_t patch) const;
-  /// Per-vertex radiosity for display (see PatchHierarchy::vertex_values).
-  std::vector<Rgb> vertex_radiosity() const;
+  /// The ambient radiosity of progressive refinement (Cohen et al. 1988): the unshot radiosity
+  /// that remained, times the mean interreflection factor 1 / (1 - mean reflectance). Zero
+  /// for the matrix methods and for a converged progressive solve below tolerance it is small.
+  Rgb ambient() const { return ambient_; }
+  /// radiosity() plus reflectance x ambient per element: the usual display of an unfinished
+  /// progressive solution. Equals radiosity() when the ambient is zero.
+  std::vector<Rgb> radiosity_with_ambient() const;
+  /// Per-vertex radiosity for display (see PatchHierarchy::vertex_values), optionally with
+  /// the ambient term.
+  std::vector<Rgb> vertex_radiosity(bool with_ambient = false) const;
   /// Area-weighted mean radiosity over the patches of a group. Throws Error{invalid_argument}
   /// naming the group when the scene has no such group.
   Rgb group_radiosity(std::string_view group) const;
@@ -92,6 +103,8 @@ class RADIOSITY_API Solution {
   std::vector<std::string> groups_;
   SolveStatus status_ = SolveStatus::converged;
   SolveReport report_;
+  Rgb ambient_{0.0f};
+  std::vector<Rgb> ambient_radiosity_;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field.

@@ -15,33 +15,10 @@
 #include "detail/rng.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/render.hpp"
+#include "render/camera.hpp"
 
 namespace radiosity {
 inline namespace v1 {
-
-namespace {
-
-struct PinholeCamera {
-  glm::vec3 eye, forward, right, up;
-  float tan_half_fov, aspect;
-
-  PinholeCamera(const Camera& c, int width, int height)
-      : eye(c.eye),
-        forward(glm::normalize(c.look_at - c.eye)),
-        right(glm::normalize(glm::cross(forward, c.up))),
-        up(glm::cross(right, forward)),
-        tan_half_fov(std::tan(glm::radians(0.5f * c.fov_deg))),
-        aspect(static_cast<float>(width) / static_cast<float>(height)) {}
-
-  /// Direction through image position (sx, sy) in [0,1]^2, (0,0) the top-left corner.
-  glm::vec3 direction(float sx, float sy) const {
-    float px = (2.0f * sx - 1.0f) * tan_half_fov * aspect;
-    float py = (1.0f - 2.0f * sy) * tan_half_fov;
-    return glm::normalize(forward + px * right + py * up);
-  }
-};
-
-}  // namespace
 
 Image render(const Scene& scene, const Solution& solution, const RenderOptions& options) {
   if (options.width <= 0 || options.height <= 0)
@@ -55,9 +32,9 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
       throw Error(ErrorCode::invalid_argument, "render: the solution was not made from this scene");
 
   Camera camera_settings = options.camera ? *options.camera : scene.camera();
-  const PinholeCamera camera(camera_settings, options.width, options.height);
+  const detail::PinholeCamera camera(camera_settings, options.width, options.height);
   const detail::RayScene rays = detail::RayScene::from_leaves(hierarchy);
-  const std::vector<Rgb> vertex_B = solution.vertex_radiosity();
+  const std::vector<Rgb> vertex_B = solution.vertex_radiosity(options.ambient);
 
   // spp rounded up to a square for a jittered g x g grid per pixel.
   const int g = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9));

@@ -107,6 +107,8 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
     p.fraction = done ? 1.0
                       : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
     if (done) result.status = SolveStatus::converged;
+    p.hierarchy = &ctx.hierarchy;
+    p.leaf_radiosity = result.B.data();
     if (!ctx.progress.report(p, done)) {
       result.status = SolveStatus::cancelled;
       break;

@@ -44,6 +44,20 @@ SolverResult solve_progressive(const SolverContext& ctx) {
   const std::size_t column_bytes = m * sizeof(float);
   std::vector<float> scratch(m);
 
+  // Ambient radiosity: the unshot power spread over the whole scene area and multiplied by the
+  // interreflection factor (Cohen et al. 1988, eqs. 5-6). For display only; it tends to 0.
+  auto ambient = [&] {
+    glm::dvec3 sum(0.0);
+    for (std::size_t j = 0; j < n; ++j) sum += static_cast<double>(sys.patch_area[j]) * glm::dvec3(unshot[j]);
+    return Rgb(sum / sys.total_area) * sys.interreflection;
+  };
+  auto report = [&](Progress p, bool force) {
+    p.hierarchy = &ctx.hierarchy;
+    p.leaf_radiosity = result.B.data();
+    p.ambient = ambient();
+    return ctx.progress.report(p, force);
+  };
+
   auto t0 = std::chrono::steady_clock::now();
   result.status = SolveStatus::iteration_cap;
   for (int step = 1; step <= ctx.options.max_iterations; ++step) {
@@ -59,7 +73,7 @@ SolverResult solve_progressive(const SolverContext& ctx) {
     if (residual < ctx.options.tolerance) {
       result.residual = residual;
       result.status = SolveStatus::converged;
-      ctx.progress.report(Progress{Phase::solving, 1.0, result.iterations, residual}, true);
+      report(Progress{Phase::solving, 1.0, result.iterations, residual}, true);
       break;
     }
 
@@ -94,12 +108,13 @@ SolverResult solve_progressive(const SolverContext& ctx) {
     result.time_history.push_back(seconds_since(t0));
     Progress p{Phase::solving, std::clamp(std::log(residual) / std::log(ctx.options.tolerance), 0.0, 1.0), step,
                residual};
-    if (!ctx.progress.report(p)) {
+    if (!report(p, false)) {
       result.status = SolveStatus::cancelled;
       break;
     }
   }
   result.form_factor_bytes = cached_bytes + column_bytes;
+  result.ambient = ambient();
   if (result.status != SolveStatus::converged) {
     double total = 0.0;
     for (std::size_t j = 0; j < n; ++j) total += sum3(unshot[j]) * sys.patch_area[j];

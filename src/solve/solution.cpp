@@ -4,12 +4,16 @@ namespace radiosity {
 inline namespace v1 {
 
 Solution::Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
-                   SolveStatus status, SolveReport report)
+                   SolveStatus status, SolveReport report, Rgb ambient, std::vector<Rgb> ambient_radiosity)
     : hierarchy_(std::move(hierarchy)),
       radiosity_(std::move(radiosity)),
       groups_(std::move(groups)),
       status_(status),
-      report_(std::move(report)) {
+      report_(std::move(report)),
+      ambient_(ambient),
+      ambient_radiosity_(std::move(ambient_radiosity)) {
+  if (!ambient_radiosity_.empty() && ambient_radiosity_.size() != hierarchy_.elements().size())
+    throw Error(ErrorCode::invalid_argument, "Solution: ambient_radiosity must be empty or have one value per element");
   if (radiosity_.size() != hierarchy_.elements().size())
     throw Error(ErrorCode::invalid_argument, "Solution: " + std::to_string(radiosity_.size()) +
                                                  " radiosity values for " +
@@ -20,7 +24,15 @@ Rgb Solution::patch_radiosity(std::uint32_t patch) const {
   return radiosity_.at(hierarchy_.patches().at(patch).root);
 }
 
-std::vector<Rgb> Solution::vertex_radiosity() const { return hierarchy_.vertex_values(radiosity_); }
+std::vector<Rgb> Solution::radiosity_with_ambient() const {
+  std::vector<Rgb> out = radiosity_;
+  for (std::size_t i = 0; i < ambient_radiosity_.size(); ++i) out[i] += ambient_radiosity_[i];
+  return out;
+}
+
+std::vector<Rgb> Solution::vertex_radiosity(bool with_ambient) const {
+  return hierarchy_.vertex_values(with_ambient ? radiosity_with_ambient() : radiosity_);
+}
 
 GroupId Solution::group_id(std::string_view group) const {
   for (std::size_t i = 0; i < groups_.size(); ++i)

@@ -97,7 +97,15 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   report.emitted_power = Rgb(emitted);
   report.absorbed_power = Rgb(absorbed);
   hierarchy.aggregate(B_elements);
-  return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), r.status, std::move(report));
+  std::vector<Rgb> ambient_elements;
+  if (r.ambient != Rgb(0.0f)) {
+    ambient_elements.assign(hierarchy.elements().size(), Rgb(0.0f));
+    for (std::size_t i = 0; i < system.unknowns(); ++i)
+      ambient_elements[system.leaves[i]] = system.reflectance[i] * r.ambient;
+    hierarchy.aggregate(ambient_elements);
+  }
+  return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), r.status, std::move(report),
+                  r.ambient, std::move(ambient_elements));
 }
 
 }  // namespace v1

@@ -19,7 +19,12 @@ RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hiera
     patch[i] = e.patch;
     patch_area[e.patch] += e.area;
     emitted += static_cast<double>(e.area) * (mat.emission.x + mat.emission.y + mat.emission.z);
+    total_area += e.area;
   }
+  glm::dvec3 mean_rho(0.0);
+  for (std::size_t i = 0; i < m; ++i) mean_rho += static_cast<double>(area[i]) * glm::dvec3(reflectance[i]);
+  if (total_area > 0.0) mean_rho /= total_area;
+  interreflection = Rgb(1.0 / (glm::dvec3(1.0) - mean_rho));
 }
 
 void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const {

@@ -22,6 +22,10 @@ struct RadiositySystem {
   std::vector<std::uint32_t> patch;   ///< per unknown
   std::vector<float> patch_area;
   double emitted = 0.0;               ///< sum_e A_e (E_r + E_g + E_b), the residual's denominator
+  /// 1 / (1 - area-weighted mean reflectance), per channel: the interreflection factor of the
+  /// ambient term (Cohen et al. 1988, eq. 6).
+  Rgb interreflection{1.0f};
+  double total_area = 0.0;
 
   RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy);
   std::size_t unknowns() const { return leaves.size(); }
@@ -34,6 +38,7 @@ struct RadiositySystem {
 struct SolverResult {
   std::vector<Rgb> B;          ///< per unknown
   std::vector<Rgb> H;          ///< irradiance per unknown (for the absorbed power)
+  Rgb ambient{0.0f};           ///< progressive refinement's ambient radiosity at the end
   SolveStatus status = SolveStatus::converged;
   int iterations = 0;
   double residual = 0.0;

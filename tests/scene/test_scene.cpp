@@ -94,7 +94,7 @@ TEST_SUITE("scene") {
     CHECK(s.polygons().empty());
   }
 
-  TEST_CASE("reflectance outside [0,1), negative emission and NaN are rejected naming the material") {
+  TEST_CASE("reflectance of 1 or more, negative emission and NaN are rejected naming the material") {
     rad::Scene s;
     rad::Material m;
     m.name = "bright";

@@ -1,0 +1,115 @@
+// Private helpers shared by the reflection models in src/brdf: constants, parameter checks and
+// sampling warps. Not installed.
+//
+// Based on:
+//   Shirley, P. & Chiu, K. (1997). A low distortion map between disk and square.
+//     Journal of Graphics Tools 2(3), 45-52. (concentric disk map for cosine sampling)
+//   Malley's method (Malley 1988, MSc thesis, Univ. of Utah): cosine-weighted directions are
+//     uniform disk points projected up onto the hemisphere.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "radiosity/brdf.hpp"
+#include "radiosity/common.hpp"
+
+namespace radiosity {
+namespace detail {
+namespace brdf {
+
+constexpr float kPi = 3.14159265358979323846f;
+constexpr float kInvPi = 0.318309886183790671538f;
+constexpr float kInv2Pi = 0.159154943091895335769f;
+/// Largest float below 1, so that u in [0, 1) stays there after clamping.
+constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+
+inline float clamp01(float u) { return std::min(std::max(u, 0.0f), kOneMinusEpsilon); }
+inline glm::vec2 clamp01(const glm::vec2& u) { return {clamp01(u.x), clamp01(u.y)}; }
+
+inline bool all_finite(const Rgb& c) { return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z); }
+inline float mean(const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; }
+
+[[noreturn]] inline void throw_invalid(const std::string& where, const std::string& what) {
+  throw Error(ErrorCode::invalid_argument, where + ": " + what);
+}
+
+/// Each channel finite and in [0, 1]; `name` is the parameter named in the error.
+inline void check_unit_rgb(const char* where, const char* name, const Rgb& c) {
+  if (!all_finite(c)) throw_invalid(where, std::string(name) + " is not finite");
+  for (int k = 0; k < 3; ++k) {
+    if (c[k] < 0.0f || c[k] > 1.0f) {
+      throw_invalid(where, std::string(name) + " channel " + std::to_string(k) + " = " + std::to_string(c[k]) +
+                               " is outside [0, 1]");
+    }
+  }
+}
+
+/// diffuse and specular each in [0, 1] and their sum <= 1 per channel (energy conservation).
+inline void check_diffuse_specular(const char* where, const Rgb& diffuse, const Rgb& specular) {
+  check_unit_rgb(where, "diffuse", diffuse);
+  check_unit_rgb(where, "specular", specular);
+  for (int k = 0; k < 3; ++k) {
+    if (diffuse[k] + specular[k] > 1.0f) {
+      throw_invalid(where, "diffuse + specular = " + std::to_string(diffuse[k] + specular[k]) + " in channel " +
+                               std::to_string(k) + " exceeds 1 (not energy conserving)");
+    }
+  }
+}
+
+inline void check_positive(const char* where, const char* name, float v) {
+  if (!std::isfinite(v)) throw_invalid(where, std::string(name) + " is not finite");
+  if (!(v > 0.0f)) throw_invalid(where, std::string(name) + " = " + std::to_string(v) + " must be > 0");
+}
+
+inline void check_non_negative(const char* where, const char* name, float v) {
+  if (!std::isfinite(v)) throw_invalid(where, std::string(name) + " is not finite");
+  if (v < 0.0f) throw_invalid(where, std::string(name) + " = " + std::to_string(v) + " must be >= 0");
+}
+
+/// Mirror direction of w about the normal (0, 0, 1).
+inline glm::vec3 reflect_z(const glm::vec3& w) { return {-w.x, -w.y, w.z}; }
+
+/// Mirror direction of w about the unit vector h: 2 (w.h) h - w.
+inline glm::vec3 reflect_about(const glm::vec3& w, const glm::vec3& h) { return 2.0f * glm::dot(w, h) * h - w; }
+
+/// Concentric map of [0,1)^2 onto the unit disk (Shirley & Chiu 1997): area-preserving, and
+/// continuous, so stratification survives.
+inline glm::vec2 concentric_disk(const glm::vec2& u) {
+  const float a = 2.0f * u.x - 1.0f;
+  const float b = 2.0f * u.y - 1.0f;
+  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
+  float r = 0.0f;
+  float phi = 0.0f;
+  if (std::abs(a) > std::abs(b)) {
+    r = a;
+    phi = (kPi / 4.0f) * (b / a);
+  } else {
+    r = b;
+    phi = (kPi / 2.0f) - (kPi / 4.0f) * (a / b);
+  }
+  return {r * std::cos(phi), r * std::sin(phi)};
+}
+
+/// Cosine-weighted direction on the upper hemisphere (Malley's method); pdf = cos theta / pi.
+inline glm::vec3 sample_cosine_hemisphere(const glm::vec2& u) {
+  const glm::vec2 d = concentric_disk(u);
+  const float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
+  return {d.x, d.y, z};
+}
+
+inline float cosine_hemisphere_pdf(const glm::vec3& w) { return w.z > 0.0f ? w.z * kInvPi : 0.0f; }
+
+/// Remaps u (in [0, 1)) that fell below `p` (or above it) back onto [0, 1) so that one uniform
+/// number both picks a lobe and drives that lobe's sampler.
+inline float remap_below(float u, float p) { return clamp01(u / p); }
+inline float remap_above(float u, float p) { return clamp01((u - p) / (1.0f - p)); }
+
+}  // namespace brdf
+}  // namespace detail
+}  // namespace radiosity

@@ -1,0 +1,14 @@
+// Scene readers behind load_scene(), one per file format. Internal: load_scene() picks one by
+// the file's extension.
+#pragma once
+
+#include <filesystem>
+
+#include "radiosity/scene.hpp"
+
+namespace radiosity::detail {
+
+/// Wavefront OBJ with its MTL libraries (see load_scene() in io.hpp for the mapping).
+Scene load_obj(const std::filesystem::path& path);
+
+}  // namespace radiosity::detail

@@ -1,0 +1,254 @@
+// PLY export of a solution's leaves and the --stats JSON, on a hand-made Solution (a quad and a
+// triangle meshed into a few patches, one leaf subdivided so the mesh has hanging vertices).
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <nlohmann/json.hpp>
+
+#include "io/srgb.hpp"
+#include "radiosity/io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using radiosity::Error;
+using radiosity::ErrorCode;
+using radiosity::Rgb;
+
+const fs::path kTmp = RADIOSITY_TEST_TMP;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+/// A solution whose radiosity is a smooth function of position, with a hand-written report.
+radiosity::Solution small_solution() {
+  radiosity::Scene scene;
+  radiosity::Material white;
+  white.name = "white";
+  white.reflectance = Rgb(0.7f);
+  radiosity::Material lamp;
+  lamp.name = "lamp";
+  lamp.emission = Rgb(10.0f, 8.0f, 6.0f);
+  const radiosity::MaterialId w = scene.add_material(white);
+  const radiosity::MaterialId l = scene.add_material(lamp);
+  scene.add_polygon({{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, w, "floor");
+  scene.add_polygon({{0, 1, 0}, {1, 1, 0}, {0, 1, 1}}, l, "light");
+
+  radiosity::MeshOptions mesh;
+  mesh.max_patch_area = 0.25f;
+  mesh.max_element_area = 0.25f;
+  radiosity::PatchHierarchy h(scene, mesh);
+  h.subdivide(h.leaves().front());
+
+  std::vector<Rgb> B(h.elements().size());
+  for (std::uint32_t leaf : h.leaves()) {
+    const glm::vec3 c = h.element(leaf).centroid;
+    B[leaf] = Rgb(1.0f + c.x, 2.0f + c.z, 3.0f + c.y);
+  }
+  h.aggregate(B);
+
+  radiosity::SolveReport report;
+  report.iterations = 3;
+  report.residual = 5e-4;
+  report.residual_history = {0.5, 0.01, 5e-4};
+  report.time_history = {0.1, 0.2, 0.3};
+  report.patch_count = h.patches().size();
+  report.element_count = h.leaves().size();
+  report.form_factor_bytes = 1234;
+  report.emitted_power = Rgb(5.0f, 4.0f, 3.0f);
+  report.absorbed_power = Rgb(4.5f, 3.5f, 2.5f);
+  report.seconds_meshing = 0.001;
+  report.seconds_form_factors = 0.25;
+  report.seconds_solving = 0.125;
+  report.warnings = {"first warning", "second warning"};
+  std::vector<std::string> groups = scene.groups();
+  return radiosity::Solution(std::move(h), std::move(B), std::move(groups), radiosity::SolveStatus::iteration_cap,
+                             std::move(report));
+}
+
+std::string read_all(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+template <typename T>
+T get_le(const std::string& bytes, std::size_t offset) {
+  std::uint8_t b[sizeof(T)];
+  for (std::size_t i = 0; i < sizeof(T); ++i) b[i] = static_cast<std::uint8_t>(bytes[offset + i]);
+  std::uint32_t u = 0;
+  for (std::size_t i = sizeof(T); i-- > 0;) u = (u << 8) | b[i];
+  T v;
+  std::memcpy(&v, &u, sizeof(T));
+  return v;
+}
+
+float triangle_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const glm::vec3 u = b - a, v = c - a;
+  const glm::vec3 n(u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x);
+  return 0.5f * std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+}
+
+}  // namespace
+
+TEST_SUITE("io") {
+
+TEST_CASE("write_ply writes the leaves as triangles over the vertices they use, with radiosity and sRGB colour") {
+  const radiosity::Solution sol = small_solution();
+  const radiosity::PatchHierarchy& h = sol.hierarchy();
+  std::set<std::uint32_t> used;
+  std::size_t triangles = 0;
+  double leaf_area = 0.0;
+  for (std::uint32_t leaf : h.leaves()) {
+    const radiosity::Element& e = h.element(leaf);
+    for (int c = 0; c < e.corner_count(); ++c) used.insert(e.corners[static_cast<std::size_t>(c)]);
+    triangles += static_cast<std::size_t>(e.corner_count() - 2);
+    leaf_area += e.area;
+  }
+
+  fs::create_directories(kTmp);
+  const fs::path path = kTmp / "solution.ply";
+  radiosity::write_ply(sol, path, radiosity::PngOptions{0.5f});
+  const std::string bytes = read_all(path);
+
+  const std::size_t end = bytes.find("end_header\n");
+  REQUIRE(end != std::string::npos);
+  std::istringstream header(bytes.substr(0, end));
+  std::string line;
+  std::getline(header, line);
+  CHECK(line == "ply");
+  std::getline(header, line);
+  CHECK(line == "format binary_little_endian 1.0");
+  std::size_t vertices = 0, faces = 0;
+  std::vector<std::string> properties;
+  while (std::getline(header, line)) {
+    std::istringstream words(line);
+    std::string a, b, c;
+    words >> a >> b >> c;
+    if (a == "element" && b == "vertex") vertices = std::stoul(c);
+    if (a == "element" && b == "face") faces = std::stoul(c);
+    if (a == "property") properties.push_back(line);
+  }
+  CHECK(vertices == used.size());
+  CHECK(faces == triangles);
+  CHECK(vertices < h.vertices().size() + 1);
+  REQUIRE(properties.size() == 10);
+  CHECK(properties[0] == "property float x");
+  CHECK(properties[3] == "property float radiosity_r");
+  CHECK(properties[6] == "property uchar red");
+  CHECK(properties[9] == "property list uchar int vertex_indices");
+
+  // Body: 27 bytes a vertex, 13 a triangle, nothing else.
+  const std::size_t body = end + std::string("end_header\n").size();
+  REQUIRE(bytes.size() == body + 27 * vertices + 13 * faces);
+  const std::vector<Rgb> B = sol.vertex_radiosity();
+  std::vector<glm::vec3> positions(vertices);
+  for (std::size_t i = 0; i < vertices; ++i) {
+    const std::size_t o = body + 27 * i;
+    positions[i] = glm::vec3(get_le<float>(bytes, o), get_le<float>(bytes, o + 4), get_le<float>(bytes, o + 8));
+    const Rgb b(get_le<float>(bytes, o + 12), get_le<float>(bytes, o + 16), get_le<float>(bytes, o + 20));
+    // Find the hierarchy vertex at this position and compare its radiosity.
+    bool found = false;
+    for (std::uint32_t v : used)
+      if (h.vertices()[v] == positions[i]) {
+        found = true;
+        CHECK(b == B[v]);
+        // Display colour: sRGB of exposure x B / pi.
+        for (int c = 0; c < 3; ++c)
+          CHECK(static_cast<std::uint8_t>(bytes[o + 24 + static_cast<std::size_t>(c)]) ==
+                radiosity::detail::srgb8(0.5f * b[c] / 3.14159265358979323846f));
+      }
+    CHECK(found);
+  }
+  double area = 0.0;
+  for (std::size_t t = 0; t < faces; ++t) {
+    const std::size_t o = body + 27 * vertices + 13 * t;
+    CHECK(static_cast<std::uint8_t>(bytes[o]) == 3);
+    std::uint32_t idx[3];
+    for (int k = 0; k < 3; ++k) {
+      idx[k] = get_le<std::uint32_t>(bytes, o + 1 + 4 * static_cast<std::size_t>(k));
+      REQUIRE(idx[k] < vertices);
+    }
+    area += triangle_area(positions[idx[0]], positions[idx[1]], positions[idx[2]]);
+  }
+  CHECK(area == doctest::Approx(leaf_area).epsilon(1e-5));
+  CHECK(area == doctest::Approx(1.5).epsilon(1e-5));  // unit quad + half-unit triangle
+}
+
+TEST_CASE("write_ply errors name the path") {
+  const radiosity::Solution sol = small_solution();
+  const fs::path bad = kTmp / "no_such_dir" / "out.ply";
+  try {
+    radiosity::write_ply(sol, bad);
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK(e.code() == ErrorCode::io_error);
+    CHECK(contains(e.what(), bad.string()));
+  }
+}
+
+TEST_CASE("write_stats_json records status, sizes, power, per-group radiosity, timings and warnings") {
+  const radiosity::Solution sol = small_solution();
+  fs::create_directories(kTmp);
+  const fs::path path = kTmp / "stats.json";
+  radiosity::write_stats_json(sol, path);
+  const nlohmann::json j = nlohmann::json::parse(read_all(path));
+
+  CHECK(j.at("version") == radiosity::version());
+  CHECK(!j.contains("method"));
+  CHECK(j.at("status") == "iteration_cap");
+  CHECK(j.at("iterations") == 3);
+  CHECK(j.at("residual").get<double>() == 5e-4);
+  CHECK(j.at("patches") == sol.hierarchy().patches().size());
+  CHECK(j.at("elements") == sol.hierarchy().leaves().size());
+  CHECK(j.at("form_factor_bytes") == 1234);
+  CHECK(j.at("emitted_power") == nlohmann::json::array({5.0, 4.0, 3.0}));
+  CHECK(j.at("absorbed_power") == nlohmann::json::array({4.5, 3.5, 2.5}));
+  CHECK(j.at("mesh").at("max_patch_area").get<double>() == doctest::Approx(0.25));
+  for (const char* g : {"floor", "light"}) {
+    const nlohmann::json& group = j.at("groups").at(g);
+    const Rgb B = sol.group_radiosity(g);
+    for (int c = 0; c < 3; ++c) CHECK(group.at("radiosity")[static_cast<std::size_t>(c)].get<float>() == B[c]);
+    CHECK(group.at("area").get<double>() == doctest::Approx(sol.group_area(g)));
+  }
+  CHECK(j.at("groups").at("floor").at("area").get<double>() == doctest::Approx(1.0));
+  CHECK(j.at("timings").at("meshing").get<double>() == 0.001);
+  CHECK(j.at("timings").at("form_factors").get<double>() == 0.25);
+  CHECK(j.at("timings").at("solving").get<double>() == 0.125);
+  CHECK(j.at("residual_history") == nlohmann::json::array({0.5, 0.01, 5e-4}));
+  CHECK(j.at("time_history").size() == 3);
+  CHECK(j.at("warnings") == nlohmann::json::array({"first warning", "second warning"}));
+}
+
+TEST_CASE("write_stats_json with options records the scene and the solve's method") {
+  const radiosity::Solution sol = small_solution();
+  radiosity::SolveOptions opt;
+  opt.method = radiosity::SolverMethod::progressive;
+  opt.form_factors.method = radiosity::FormFactorMethod::analytic;
+  opt.tolerance = 1e-4;
+  const fs::path path = kTmp / "stats_options.json";
+  radiosity::write_stats_json(sol, path, opt, "room.obj");
+  const nlohmann::json j = nlohmann::json::parse(read_all(path));
+  CHECK(j.at("scene") == "room.obj");
+  CHECK(j.at("method") == "progressive");
+  CHECK(j.at("form_factor_method") == "analytic");
+  CHECK(j.at("tolerance").get<double>() == 1e-4);
+  CHECK(j.at("status") == "iteration_cap");
+
+  const fs::path bad = kTmp / "no_such_dir" / "stats.json";
+  try {
+    radiosity::write_stats_json(sol, bad);
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK(e.code() == ErrorCode::io_error);
+    CHECK(contains(e.what(), bad.string()));
+  }
+}
+
+}  // TEST_SUITE("io")

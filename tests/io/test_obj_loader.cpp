@@ -1,0 +1,243 @@
+// load_scene() on OBJ/MTL fixtures in tests/data: groups, material mapping, triangulation
+// warnings, and an Error naming the file and the line for every kind of broken input.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "radiosity/io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using radiosity::Error;
+using radiosity::ErrorCode;
+using radiosity::Rgb;
+
+const fs::path kData = RADIOSITY_TEST_DATA;
+const fs::path kTmp = RADIOSITY_TEST_TMP;
+constexpr float kPi = 3.14159265358979323846f;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+/// Loads a file that must fail; returns the error.
+Error load_error(const fs::path& path) {
+  try {
+    radiosity::load_scene(path);
+  } catch (const Error& e) {
+    return e;
+  }
+  FAIL("load_scene(" << path.string() << ") did not throw");
+  return Error(ErrorCode::internal, "");
+}
+
+/// Checks code, and that the message names `file` and "file:line:".
+void check_error(const fs::path& path, ErrorCode code, const std::string& file, int line, const std::string& problem) {
+  Error e = load_error(path);
+  INFO("message: " << e.what());
+  CHECK(e.code() == code);
+  CHECK(contains(e.what(), file + ":" + std::to_string(line) + ":"));
+  CHECK(contains(e.what(), problem));
+}
+
+fs::path write_tmp(const std::string& name, const std::string& text) {
+  fs::create_directories(kTmp);
+  const fs::path p = kTmp / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+bool near(const Rgb& a, const Rgb& b, float eps = 1e-5f) {
+  return std::fabs(a.x - b.x) <= eps && std::fabs(a.y - b.y) <= eps && std::fabs(a.z - b.z) <= eps;
+}
+
+}  // namespace
+
+TEST_SUITE("io") {
+
+TEST_CASE("two quads keep o/g names as groups, Kd as reflectance and pi*Ke as emission") {
+  radiosity::Scene s = radiosity::load_scene(kData / "two_quads.obj");
+  REQUIRE(s.polygons().size() == 2);
+  REQUIRE(s.groups().size() == 2);
+  CHECK(s.groups()[0] == "floor");
+  CHECK(s.groups()[1] == "light");
+  CHECK(s.warnings().empty());
+
+  const radiosity::Polygon& floor = s.polygons()[0];
+  CHECK(floor.vertices.size() == 4);  // not triangulated
+  CHECK(floor.area == doctest::Approx(1.0));
+  CHECK(near(floor.normal, Rgb(0, 1, 0)));
+  CHECK(s.groups()[floor.group] == "floor");
+  const radiosity::Material& white = s.material(floor.material);
+  CHECK(white.name == "white");
+  CHECK(near(white.reflectance, Rgb(0.8f, 0.7f, 0.6f)));
+  CHECK(near(white.emission, Rgb(0.0f)));
+
+  const radiosity::Polygon& light = s.polygons()[1];
+  CHECK(near(light.normal, Rgb(0, -1, 0)));
+  const radiosity::Material& lamp = s.material(light.material);
+  CHECK(lamp.name == "lamp");
+  CHECK(near(lamp.reflectance, Rgb(0.78f)));  // "Kd 0.78" means grey
+  CHECK(near(lamp.emission, kPi * Rgb(17, 12, 4), 1e-4f));
+}
+
+TEST_CASE("MTL Ks, Ns, illum, Tf and Ni map to specular, mirror and glass, and unknown materials get the default grey") {
+  radiosity::Scene s = radiosity::load_scene(kData / "materials.obj");
+  REQUIRE(s.polygons().size() == 6);
+  REQUIRE(s.groups().size() == 1);
+  CHECK(s.groups()[0] == "things");
+  auto mat = [&](std::size_t polygon) -> const radiosity::Material& {
+    return s.material(s.polygons()[polygon].material);
+  };
+
+  CHECK(mat(0).name == "default");  // a face before any usemtl
+  CHECK(near(mat(0).reflectance, Rgb(0.5f)));
+
+  CHECK(mat(1).name == "mirror");  // illum 3: ideal mirror
+  CHECK(near(mat(1).specular, Rgb(0.9f)));
+  CHECK(mat(1).specular_exponent == 0.0f);
+
+  CHECK(mat(2).name == "glass");  // illum 7 with Tf and Ni
+  CHECK(near(mat(2).transmittance, Rgb(0.9f, 0.95f, 1.0f)));
+  CHECK(mat(2).ior == doctest::Approx(1.45));
+  CHECK(near(mat(2).specular, Rgb(0.1f)));
+
+  CHECK(mat(3).name == "glossy");  // Kd 0.8 + Ks 0.5: Ks scaled to keep Kd + Ks at 0.99
+  CHECK(mat(3).specular_exponent == 250.0f);
+  CHECK(near(mat(3).reflectance + mat(3).specular, Rgb(0.99f)));
+
+  CHECK(mat(4).name == "extra_red");  // from the second file of the mtllib line
+  CHECK(near(mat(4).reflectance, Rgb(0.6f, 0.1f, 0.1f)));
+  CHECK(s.polygons()[4].vertices.size() == 4);  // negative (relative) indices
+
+  CHECK(mat(5).name == "default");  // usemtl nosuch
+  CHECK(s.polygons()[5].material == s.polygons()[0].material);
+
+  REQUIRE(s.warnings().size() == 2);
+  CHECK(contains(s.warnings()[0], "materials.mtl:19:"));
+  CHECK(contains(s.warnings()[0], "glossy"));
+  CHECK(contains(s.warnings()[1], "materials.obj:19:"));
+  CHECK(contains(s.warnings()[1], "nosuch"));
+}
+
+TEST_CASE("non-planar and non-convex faces are triangulated with a warning naming file and line") {
+  radiosity::Scene s = radiosity::load_scene(kData / "cornell_like.obj");
+  REQUIRE(s.materials().size() == 1);
+  CHECK(s.materials()[0].name == "default");
+  CHECK(near(s.materials()[0].reflectance, Rgb(0.5f)));
+  CHECK(s.groups().size() == 6);
+  REQUIRE(s.warnings().size() == 2);
+  CHECK(contains(s.warnings()[0], "cornell_like.obj:17:"));
+  CHECK(contains(s.warnings()[0], "back_wall"));
+  CHECK(contains(s.warnings()[1], "cornell_like.obj:29:"));
+  CHECK(contains(s.warnings()[1], "shelf"));
+
+  // No geometry lost: the L-shaped shelf keeps its area (0.75) as triangles.
+  const radiosity::GroupId shelf = *s.find_group("shelf");
+  double shelf_area = 0.0;
+  for (const radiosity::Polygon& p : s.polygons())
+    if (p.group == shelf) {
+      CHECK(p.vertices.size() == 3);
+      shelf_area += p.area;
+    }
+  CHECK(shelf_area == doctest::Approx(0.75));
+}
+
+TEST_CASE("a UTF-8 byte order mark does not hide the first vertex") {
+  radiosity::Scene s = radiosity::load_scene(write_tmp("bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  REQUIRE(s.polygons().size() == 1);
+  CHECK(s.polygons()[0].area == doctest::Approx(0.5));
+}
+
+TEST_CASE("a face with more than 255 vertices stays one polygon") {
+  // tinyobjloader counts face vertices in an unsigned char; the loader must not rely on it.
+  std::string obj = "# a 300-gon\n";
+  const int n = 300;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2.0 * 3.14159265358979323846 * i / n;
+    obj += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  obj += "f";
+  for (int i = 1; i <= n; ++i) obj += " " + std::to_string(i);
+  obj += "\n";
+  radiosity::Scene s = radiosity::load_scene(write_tmp("polygon300.obj", obj));
+  REQUIRE(s.polygons().size() == 1);
+  CHECK(s.polygons()[0].area == doctest::Approx(3.14159).epsilon(1e-3));
+}
+
+TEST_CASE("a missing OBJ file or an unsupported extension is an error naming the path") {
+  Error missing = load_error(kData / "no_such_file.obj");
+  CHECK(missing.code() == ErrorCode::file_not_found);
+  CHECK(contains(missing.what(), "no_such_file.obj"));
+
+  Error ext = load_error(kData / "scene.gltf");
+  CHECK(ext.code() == ErrorCode::invalid_argument);
+  CHECK(contains(ext.what(), "scene.gltf"));
+  CHECK(contains(ext.what(), "'.gltf'"));
+}
+
+TEST_CASE("a missing MTL file is an error naming the OBJ, the mtllib line and the MTL") {
+  check_error(kData / "missing_mtl.obj", ErrorCode::file_not_found, "missing_mtl.obj", 3, "does_not_exist.mtl");
+}
+
+TEST_CASE("an out-of-range vertex index is an error naming file and line") {
+  check_error(kData / "bad_index.obj", ErrorCode::parse_error, "bad_index.obj", 8, "out of range");
+  check_error(write_tmp("negative_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n"), ErrorCode::parse_error,
+              "negative_index.obj", 4, "out of range");
+}
+
+TEST_CASE("a zero vertex index is an error naming file and line") {
+  check_error(kData / "zero_index.obj", ErrorCode::parse_error, "zero_index.obj", 5, "index 0");
+  check_error(write_tmp("zero_normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//0 3//1\n"),
+              ErrorCode::parse_error, "zero_normal.obj", 5, "normal index");
+}
+
+TEST_CASE("a NaN or infinite coordinate is an error naming file and line") {
+  check_error(kData / "nan_vertex.obj", ErrorCode::parse_error, "nan_vertex.obj", 4, "'nan'");
+  check_error(kData / "inf_vertex.obj", ErrorCode::parse_error, "inf_vertex.obj", 3, "'1e39'");
+  check_error(write_tmp("short_vertex.obj", "v 0 0 0\nv 1 0\n"), ErrorCode::parse_error, "short_vertex.obj", 2,
+              "coordinates");
+}
+
+TEST_CASE("a zero-area face is an error naming file and line") {
+  check_error(kData / "zero_area.obj", ErrorCode::invalid_scene, "zero_area.obj", 9, "degenerate");
+}
+
+TEST_CASE("a face with fewer than 3 vertices is an error naming file and line") {
+  check_error(kData / "short_face.obj", ErrorCode::parse_error, "short_face.obj", 5, "2 vertices");
+  check_error(write_tmp("empty_face.obj", "v 0 0 0\nf\n"), ErrorCode::parse_error, "empty_face.obj", 2, "0 vertices");
+}
+
+TEST_CASE("a reflectance of 1 or more in an MTL is an error naming the MTL, its line and the material") {
+  check_error(kData / "kd_too_high.obj", ErrorCode::invalid_scene, "kd_too_high.mtl", 4, "'hot'");
+  Error e = load_error(kData / "kd_too_high.obj");
+  CHECK(contains(e.what(), "Kd"));
+  const std::string obj = "mtllib MTL\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl bad\nf 1 2 3\n";
+  auto with_mtl = [&](const std::string& name, const std::string& mtl) {
+    write_tmp(name + ".mtl", mtl);
+    return write_tmp(name + ".obj", obj.substr(0, 7) + name + ".mtl" + obj.substr(10));
+  };
+  check_error(with_mtl("kd_one", "newmtl bad\n\nKd 1 1 1\n"), ErrorCode::invalid_scene, "kd_one.mtl", 3, "'bad'");
+  check_error(with_mtl("kd_nan", "newmtl bad\nKd 0.5 nan 0.5\n"), ErrorCode::parse_error, "kd_nan.mtl", 2, "'nan'");
+  check_error(with_mtl("ke_negative", "newmtl bad\nKd 0.5\nKe -1 0 0\n"), ErrorCode::invalid_scene,
+              "ke_negative.mtl", 3, "Ke");
+}
+
+TEST_CASE("line numbers count comments, blank lines and CRLF or CR line ends") {
+  check_error(kData / "line_numbers.obj", ErrorCode::parse_error, "line_numbers.obj", 23, "'99'");
+  std::ifstream in(kData / "line_numbers.obj", std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string crlf, cr;
+  for (char c : text) {
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    cr += c == '\n' ? '\r' : c;
+  }
+  check_error(write_tmp("line_numbers_crlf.obj", crlf), ErrorCode::parse_error, "line_numbers_crlf.obj", 23, "'99'");
+  check_error(write_tmp("line_numbers_cr.obj", cr), ErrorCode::parse_error, "line_numbers_cr.obj", 23, "'99'");
+  check_error(write_tmp("line_numbers_bom.obj", "\xEF\xBB\xBF" + crlf), ErrorCode::parse_error, "line_numbers_bom.obj",
+              23, "'99'");
+}
+
+}  // TEST_SUITE("io")
