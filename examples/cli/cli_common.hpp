@@ -88,6 +88,9 @@ struct SolveArgs {
   unsigned threads = 0;
   std::uint64_t seed = 1;
   int max_iterations = 0;
+  bool adaptive = false;
+  float adaptive_threshold = 0.3f;
+  int adaptive_passes = 3;
 };
 
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a) {
@@ -106,6 +109,13 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a) {
       ->capture_default_str();
   cmd.add_option("--max-iterations", a.max_iterations, "Sweeps or shooting steps at most (0 = default)")
       ->check(CLI::NonNegativeNumber);
+  cmd.add_flag("--adaptive", a.adaptive, "Subdivide elements where radiosity varies fast (shadow edges)");
+  cmd.add_option("--adaptive-threshold", a.adaptive_threshold, "Relative contrast that splits an element")
+      ->check(CLI::Range(0.001f, 1.0f))
+      ->capture_default_str();
+  cmd.add_option("--adaptive-passes", a.adaptive_passes, "Refinement passes at most")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)");
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->capture_default_str();
@@ -124,6 +134,9 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.max_iterations = a.max_iterations;
   o.threads = a.threads;
   o.seed = a.seed;
+  o.adaptive.enabled = a.adaptive;
+  o.adaptive.threshold = a.adaptive_threshold;
+  o.adaptive.max_passes = a.adaptive_passes;
   o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
   return o;
 }
@@ -144,6 +157,8 @@ inline void print_summary(const rad::Solution& sol) {
                                                                          : "cancelled";
   std::printf("solved: %zu patches, %zu elements, %d iterations, residual %.3g (%s)\n", r.patch_count,
               r.element_count, r.iterations, r.residual, status);
+  if (r.refinement_passes > 0)
+    std::printf("adaptive: %zu elements split in %d passes\n", r.refined_elements, r.refinement_passes);
   std::printf("time: meshing %.3f s, form factors %.3f s, solving %.3f s\n", r.seconds_meshing,
               r.seconds_form_factors, r.seconds_solving);
 }

@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
   render->add_option("--up", up, "Camera up vector x,y,z");
   render->add_option("--fov", fov, "Vertical field of view, degrees")->check(CLI::Range(0.0f, 180.0f));
   render->add_option("--exposure", exposure, "PNG exposure (linear scale)")->capture_default_str();
+  bool wireframe = false, ambient = false;
+  render->add_flag("--wireframe", wireframe, "Draw the element mesh over the image");
+  render->add_flag("--ambient", ambient, "Add progressive refinement's ambient term to the display");
   add_solve_options(*render, render_args);
 
   // solve
@@ -67,6 +70,8 @@ int main(int argc, char** argv) {
       ro.spp = spp;
       ro.threads = render_args.threads;
       ro.seed = render_args.seed;
+      ro.wireframe = wireframe;
+      ro.ambient = ambient;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
         rad::Camera c = scene.camera();
         if (!eye.empty()) c.eye = parse_vec3(eye, "--eye");

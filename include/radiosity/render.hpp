@@ -40,6 +40,9 @@ struct RenderOptions {
   /// Show radiosity plus reflectance x ambient (Solution::radiosity_with_ambient): the usual
   /// display of an unfinished progressive solution.
   bool ambient = false;
+  /// Draw the edges of the leaf elements in black over the image (to see the mesh and the
+  /// adaptive subdivision).
+  bool wireframe = false;
   ProgressFn on_progress;
 };
 

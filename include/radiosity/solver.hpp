@@ -21,6 +21,20 @@ enum class SolverMethod {
   progressive,   ///< shooting, brightest unshot power first (Cohen et al. 1988)
 };
 
+/// Adaptive subdivision of elements where radiosity varies fast (shadow boundaries, near
+/// lights), after the first solve: split, compute the new elements' form factors, continue.
+struct AdaptiveOptions {
+  bool enabled = false;
+  /// Split a leaf when its luminance differs from the interpolated value at one of its corners
+  /// by more than this fraction of their mean (or of a floor of 10 % of the scene's mean
+  /// reflected luminance, for dark regions). In (0, 1]; smaller splits more.
+  float threshold = 0.3f;
+  int max_passes = 3;             ///< refinement passes at most, >= 1
+  int max_depth = 3;              ///< quadtree levels below the initial elements, >= 1
+  /// Leaves at most after refinement; 0 = 4 x the initial leaf count.
+  std::size_t max_elements = 0;
+};
+
 /// Everything solve() needs; every field has a default.
 struct SolveOptions {
   SolverMethod method = SolverMethod::gauss_seidel;
@@ -36,6 +50,7 @@ struct SolveOptions {
   std::uint64_t seed = 1;        ///< overrides form_factors.seed
   /// Largest form-factor matrix the matrix methods may allocate, in bytes; 0 = 4 GiB.
   std::size_t memory_budget_bytes = 0;
+  AdaptiveOptions adaptive;
   ProgressFn on_progress;        ///< optional; return false to cancel
 };
 
@@ -48,7 +63,9 @@ struct SolveReport {
   std::vector<double> residual_history;  ///< after each sweep / step
   std::vector<double> time_history;      ///< seconds since the solve phase began, same indexing
   std::size_t patch_count = 0;
-  std::size_t element_count = 0;         ///< leaves
+  std::size_t element_count = 0;         ///< leaves (after adaptive refinement)
+  std::size_t refined_elements = 0;      ///< leaves split by adaptive subdivision
+  int refinement_passes = 0;
   std::size_t form_factor_bytes = 0;     ///< memory held by form factors at the peak
   Rgb emitted_power{0.0f};               ///< sum A E, W per channel
   Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance

@@ -41,13 +41,32 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
   const float inv_pi = 1.0f / glm::pi<float>();
   Image image(options.width, options.height);
 
+  // Wireframe overlay: is the hit within about a pixel of an edge of its element? Quads are
+  // drawn as two triangles; their shared diagonal (corner 0 to corner 2) is not an edge.
+  const float pixel_angle = 2.0f * camera.tan_half_fov / static_cast<float>(options.height);
+  auto near_element_edge = [&](std::uint32_t element, const std::uint32_t* tri, float w, float u, float v, float t) {
+    const Element& el = hierarchy.element(element);
+    const glm::vec3 &p0 = hierarchy.vertices()[tri[0]], &p1 = hierarchy.vertices()[tri[1]],
+                    &p2 = hierarchy.vertices()[tri[2]];
+    const float twice_area = glm::length(glm::cross(p1 - p0, p2 - p0));
+    const float width = 0.75f * pixel_angle * t;
+    // Distance to an edge = barycentric coordinate of the opposite vertex x its altitude.
+    const float d01 = v * twice_area / glm::length(p1 - p0), d12 = w * twice_area / glm::length(p2 - p1),
+                d20 = u * twice_area / glm::length(p0 - p2);
+    if (el.corner_count() == 3) return std::min({d01, d12, d20}) < width;
+    const bool first_half = tri[1] == el.corners[1];  // (c0, c1, c2) or (c0, c2, c3)
+    return first_half ? std::min(d01, d12) < width : std::min(d12, d20) < width;
+  };
+
   auto shade = [&](const glm::vec3& dir) -> Rgb {
     auto hit = rays.intersect(camera.eye, dir, 0.0f, std::numeric_limits<float>::infinity());
     if (!hit) return Rgb(0.0f);
     // One-sided surfaces: the back of a polygon reflects nothing.
     if (glm::dot(hierarchy.normal(hit->id), dir) >= 0.0f) return Rgb(0.0f);
     const std::uint32_t* tri = rays.triangle(hit->triangle);
-    Rgb b = (1.0f - hit->u - hit->v) * vertex_B[tri[0]] + hit->u * vertex_B[tri[1]] + hit->v * vertex_B[tri[2]];
+    const float w = 1.0f - hit->u - hit->v;
+    Rgb b = w * vertex_B[tri[0]] + hit->u * vertex_B[tri[1]] + hit->v * vertex_B[tri[2]];
+    if (options.wireframe && near_element_edge(hit->id, tri, w, hit->u, hit->v, hit->t)) return Rgb(0.0f);
     return b * inv_pi;
   };
 

@@ -24,14 +24,25 @@ double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z
 
 }  // namespace
 
-SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
+SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixStore& store,
+                          const std::vector<Rgb>& B0) {
   const RadiositySystem& sys = ctx.system;
   const std::size_t m = sys.unknowns(), n = sys.patches();
   SolverResult result;
-  result.B = sys.emission;
+  result.B = B0.empty() ? sys.emission : B0;
   result.H.assign(m, Rgb(0.0f));
 
-  const std::size_t bytes = m * n * sizeof(float);
+  // Which leaves still need a row, and where it goes.
+  store.patches = n;
+  if (store.slot.size() < ctx.hierarchy.elements().size()) store.slot.resize(ctx.hierarchy.elements().size(), kNone);
+  std::vector<std::uint32_t> missing;
+  for (std::uint32_t e : sys.leaves)
+    if (store.slot[e] == kNone) missing.push_back(e);
+  const std::size_t slots_needed =
+      store.rows.size() / std::max<std::size_t>(n, 1) + (missing.size() > store.free_slots.size()
+                                                               ? missing.size() - store.free_slots.size()
+                                                               : 0);
+  const std::size_t bytes = slots_needed * n * sizeof(float);
   if (bytes > ctx.options.memory_budget_bytes) {
     std::ostringstream s;
     s << "the form-factor matrix of " << m << " elements x " << n << " patches needs " << bytes / (1024.0 * 1024.0)
@@ -39,28 +50,47 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
       << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive or a coarser mesh";
     throw Error(ErrorCode::memory_budget, s.str());
   }
-  result.form_factor_bytes = bytes;
+  std::vector<std::uint32_t> slots(missing.size());
+  for (std::size_t k = 0; k < missing.size(); ++k) {
+    if (!store.free_slots.empty()) {
+      slots[k] = store.free_slots.back();
+      store.free_slots.pop_back();
+    } else {
+      slots[k] = static_cast<std::uint32_t>(store.rows.size() / std::max<std::size_t>(n, 1));
+      store.rows.resize(store.rows.size() + n);
+    }
+  }
+  result.form_factor_bytes = store.bytes();
 
   // Form factors, in chunks so that progress is reported and cancel is honoured.
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<float> F(m * n);
-  const std::size_t chunk = std::max<std::size_t>(64, m / 200);
+  const std::size_t chunk = std::max<std::size_t>(64, missing.size() / 200);
   std::vector<std::uint32_t> rows;
-  for (std::size_t begin = 0; begin < m; begin += chunk) {
-    std::size_t end = std::min(m, begin + chunk);
-    rows.assign(sys.leaves.begin() + static_cast<std::ptrdiff_t>(begin),
-                sys.leaves.begin() + static_cast<std::ptrdiff_t>(end));
-    ctx.estimator.element_rows(rows, F.data() + begin * n);
+  std::vector<float> buffer;
+  for (std::size_t begin = 0; begin < missing.size(); begin += chunk) {
+    std::size_t end = std::min(missing.size(), begin + chunk);
+    rows.assign(missing.begin() + static_cast<std::ptrdiff_t>(begin), missing.begin() + static_cast<std::ptrdiff_t>(end));
+    buffer.resize(rows.size() * n);
+    ctx.estimator.element_rows(rows, buffer.data());
+    for (std::size_t k = begin; k < end; ++k) {
+      std::copy_n(buffer.data() + (k - begin) * n, n, store.rows.data() + std::size_t{slots[k]} * n);
+      store.slot[missing[k]] = slots[k];
+    }
     Progress p;
     p.phase = Phase::form_factors;
-    p.fraction = static_cast<double>(end) / static_cast<double>(m);
-    if (!ctx.progress.report(p, end == m)) {
+    p.fraction = static_cast<double>(end) / static_cast<double>(missing.size());
+    if (!ctx.progress.report(p, end == missing.size())) {
+      // Leaves without a row would be read below: forget the partial work and stop here with
+      // the starting estimate, which is consistent.
+      for (std::size_t k = 0; k < missing.size(); ++k)
+        if (store.slot[missing[k]] == kNone) store.free_slots.push_back(slots[k]);
       result.status = SolveStatus::cancelled;
       result.seconds_form_factors = seconds_since(t0);
-      return result;  // B = E is consistent: nothing has been propagated yet
+      return result;
     }
   }
   result.seconds_form_factors = seconds_since(t0);
+  auto row = [&](std::size_t i) { return store.row(sys.leaves[i]); };
 
   // Sweeps. Residual: power that the last sweep changed, over the emitted power.
   auto t1 = std::chrono::steady_clock::now();
@@ -74,9 +104,9 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
       // Jacobi: every element from the previous sweep's patch radiosity; rows are independent.
       parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
-          const float* row = F.data() + i * n;
+          const float* F = row(i);
           Rgb gathered(0.0f);
-          for (std::size_t j = 0; j < n; ++j) gathered += row[j] * patch_B[j];
+          for (std::size_t j = 0; j < n; ++j) gathered += F[j] * patch_B[j];
           next[i] = sys.emission[i] + sys.reflectance[i] * gathered;
         }
       });
@@ -85,9 +115,9 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
     } else {
       // Gauss-Seidel: each element sees the patch means already updated by earlier elements.
       for (std::size_t i = 0; i < m; ++i) {
-        const float* row = F.data() + i * n;
+        const float* F = row(i);
         Rgb gathered(0.0f);
-        for (std::size_t j = 0; j < n; ++j) gathered += row[j] * patch_B[j];
+        for (std::size_t j = 0; j < n; ++j) gathered += F[j] * patch_B[j];
         Rgb b = sys.emission[i] + sys.reflectance[i] * gathered;
         Rgb d = b - result.B[i];
         change += sys.area[i] * l1(d);
@@ -120,9 +150,9 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel) {
   sys.patch_means(result.B, patch_B);
   parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      const float* row = F.data() + i * n;
+      const float* F = row(i);
       Rgb h(0.0f);
-      for (std::size_t j = 0; j < n; ++j) h += row[j] * patch_B[j];
+      for (std::size_t j = 0; j < n; ++j) h += F[j] * patch_B[j];
       result.H[i] = h;
     }
   });

@@ -1,6 +1,8 @@
 // The solve() facade: mesh, form factors, solver, Solution.
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "formfactor/estimators.hpp"
@@ -33,6 +35,17 @@ void validate(const SolveOptions& o) {
   };
   check_area(o.mesh.max_patch_area, "max_patch_area");
   check_area(o.mesh.max_element_area, "max_element_area");
+  if (o.adaptive.enabled) {
+    if (!(o.adaptive.threshold > 0.0f && o.adaptive.threshold <= 1.0f))
+      throw Error(ErrorCode::invalid_argument,
+                  "adaptive.threshold must be in (0, 1], got " + std::to_string(o.adaptive.threshold));
+    if (o.adaptive.max_passes < 1)
+      throw Error(ErrorCode::invalid_argument,
+                  "adaptive.max_passes must be >= 1, got " + std::to_string(o.adaptive.max_passes));
+    if (o.adaptive.max_depth < 1)
+      throw Error(ErrorCode::invalid_argument,
+                  "adaptive.max_depth must be >= 1, got " + std::to_string(o.adaptive.max_depth));
+  }
   detail::resolve(o.form_factors);
 }
 
@@ -57,7 +70,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   if (o.max_iterations == 0)
     o.max_iterations = o.method == SolverMethod::progressive ? static_cast<int>(100 * report.patch_count) : 1000;
 
-  detail::RadiositySystem system(scene, hierarchy);
+  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy);
   std::vector<Rgb> B_elements(hierarchy.elements().size(), Rgb(0.0f));
   std::vector<std::string> groups = scene.groups();
 
@@ -65,7 +78,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
     return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
                     std::move(report));
 
-  if (system.emitted <= 0.0) {
+  if (system->emitted <= 0.0) {
     // Nothing emits: B = 0 is the exact answer.
     report.warnings.push_back("the scene emits no light; every radiosity is 0");
     return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), SolveStatus::converged,
@@ -73,38 +86,127 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   }
 
   auto estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
-  detail::SolverContext context{scene, hierarchy, system, *estimator, o, gate};
+  detail::MatrixStore store;
+  const bool progressive = o.method == SolverMethod::progressive;
   auto t1 = std::chrono::steady_clock::now();
-  detail::SolverResult r = o.method == SolverMethod::progressive
-                               ? detail::solve_progressive(context)
-                               : detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel);
-  const double total = seconds_since(t1);
 
-  report.iterations = r.iterations;
-  report.residual = r.residual;
-  report.residual_history = std::move(r.residual_history);
-  report.time_history = std::move(r.time_history);
-  report.form_factor_bytes = r.form_factor_bytes;
-  report.seconds_form_factors = r.seconds_form_factors;
-  report.seconds_solving = total - r.seconds_form_factors;
+  // Per element id, so values survive the re-indexing of unknowns when leaves are split.
+  std::vector<Rgb> H_elements(hierarchy.elements().size(), Rgb(0.0f));
+  auto keep = [&](const detail::SolverResult& res) {
+    B_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
+    H_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
+    for (std::size_t i = 0; i < system->unknowns(); ++i) {
+      B_elements[system->leaves[i]] = res.B[i];
+      H_elements[system->leaves[i]] = res.H[i];
+    }
+    report.iterations += res.iterations;
+    report.residual = res.residual;
+    const double offset = report.time_history.empty() ? 0.0 : report.time_history.back();
+    report.residual_history.insert(report.residual_history.end(), res.residual_history.begin(),
+                                   res.residual_history.end());
+    for (double t : res.time_history) report.time_history.push_back(offset + t);
+    report.form_factor_bytes = std::max(report.form_factor_bytes, res.form_factor_bytes);
+    report.seconds_form_factors += res.seconds_form_factors;
+  };
+
+  detail::SolverResult r;
+  {
+    detail::SolverContext context{scene, hierarchy, *system, *estimator, o, gate};
+    r = progressive ? detail::solve_progressive(context)
+                    : detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, {});
+  }
+  keep(r);
+  SolveStatus status = r.status;
+
+  if (o.adaptive.enabled && status != SolveStatus::cancelled) {
+    std::uint8_t initial_depth = 0;
+    for (std::uint32_t e : hierarchy.leaves()) initial_depth = std::max(initial_depth, hierarchy.element(e).depth);
+    const auto max_depth = static_cast<std::uint8_t>(std::min(250, initial_depth + o.adaptive.max_depth));
+    const std::size_t budget =
+        o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * hierarchy.leaves().size();
+    for (int pass = 1; pass <= o.adaptive.max_passes; ++pass) {
+      const std::vector<std::uint32_t> split =
+          detail::leaves_to_refine(hierarchy, B_elements, o.adaptive, max_depth, budget);
+      if (split.empty()) break;
+      std::vector<std::uint32_t> created;
+      for (std::uint32_t e : split) {
+        if (e < store.slot.size() && store.slot[e] != kNone) {
+          store.free_slots.push_back(store.slot[e]);
+          store.slot[e] = kNone;
+        }
+        const std::uint32_t first = hierarchy.subdivide(e);
+        for (std::uint32_t c = first; c < first + 4; ++c) created.push_back(c);
+      }
+      // Children start from their parent's value (a warm start for the next sweeps).
+      B_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
+      H_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
+      for (std::uint32_t c : created) {
+        B_elements[c] = B_elements[hierarchy.element(c).parent];
+        H_elements[c] = H_elements[hierarchy.element(c).parent];
+      }
+      report.refined_elements += split.size();
+      report.refinement_passes = pass;
+      system.emplace(scene, hierarchy);
+      Progress p{Phase::refining, static_cast<double>(pass) / o.adaptive.max_passes, pass, report.residual};
+      if (!gate.report(p, true)) {
+        status = SolveStatus::cancelled;
+        break;
+      }
+
+      if (!progressive) {
+        // Matrix methods: rows for the new elements only, then sweeps from the warm start.
+        std::vector<Rgb> B0(system->unknowns());
+        for (std::size_t i = 0; i < system->unknowns(); ++i) B0[i] = B_elements[system->leaves[i]];
+        detail::SolverContext context{scene, hierarchy, *system, *estimator, o, gate};
+        r = detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, B0);
+        keep(r);
+        status = r.status;
+        if (status == SolveStatus::cancelled) break;
+      } else {
+        // Progressive: substructuring's gather. Each new element takes its radiosity from the
+        // patch radiosities it sees, B_c = E_c + rho_c sum_j F_cj B_j; no matrix is kept.
+        std::vector<Rgb> patch_B;
+        std::vector<Rgb> B_now(system->unknowns());
+        for (std::size_t i = 0; i < system->unknowns(); ++i) B_now[i] = B_elements[system->leaves[i]];
+        system->patch_means(B_now, patch_B);
+        const std::size_t n = system->patches();
+        std::vector<float> rows(created.size() * n);
+        auto tf = std::chrono::steady_clock::now();
+        estimator->element_rows(created, rows.data());
+        report.seconds_form_factors += seconds_since(tf);
+        for (std::size_t k = 0; k < created.size(); ++k) {
+          Rgb h(0.0f);
+          for (std::size_t j = 0; j < n; ++j) h += rows[k * n + j] * patch_B[j];
+          const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(created[k]).patch].material);
+          H_elements[created[k]] = h;
+          B_elements[created[k]] = mat.emission + mat.reflectance * h;
+        }
+      }
+    }
+  }
+  const double total = seconds_since(t1);
+  report.seconds_solving = total - report.seconds_form_factors;
+  report.element_count = hierarchy.leaves().size();
+
   glm::dvec3 emitted(0.0), absorbed(0.0);
-  for (std::size_t i = 0; i < system.unknowns(); ++i) {
-    const double a = system.area[i];
-    emitted += a * glm::dvec3(system.emission[i]);
-    absorbed += a * (glm::dvec3(1.0) - glm::dvec3(system.reflectance[i])) * glm::dvec3(r.H[i]);
-    B_elements[system.leaves[i]] = r.B[i];
+  for (std::size_t i = 0; i < system->unknowns(); ++i) {
+    const double a = system->area[i];
+    const std::uint32_t e = system->leaves[i];
+    emitted += a * glm::dvec3(system->emission[i]);
+    absorbed += a * (glm::dvec3(1.0) - glm::dvec3(system->reflectance[i])) * glm::dvec3(H_elements[e]);
   }
   report.emitted_power = Rgb(emitted);
   report.absorbed_power = Rgb(absorbed);
+  // Inner nodes (split elements) hold the mean of their children from here on.
   hierarchy.aggregate(B_elements);
   std::vector<Rgb> ambient_elements;
   if (r.ambient != Rgb(0.0f)) {
     ambient_elements.assign(hierarchy.elements().size(), Rgb(0.0f));
-    for (std::size_t i = 0; i < system.unknowns(); ++i)
-      ambient_elements[system.leaves[i]] = system.reflectance[i] * r.ambient;
+    for (std::size_t i = 0; i < system->unknowns(); ++i)
+      ambient_elements[system->leaves[i]] = system->reflectance[i] * r.ambient;
     hierarchy.aggregate(ambient_elements);
   }
-  return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), r.status, std::move(report),
+  return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements));
 }
 

@@ -70,7 +70,30 @@ struct SolverContext {
   ProgressGate& progress;
 };
 
-SolverResult solve_matrix(const SolverContext& context, bool gauss_seidel);
+/// Rows F(element -> every patch) kept across adaptive refinement passes, so a pass computes
+/// rows only for the elements it created. A subdivided element's row slot is reused by its
+/// first child.
+struct MatrixStore {
+  std::size_t patches = 0;
+  std::vector<float> rows;                 ///< slot-major, `patches` floats per slot
+  std::vector<std::uint32_t> slot;         ///< element id -> slot, kNone when it has no row
+  std::vector<std::uint32_t> free_slots;   ///< slots of elements that were subdivided
+
+  std::size_t bytes() const { return rows.capacity() * sizeof(float); }
+  const float* row(std::uint32_t element) const { return rows.data() + std::size_t{slot[element]} * patches; }
+};
+
+/// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
+/// of them on the first call), then iterates from `B0` (per unknown; empty = start from E).
+SolverResult solve_matrix(const SolverContext& context, bool gauss_seidel, MatrixStore& store,
+                          const std::vector<Rgb>& B0);
 SolverResult solve_progressive(const SolverContext& context);
+
+/// Adaptive subdivision (Cohen, Greenberg, Immel & Brock 1986): the leaves whose radiosity
+/// differs from the interpolated values at their corners (i.e. from their neighbours) by more
+/// than `threshold`, relative, and that may still be split.
+std::vector<std::uint32_t> leaves_to_refine(const PatchHierarchy& hierarchy, const std::vector<Rgb>& B_elements,
+                                            const AdaptiveOptions& options, std::uint8_t max_depth,
+                                            std::size_t element_budget);
 
 }  // namespace radiosity::detail
