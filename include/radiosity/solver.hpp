@@ -61,7 +61,7 @@ struct SolveReport {
   int iterations = 0;
   double residual = 0.0;
   std::vector<double> residual_history;  ///< after each sweep / step
-  std::vector<double> time_history;      ///< seconds since the solve phase began, same indexing
+  std::vector<double> time_history;      ///< seconds since form factors began, same indexing
   std::size_t patch_count = 0;
   std::size_t element_count = 0;         ///< leaves (after adaptive refinement)
   std::size_t refined_elements = 0;      ///< leaves split by adaptive subdivision
