@@ -93,9 +93,12 @@ struct SolveArgs {
   int adaptive_passes = 3;
 };
 
-inline void add_solve_options(CLI::App& cmd, SolveArgs& a) {
-  cmd.add_option("--method", a.method, "Solver")
-      ->check(CLI::IsMember({"jacobi", "gauss-seidel", "progressive"}))
+/// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
+inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
+  std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
+  if (with_path) methods.push_back("path");
+  cmd.add_option("--method", a.method, with_path ? "Solver, or path for the reference path tracer" : "Solver")
+      ->check(CLI::IsMember(methods))
       ->capture_default_str();
   cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
       ->check(CLI::IsMember({"ray-cast", "analytic"}))

@@ -2,6 +2,7 @@
 // Output formats are a contract that scripts parse: see docs/CLI.md.
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "cli_common.hpp"
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
   SolveArgs render_args;
   std::string out = "radiosity.exr", png;
   bool no_png = false;
-  int width = 512, height = 512, spp = 4;
+  int width = 512, height = 512, spp = 0;
   std::string eye, look_at, up;
   float fov = 0.0f;
   float exposure = 1.0f;
@@ -28,9 +29,8 @@ int main(int argc, char** argv) {
   render->add_flag("--no-png", no_png, "Do not write a PNG preview");
   render->add_option("--width", width, "Image width")->check(CLI::PositiveNumber)->capture_default_str();
   render->add_option("--height", height, "Image height")->check(CLI::PositiveNumber)->capture_default_str();
-  render->add_option("--spp", spp, "Stratified samples per pixel (rounded up to a square)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  render->add_option("--spp", spp, "Stratified samples per pixel, rounded up to a square (default 4, path: 256)")
+      ->check(CLI::PositiveNumber);
   render->add_option("--eye", eye, "Camera position x,y,z");
   render->add_option("--look-at", look_at, "Camera target x,y,z");
   render->add_option("--up", up, "Camera up vector x,y,z");
@@ -39,7 +39,10 @@ int main(int argc, char** argv) {
   bool wireframe = false, ambient = false;
   render->add_flag("--wireframe", wireframe, "Draw the element mesh over the image");
   render->add_flag("--ambient", ambient, "Add progressive refinement's ambient term to the display");
-  add_solve_options(*render, render_args);
+  int max_depth = 0;
+  render->add_option("--max-depth", max_depth, "Path tracer: reflections at most (0 = unlimited, Russian roulette)")
+      ->check(CLI::NonNegativeNumber);
+  add_solve_options(*render, render_args, true);
 
   // solve
   SolveArgs solve_args;
@@ -61,17 +64,7 @@ int main(int argc, char** argv) {
     if (*render) {
       rad::Scene scene = load(render_args.scene);
       print_warnings(scene.warnings());
-      rad::Solution sol = rad::solve(scene, to_options(render_args, bar));
-      bar.finish();
-      print_summary(sol);
-      rad::RenderOptions ro;
-      ro.width = width;
-      ro.height = height;
-      ro.spp = spp;
-      ro.threads = render_args.threads;
-      ro.seed = render_args.seed;
-      ro.wireframe = wireframe;
-      ro.ambient = ambient;
+      std::optional<rad::Camera> camera;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
         rad::Camera c = scene.camera();
         if (!eye.empty()) c.eye = parse_vec3(eye, "--eye");
@@ -79,11 +72,40 @@ int main(int argc, char** argv) {
         if (!up.empty()) c.up = parse_vec3(up, "--up");
         if (fov > 0.0f) c.fov_deg = fov;
         scene.set_camera(c);  // validates
-        ro.camera = c;
+        camera = c;
       }
-      ro.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
-      rad::Image image = rad::render(scene, sol, ro);
-      bar.finish();
+      rad::Image image;
+      if (render_args.method == "path") {
+        // The reference: an unbiased path tracer, no radiosity solve.
+        rad::PathTraceOptions po;
+        po.width = width;
+        po.height = height;
+        po.spp = spp > 0 ? spp : 256;
+        po.max_depth = max_depth;
+        po.camera = camera;
+        po.threads = render_args.threads;
+        po.seed = render_args.seed;
+        po.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+        image = rad::render_path_traced(scene, po);
+        bar.finish();
+        std::printf("path traced: %d samples per pixel\n", po.spp);
+      } else {
+        rad::Solution sol = rad::solve(scene, to_options(render_args, bar));
+        bar.finish();
+        print_summary(sol);
+        rad::RenderOptions ro;
+        ro.width = width;
+        ro.height = height;
+        ro.spp = spp > 0 ? spp : 4;
+        ro.threads = render_args.threads;
+        ro.seed = render_args.seed;
+        ro.wireframe = wireframe;
+        ro.ambient = ambient;
+        ro.camera = camera;
+        ro.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+        image = rad::render(scene, sol, ro);
+        bar.finish();
+      }
       rad::write_exr(image, out);
       std::printf("wrote %s (%dx%d, linear float RGB)\n", std::filesystem::absolute(out).c_str(), width, height);
       if (!no_png) {

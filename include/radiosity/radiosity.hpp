@@ -3,10 +3,12 @@
 // write_exr, write_png and version, with the types they use.
 #pragma once
 
+#include "radiosity/brdf.hpp"
 #include "radiosity/common.hpp"
 #include "radiosity/form_factors.hpp"
 #include "radiosity/io.hpp"
 #include "radiosity/mesh.hpp"
+#include "radiosity/path_tracer.hpp"
 #include "radiosity/render.hpp"
 #include "radiosity/scene.hpp"
 #include "radiosity/solver.hpp"

@@ -1,0 +1,310 @@
+// Brute-force path tracing of diffuse scenes: the reference the radiosity images are checked
+// against.
+// Based on:
+//   J. T. Kajiya, "The rendering equation", SIGGRAPH 1986 (the path integral estimated here).
+//   E. Veach, "Robust Monte Carlo Methods for Light Transport Simulation", PhD thesis, Stanford
+//     1997: next-event estimation and multiple importance sampling with the power heuristic
+//     (ch. 9, eq. 9.13), the area-to-solid-angle pdf conversion (eq. 8.10).
+//   J. Arvo & D. Kirk, "Particle transport and image synthesis", SIGGRAPH 1990 (Russian roulette).
+//   T. Duff et al., "Building an orthonormal basis, revisited", JCGT 6(1), 2017.
+//   M. Pharr, W. Jakob & G. Humphreys, "Physically Based Rendering", 3rd ed. 2016, sec. 13.6
+//     (cosine-weighted hemisphere sampling, Malley's method) and sec. 14.5 (path loop layout).
+#include "radiosity/path_tracer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+
+#include "detail/parallel.hpp"
+#include "detail/rng.hpp"
+#include "geometry/ray_scene.hpp"
+#include "render/camera.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+constexpr float kPi = glm::pi<float>();
+constexpr float kInvPi = 1.0f / glm::pi<float>();
+/// Reflections a path has before Russian roulette may end it.
+constexpr int kRouletteStart = 3;
+/// Russian roulette never keeps a path with probability above this, so every path ends.
+constexpr float kMaxSurvival = 0.95f;
+/// Roughly how many paths a band of rows holds, so progress is reported every ~50 ms.
+constexpr std::size_t kPathsPerBand = std::size_t{1} << 17;
+
+[[noreturn]] void bad_option(const std::string& what) {
+  throw Error(ErrorCode::invalid_argument, "PathTraceOptions::" + what);
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+float max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+/// Power heuristic with exponent 2 (Veach 1997, eq. 9.13) for one sample of each strategy.
+float power_heuristic(float pdf_this, float pdf_other) {
+  const float a = pdf_this * pdf_this, b = pdf_other * pdf_other;
+  return a / (a + b);
+}
+
+/// Index i with cdf[i-1] <= u < cdf[i] in a normalised cumulative table (last entry 1).
+std::size_t sample_cdf(const std::vector<float>& cdf, float u) {
+  auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
+  return std::min(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+}
+
+/// The surfaces as the tracer needs them, indexed by polygon id (= RayScene hit id).
+struct Surface {
+  glm::vec3 normal{0.0f};
+  glm::vec3 origin{0.0f};  ///< a vertex, to snap hit points onto the plane
+  Rgb emission{0.0f};      ///< exitance E, W/m^2
+  Rgb reflectance{0.0f};   ///< Lambertian albedo
+  /// Probability density per unit area with which next-event estimation picks a point here:
+  /// P(choose this polygon) / area; 0 for non-emitters.
+  float light_pdf_area = 0.0f;
+};
+
+/// An emitting polygon, fan-triangulated for uniform area sampling.
+struct Emitter {
+  std::uint32_t polygon = 0;
+  std::vector<glm::vec3> a, b, c;  ///< the fan's triangles
+  std::vector<float> cdf;          ///< over the triangles, by area
+};
+
+class PathTracer {
+ public:
+  PathTracer(const Scene& scene, const PathTraceOptions& options)
+      : options_(options),
+        camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
+        rays_(detail::RayScene::from_polygons(scene)),
+        g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
+    const auto& polygons = scene.polygons();
+    surfaces_.resize(polygons.size());
+    double total_power = 0.0;
+    for (std::size_t p = 0; p < polygons.size(); ++p) {
+      const Polygon& poly = polygons[p];
+      const Material& m = scene.material(poly.material);
+      Surface& s = surfaces_[p];
+      s.normal = poly.normal;
+      s.origin = poly.vertices[0];
+      s.emission = m.emission;
+      s.reflectance = m.reflectance;
+      const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;
+      if (!(power > 0.0)) continue;
+      Emitter e;
+      e.polygon = static_cast<std::uint32_t>(p);
+      float area = 0.0f;
+      for (std::size_t k = 1; k + 1 < poly.vertices.size(); ++k) {
+        e.a.push_back(poly.vertices[0]);
+        e.b.push_back(poly.vertices[k]);
+        e.c.push_back(poly.vertices[k + 1]);
+        const glm::vec3 edge_b = poly.vertices[k] - poly.vertices[0], edge_c = poly.vertices[k + 1] - poly.vertices[0];
+        area += 0.5f * glm::length(glm::cross(edge_b, edge_c));
+        e.cdf.push_back(area);
+      }
+      for (float& v : e.cdf) v /= area;
+      e.cdf.back() = 1.0f;
+      emitters_.push_back(std::move(e));
+      emitter_power_.push_back(power);
+      total_power += power;
+    }
+    // Emitters are chosen in proportion to their power summed over channels.
+    double running = 0.0;
+    for (std::size_t i = 0; i < emitters_.size(); ++i) {
+      const double probability = emitter_power_[i] / total_power;
+      running += probability;
+      emitter_cdf_.push_back(static_cast<float>(running));
+      const std::uint32_t p = emitters_[i].polygon;
+      surfaces_[p].light_pdf_area = static_cast<float>(probability / polygons[p].area);
+    }
+    if (!emitter_cdf_.empty()) emitter_cdf_.back() = 1.0f;
+    // Ray offsets: far above float rounding at the scene's scale, far below any feature.
+    epsilon_ = std::max(1e-5f * scene.bounds().diagonal(), 1e-6f);
+  }
+
+  Image render() const {
+    Image image(options_.width, options_.height);
+    const std::size_t paths_per_row = static_cast<std::size_t>(options_.width) * g_ * g_;
+    const int band = static_cast<int>(std::max<std::size_t>(1, kPathsPerBand / paths_per_row));
+    const std::size_t grain = std::max<std::size_t>(1, 1024 / (static_cast<std::size_t>(g_) * g_));
+    // Bands of rows: parallel inside a band, progress and cancel between bands on this thread.
+    for (int y0 = 0; y0 < options_.height; y0 += band) {
+      const int y1 = std::min(options_.height, y0 + band);
+      const std::size_t count = static_cast<std::size_t>(y1 - y0) * options_.width;
+      detail::parallel_for(options_.threads, count, grain, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          const int x = static_cast<int>(k % options_.width), y = y0 + static_cast<int>(k / options_.width);
+          image.at(x, y) = pixel(x, y);
+        }
+      });
+      if (options_.on_progress) {
+        Progress progress{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
+        if (!options_.on_progress(progress)) break;
+      }
+    }
+    return image;
+  }
+
+ private:
+  /// Box-filtered mean of g x g jittered paths through the pixel, from the pixel's own stream.
+  Rgb pixel(int x, int y) const {
+    const std::uint64_t index = static_cast<std::uint64_t>(y) * options_.width + x;
+    detail::Rng rng(options_.seed, index, 0x9a7b'0001ull);
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (int j = 0; j < g_; ++j)
+      for (int i = 0; i < g_; ++i) {
+        const glm::vec2 u = rng.uniform2();
+        const float sx = (static_cast<float>(x) + (static_cast<float>(i) + u.x) / g_) / options_.width;
+        const float sy = (static_cast<float>(y) + (static_cast<float>(j) + u.y) / g_) / options_.height;
+        const Rgb L = trace(camera_.eye, camera_.direction(sx, sy), rng);
+        for (int c = 0; c < 3; ++c) sum[c] += L[c];
+      }
+    const double n = static_cast<double>(g_) * g_;
+    return Rgb(static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n), static_cast<float>(sum[2] / n));
+  }
+
+  /// Radiance arriving at `origin` from direction -`dir` (one path sample).
+  Rgb trace(glm::vec3 origin, glm::vec3 dir, detail::Rng& rng) const {
+    Rgb L(0.0f);
+    Rgb beta(1.0f);            // path throughput: product of f cos / pdf so far
+    glm::vec3 prev_x = origin;  // the previous vertex (for the MIS weight of an emitter hit)
+    float prev_pdf = 0.0f;     // solid-angle pdf of the bounce that produced `dir`
+    float tnear = 0.0f;
+    for (int depth = 0;; ++depth) {
+      const auto hit = rays_.intersect(origin, dir, tnear, std::numeric_limits<float>::infinity());
+      if (!hit) break;
+      const Surface& s = surfaces_[hit->id];
+      // One-sided surfaces: the back of a polygon absorbs, as in the radiosity solver.
+      const float cos_in = -glm::dot(s.normal, dir);
+      if (cos_in <= 0.0f) break;
+      glm::vec3 x = origin + hit->t * dir;
+      x -= s.normal * glm::dot(x - s.origin, s.normal);  // snap onto the polygon's plane
+
+      // Emission seen along the path: in full from the camera; after a bounce weighted against
+      // next-event estimation, which samples the same paths (Veach eq. 9.13).
+      if (s.light_pdf_area > 0.0f) {
+        if (depth == 0) {
+          L += beta * s.emission * kInvPi;
+        } else {
+          const glm::vec3 w = x - prev_x;
+          const float pdf_light = s.light_pdf_area * glm::dot(w, w) / cos_in;
+          L += beta * s.emission * (kInvPi * power_heuristic(prev_pdf, pdf_light));
+        }
+      }
+      if (options_.max_depth > 0 && depth >= options_.max_depth) break;
+      if (max_component(s.reflectance) <= 0.0f) break;
+
+      const glm::vec3 n = s.normal;
+      const glm::vec3 offset_origin = x + epsilon_ * n;
+      if (!emitters_.empty()) L += beta * direct_light(x, offset_origin, n, s.reflectance, rng);
+
+      // Cosine-weighted bounce: f cos / pdf = (rho/pi) cos / (cos/pi) = rho.
+      const glm::vec2 u = rng.uniform2();
+      const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+      const float cz = std::sqrt(std::max(0.0f, 1.0f - u.x));
+      glm::vec3 t, b;
+      basis(n, t, b);
+      dir = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + cz * n);
+      prev_pdf = std::max(glm::dot(n, dir), 0.0f) * kInvPi;
+      beta *= s.reflectance;
+
+      // Russian roulette (Arvo & Kirk 1990): survive with q = min(max beta, 0.95), reweight 1/q.
+      if (depth + 1 >= kRouletteStart) {
+        const float q = std::min(max_component(beta), kMaxSurvival);
+        if (!(rng.uniform() < q)) break;
+        beta /= q;
+      }
+      prev_x = x;
+      origin = offset_origin;
+      tnear = 0.0f;
+    }
+    return L;
+  }
+
+  /// Next-event estimate of the light reflected at x towards the previous vertex, divided by
+  /// the throughput: one point on one emitter, MIS-weighted against the cosine bounce.
+  Rgb direct_light(const glm::vec3& x, const glm::vec3& offset_origin, const glm::vec3& n, const Rgb& rho,
+                   detail::Rng& rng) const {
+    const Emitter& e = emitters_[sample_cdf(emitter_cdf_, rng.uniform())];
+    const std::size_t tri = sample_cdf(e.cdf, rng.uniform());
+    // Uniform point in a triangle: barycentrics (1 - sqrt(u1), u2 sqrt(u1)).
+    const glm::vec2 u = rng.uniform2();
+    const float su = std::sqrt(u.x);
+    const glm::vec3 y = (1.0f - su) * e.a[tri] + (u.y * su) * e.b[tri] + (su * (1.0f - u.y)) * e.c[tri];
+    const Surface& light = surfaces_[e.polygon];
+
+    const glm::vec3 w = y - x;
+    const float d2 = glm::dot(w, w);
+    if (!(d2 > 0.0f)) return Rgb(0.0f);
+    const glm::vec3 wi = w / std::sqrt(d2);
+    const float cos_x = glm::dot(n, wi), cos_y = -glm::dot(light.normal, wi);
+    if (cos_x <= 0.0f || cos_y <= 0.0f) return Rgb(0.0f);
+
+    // Shadow ray between the two offset points (both on the lit sides of their planes).
+    const glm::vec3 target = y + epsilon_ * light.normal;
+    const glm::vec3 sw = target - offset_origin;
+    const float dist = glm::length(sw);
+    if (rays_.occluded(offset_origin, sw / dist, 0.0f, dist)) return Rgb(0.0f);
+
+    // Area pdf to solid angle: p_w = p_A r^2 / cos_y (Veach eq. 8.10).
+    const float pdf_light = light.light_pdf_area * d2 / cos_y;
+    const float pdf_bounce = cos_x * kInvPi;
+    // f L_e cos_x / p_w, with f = rho/pi and L_e = E/pi.
+    return rho * light.emission * (kInvPi * kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
+  }
+
+  /// Orthonormal t, b completing the unit normal n (Duff et al. 2017).
+  static void basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+    const float sign = std::copysign(1.0f, n.z);
+    const float a = -1.0f / (sign + n.z);
+    const float c = n.x * n.y * a;
+    t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
+  }
+
+  const PathTraceOptions& options_;
+  detail::PinholeCamera camera_;
+  detail::RayScene rays_;
+  int g_;
+  float epsilon_ = 0.0f;
+  std::vector<Surface> surfaces_;
+  std::vector<Emitter> emitters_;
+  std::vector<double> emitter_power_;
+  std::vector<float> emitter_cdf_;
+};
+
+}  // namespace
+
+void validate(const PathTraceOptions& options) {
+  if (options.width <= 0) bad_option("width must be > 0, got " + std::to_string(options.width));
+  if (options.height <= 0) bad_option("height must be > 0, got " + std::to_string(options.height));
+  if (options.spp <= 0) bad_option("spp must be > 0, got " + std::to_string(options.spp));
+  if (options.max_depth < 0)
+    bad_option("max_depth must be >= 0 (0 = unlimited), got " + std::to_string(options.max_depth));
+  if (options.camera) {
+    const Camera& c = *options.camera;
+    if (!finite(c.eye) || !finite(c.look_at) || !finite(c.up)) bad_option("camera: eye, look_at and up must be finite");
+    if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f))
+      bad_option("camera.fov_deg must be in (0, 180), got " + std::to_string(c.fov_deg));
+    const glm::vec3 forward = c.look_at - c.eye;
+    const float length = glm::length(forward);
+    if (!(length > 0.0f)) bad_option("camera.look_at must differ from camera.eye");
+    if (!(glm::length(glm::cross(forward / length, c.up)) > 1e-6f * glm::length(c.up)))
+      bad_option("camera.up must be non-zero and not parallel to the view direction");
+  }
+}
+
+Image render_path_traced(const Scene& scene, const PathTraceOptions& options) {
+  validate(options);
+  const PathTracer tracer(scene, options);
+  return tracer.render();
+}
+
+}  // namespace v1
+}  // namespace radiosity
