@@ -101,7 +101,7 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
   cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
-      ->check(CLI::IsMember({"ray-cast", "analytic"}))
+      ->check(CLI::IsMember({"ray-cast", "hemicube", "analytic"}))
       ->capture_default_str();
   cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(CLI::NonNegativeNumber);
@@ -129,8 +129,9 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.method = a.method == "jacobi"        ? rad::SolverMethod::jacobi
              : a.method == "progressive" ? rad::SolverMethod::progressive
                                          : rad::SolverMethod::gauss_seidel;
-  o.form_factors.method =
-      a.form_factors == "analytic" ? rad::FormFactorMethod::analytic : rad::FormFactorMethod::ray_cast;
+  o.form_factors.method = a.form_factors == "analytic"   ? rad::FormFactorMethod::analytic
+                           : a.form_factors == "hemicube" ? rad::FormFactorMethod::hemicube
+                                                          : rad::FormFactorMethod::ray_cast;
   o.mesh.max_patch_area = a.max_patch_area;
   o.mesh.max_element_area = a.max_element_area;
   o.tolerance = a.tolerance;

@@ -1,4 +1,4 @@
-// The `radiosity` command-line tool: render, solve and (with the form-factor issue) factors.
+// The `radiosity` command-line tool: render, solve and factors.
 // Output formats are a contract that scripts parse: see docs/CLI.md.
 #include <cstdio>
 #include <filesystem>
@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "factors.hpp"
 
 using namespace cli;
 
@@ -53,11 +54,14 @@ int main(int argc, char** argv) {
   solve->add_option("--ply", ply, "Write the solution as a PLY mesh with per-vertex colours");
   add_solve_options(*solve, solve_args);
 
+  Command factors = add_factors_command(app);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  if (*factors.app) return factors.run();
 
   try {
     ProgressBar bar;

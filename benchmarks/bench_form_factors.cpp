@@ -1,0 +1,237 @@
+// Form-factor throughput: the ray-cast estimator next to bare Embree occlusion rays on the same
+// scene, hemicube rows per second, and the time for all factors of a ~10k-element Cornell box.
+// A plain std::chrono harness (median of a few runs for the short measurements); prints what it
+// measured. Usage: bench_form_factors [--quick] (--quick skips the ~10k-element runs).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "detail/parallel.hpp"
+#include "detail/rng.hpp"
+#include "formfactor/estimators.hpp"
+#include "formfactor/shaft.hpp"
+#include "geometry/ray_scene.hpp"
+#include "radiosity/radiosity.hpp"
+
+namespace rad = radiosity;
+namespace detail = radiosity::detail;
+
+namespace {
+
+double seconds(const std::function<void()>& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double median_seconds(int runs, const std::function<void()>& f) {
+  std::vector<double> t;
+  for (int i = 0; i < runs; ++i) t.push_back(seconds(f));
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+// A 10 x 4 x 10 room with a 4 x 4 grid of 1 x 1.5 x 1 boxes on its floor: most pairs are shadowed.
+rad::Scene grid_of_boxes() {
+  rad::Scene s;
+  const rad::MaterialId m = s.add_material({});
+  auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 towards, const char* group) {
+    std::vector<glm::vec3> q{a, b, c, d};
+    if (glm::dot(glm::cross(b - a, c - a), towards - a) < 0.0f) std::reverse(q.begin(), q.end());
+    s.add_polygon(q, m, group);
+  };
+  auto box = [&](glm::vec3 lo, glm::vec3 hi, bool inward, const char* group) {
+    const glm::vec3 c = 0.5f * (lo + hi);
+    auto face = [&](glm::vec3 a, glm::vec3 b, glm::vec3 cc, glm::vec3 d) {
+      const glm::vec3 centre = 0.25f * (a + b + cc + d);
+      quad(a, b, cc, d, inward ? c : 2.0f * centre - c, group);
+    };
+    const float x0 = lo.x, x1 = hi.x, y0 = lo.y, y1 = hi.y, z0 = lo.z, z1 = hi.z;
+    face({x0, y0, z0}, {x0, y1, z0}, {x0, y1, z1}, {x0, y0, z1});
+    face({x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1});
+    if (inward) face({x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1});  // boxes have no bottom
+    face({x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1});
+    face({x0, y0, z0}, {x1, y0, z0}, {x1, y1, z0}, {x0, y1, z0});
+    face({x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1});
+  };
+  box({0, 0, 0}, {10, 4, 10}, true, "room");
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 4; ++k) {
+      const glm::vec3 lo(1.5f + 2.0f * i, 0.0f, 1.5f + 2.0f * k);
+      box(lo, lo + glm::vec3(1.0f, 1.5f, 1.0f), false, "boxes");
+    }
+  return s;
+}
+
+// Occlusion rays like the estimator's: between uniform points of (element, patch) pairs that
+// face each other and that the shaft test cannot clear, offset off both surfaces.
+struct RaySet {
+  std::vector<glm::vec3> origin, direction;
+};
+
+RaySet shadowed_pair_rays(const rad::Scene& scene, const rad::PatchHierarchy& h, std::size_t count) {
+  std::vector<std::vector<glm::vec3>> polygons;
+  std::vector<glm::vec3> normals;
+  for (const rad::Polygon& p : scene.polygons()) {
+    polygons.push_back(p.vertices);
+    normals.push_back(p.normal);
+  }
+  const detail::ShaftCuller culler(polygons, normals);
+  const float eps = 1e-5f * scene.bounds().diagonal();
+  const auto& leaves = h.leaves();
+  const auto& patches = h.patches();
+  detail::Rng rng(7);
+  RaySet rays;
+  while (rays.origin.size() < count) {
+    const std::uint32_t e = leaves[rng.next() % leaves.size()];
+    const std::uint32_t j = static_cast<std::uint32_t>(rng.next() % patches.size());
+    const rad::Element& el = h.element(e);
+    const rad::Patch& src = patches[el.patch];
+    const rad::Patch& dst = patches[j];
+    if (src.polygon == dst.polygon) continue;
+    std::vector<glm::vec3> a, b;
+    for (int k = 0; k < el.corner_count(); ++k) a.push_back(h.vertices()[el.corners[static_cast<std::size_t>(k)]]);
+    const rad::Element& root = h.element(dst.root);
+    for (int k = 0; k < root.corner_count(); ++k) b.push_back(h.vertices()[root.corners[static_cast<std::size_t>(k)]]);
+    detail::Shaft shaft;
+    if (!shaft.build(a.data(), static_cast<int>(a.size()), src.normal, b.data(), static_cast<int>(b.size()), dst.normal,
+                     eps))
+      continue;
+    if (!culler.any(shaft, src.polygon, dst.polygon)) continue;
+    for (int r = 0; r < 16; ++r) {
+      const glm::vec3 x = h.sample_point(e, rng.uniform2()) + eps * src.normal;
+      const glm::vec3 y = h.sample_point(dst.root, rng.uniform2()) + eps * dst.normal;
+      rays.origin.push_back(x);
+      rays.direction.push_back(y - x);
+    }
+  }
+  return rays;
+}
+
+// Bare Embree: occluded() over the ray set on `threads` threads, in rays per second.
+double bare_rays_per_second(const detail::RayScene& rs, const RaySet& rays, unsigned threads) {
+  std::vector<unsigned char> hit(rays.origin.size());
+  const double t = median_seconds(3, [&] {
+    detail::parallel_for(threads, rays.origin.size(), 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) hit[i] = rs.occluded(rays.origin[i], rays.direction[i], 0.0f, 1.0f - 1e-4f);
+    });
+  });
+  std::size_t blocked = 0;
+  for (const unsigned char c : hit) blocked += c;
+  std::printf("    bare Embree rtcOccluded1, %u thread(s): %zu rays (%.0f%% blocked) in %.3f s = %.2f Mrays/s\n",
+              threads, rays.origin.size(),
+              100.0 * static_cast<double>(blocked) / static_cast<double>(rays.origin.size()), t,
+              static_cast<double>(rays.origin.size()) / t * 1e-6);
+  return static_cast<double>(rays.origin.size()) / t;
+}
+
+// All rows of the scene with the ray-cast estimator; returns rays per second.
+double ray_cast_rows(const rad::Scene& scene, const rad::PatchHierarchy& h, unsigned threads, double bare) {
+  rad::FormFactorOptions o;
+  o.threads = threads;
+  const auto est = rad::make_form_factor_estimator(scene, h, o);
+  const std::size_t m = h.leaves().size(), n = h.patches().size();
+  std::vector<float> F(m * n);
+  const double t = seconds([&] { est->element_rows(h.leaves(), F.data()); });
+  detail::RayCastCounters c;
+  detail::ray_cast_counters(*est, c);
+  std::size_t nonzero = 0;
+  for (const float f : F) nonzero += f > 0.0f ? 1 : 0;
+  const double rays_per_second = static_cast<double>(c.rays) / t;
+  std::printf("    ray-cast estimator, %u thread(s): %zu x %zu factors (%zu non-zero) in %.3f s = %.2f Mfactors/s\n",
+              threads, m, n, nonzero, t, static_cast<double>(m * n) / t * 1e-6);
+  std::printf("      %.1f%% of the pairs needed rays (shaft test); %.2f M rays = %.1f per such pair; %.2f Mrays/s\n",
+              100.0 * static_cast<double>(c.shadowed) / static_cast<double>(m * n), static_cast<double>(c.rays) * 1e-6,
+              static_cast<double>(c.rays) / std::max<double>(1.0, static_cast<double>(c.shadowed)),
+              rays_per_second * 1e-6);
+  std::printf("      ratio to bare Embree: %.2f (the share of the estimator's time that its rays would take alone)\n",
+              rays_per_second / bare);
+  return rays_per_second;
+}
+
+void ray_cast_section(const char* title, const rad::Scene& scene, const rad::MeshOptions& mesh) {
+  const rad::PatchHierarchy h(scene, mesh);
+  std::printf("\n%s: %zu polygons, %zu patches, %zu elements\n", title, scene.polygons().size(), h.patches().size(),
+              h.leaves().size());
+  const detail::RayScene rs = detail::RayScene::from_polygons(scene);
+  const RaySet rays = shadowed_pair_rays(scene, h, 2'000'000);
+  for (const unsigned threads : {1u, 2u}) {
+    const double bare = bare_rays_per_second(rs, rays, threads);
+    ray_cast_rows(scene, h, threads, bare);
+  }
+}
+
+void hemicube_section(const rad::Scene& scene) {
+  const rad::PatchHierarchy h(scene, rad::MeshOptions{});
+  std::printf("\nHemicube, resolution 256, 4 hemicubes per element (the defaults), Cornell box %zu patches:\n",
+              h.patches().size());
+  std::vector<std::uint32_t> rows(h.leaves().begin(), h.leaves().begin() + 256);
+  std::vector<float> F(rows.size() * h.patches().size());
+  for (const unsigned threads : {1u, 2u}) {
+    rad::FormFactorOptions o;
+    o.method = rad::FormFactorMethod::hemicube;
+    o.threads = threads;
+    const auto est = rad::make_form_factor_estimator(scene, h, o);
+    const double t = median_seconds(3, [&] { est->element_rows(rows, F.data()); });
+    std::printf("    %u thread(s): %zu rows in %.3f s = %.1f rows/s (%.0f hemicubes/s)\n", threads, rows.size(), t,
+                static_cast<double>(rows.size()) / t, 4.0 * static_cast<double>(rows.size()) / t);
+    o.source_samples = 1;
+    const auto one = rad::make_form_factor_estimator(scene, h, o);
+    const double t1 = median_seconds(3, [&] { one->element_rows(rows, F.data()); });
+    std::printf("    %u thread(s), 1 hemicube per element: %.1f rows/s\n", threads,
+                static_cast<double>(rows.size()) / t1);
+  }
+  rad::FormFactorOptions o;
+  o.method = rad::FormFactorMethod::hemicube;
+  o.threads = 2;
+  const auto est = rad::make_form_factor_estimator(scene, h, o);
+  std::vector<float> column(h.leaves().size());
+  const double t = median_seconds(3, [&] { est->patch_column(17, h.leaves(), column.data()); });
+  std::printf("    patch_column over all %zu elements, 2 threads: %.3f s\n", h.leaves().size(), t);
+}
+
+void cornell_10k(const rad::Scene& scene) {
+  rad::MeshOptions mesh;
+  mesh.max_patch_area = static_cast<float>(scene.total_area() / 512.0);
+  mesh.max_element_area = mesh.max_patch_area / 16.0f;
+  const rad::PatchHierarchy h(scene, mesh);
+  const std::size_t m = h.leaves().size(), n = h.patches().size();
+  std::printf("\nCornell box, %zu patches, %zu elements, all %zu factors on 2 threads:\n", n, m, m * n);
+  std::vector<float> F(m * n);
+  for (const rad::FormFactorMethod method :
+       {rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::analytic, rad::FormFactorMethod::hemicube}) {
+    rad::FormFactorOptions o;
+    o.method = method;
+    o.threads = 2;
+    const auto est = rad::make_form_factor_estimator(scene, h, o);
+    const double t = seconds([&] { est->element_rows(h.leaves(), F.data()); });
+    std::printf("    %-9s %.2f s (%.2f Mfactors/s)\n",
+                method == rad::FormFactorMethod::ray_cast   ? "ray-cast"
+                : method == rad::FormFactorMethod::analytic ? "analytic"
+                                                            : "hemicube",
+                t, static_cast<double>(m * n) / t * 1e-6);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  std::printf("bench_form_factors (radiosity %s), %u hardware threads\n", rad::version(),
+              std::thread::hardware_concurrency());
+  const rad::Scene cornell = rad::cornell_box();
+  ray_cast_section("Cornell box, default mesh", cornell, rad::MeshOptions{});
+  rad::MeshOptions grid_mesh;
+  grid_mesh.max_patch_area = 0.5f;
+  ray_cast_section("Grid of boxes in a room (mostly shadowed pairs)", grid_of_boxes(), grid_mesh);
+  hemicube_section(cornell);
+  if (!quick) cornell_10k(cornell);
+  return 0;
+}
