@@ -176,6 +176,24 @@ inline glm::vec3 parse_vec3(const std::string& s, const char* name) {
   return v;
 }
 
+/// Runs a command body and turns exceptions into the CLI's exit codes: 1 for a
+/// radiosity::Error (bad input; the message names the file, line or field), 2 for a bad
+/// argument, 3 for anything unexpected.
+inline int run_guarded(const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const rad::Error& e) {
+    std::fprintf(stderr, "radiosity: error: %s\n", e.what());
+    return 1;
+  } catch (const CLI::ValidationError& e) {
+    std::fprintf(stderr, "radiosity: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "radiosity: unexpected error: %s\n", e.what());
+    return 3;
+  }
+}
+
 /// A subcommand added by another file: `run` is called when the user chose it and returns the
 /// process exit code.
 struct Command {

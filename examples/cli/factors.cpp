@@ -35,7 +35,7 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 int run_factors(const FactorsArgs& a) {
-  try {
+  return run_guarded([&] {
     rad::Scene scene = load(a.scene);
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
@@ -69,16 +69,7 @@ int run_factors(const FactorsArgs& a) {
                  v.patch_count, v.element_count, a.method.c_str(), v.seconds, a.output.empty() ? "" : ", wrote ",
                  a.output.c_str());
     return 0;
-  } catch (const rad::Error& e) {
-    std::fprintf(stderr, "radiosity: error: %s\n", e.what());
-    return 1;
-  } catch (const CLI::ValidationError& e) {
-    std::fprintf(stderr, "radiosity: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "radiosity: unexpected error: %s\n", e.what());
-    return 3;
-  }
+  });
 }
 
 }  // namespace

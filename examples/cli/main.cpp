@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   }
   if (*factors.app) return factors.run();
 
-  try {
+  return run_guarded([&] {
     ProgressBar bar;
     if (*render) {
       rad::Scene scene = load(render_args.scene);
@@ -139,15 +139,6 @@ int main(int argc, char** argv) {
         std::printf("wrote %s\n", ply.c_str());
       }
     }
-  } catch (const rad::Error& e) {
-    std::fprintf(stderr, "radiosity: error: %s\n", e.what());
-    return 1;
-  } catch (const CLI::ValidationError& e) {
-    std::fprintf(stderr, "radiosity: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "radiosity: unexpected error: %s\n", e.what());
-    return 3;
-  }
-  return 0;
+    return 0;
+  });
 }

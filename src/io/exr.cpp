@@ -16,6 +16,7 @@
 #include <system_error>
 #include <vector>
 
+#include "io/image_checks.hpp"
 #include "radiosity/io.hpp"
 #include "radiosity/version.hpp"
 
@@ -39,13 +40,8 @@ void insert_rgb(Imf::FrameBuffer& fb, const std::string& prefix, const Rgb* pixe
 
 void check_image(const Image& image, const std::filesystem::path& path) {
   const std::string where = "write_exr: '" + path.string() + "': ";
-  if (image.width <= 0 || image.height <= 0)
-    throw Error(ErrorCode::invalid_argument, where + "image size " + std::to_string(image.width) + " x " +
-                                                 std::to_string(image.height) + " is empty");
-  const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-  if (image.pixels.size() != n)
-    throw Error(ErrorCode::invalid_argument, where + "image has " + std::to_string(image.pixels.size()) +
-                                                 " pixels, width x height = " + std::to_string(n));
+  detail::check_image_size(image, where);
+  const std::size_t n = image.pixels.size();
   std::set<std::string> names;
   for (const auto& [name, values] : image.layers) {
     if (name.empty()) throw Error(ErrorCode::invalid_argument, where + "a layer has an empty name");

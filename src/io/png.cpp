@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "io/image_checks.hpp"
 #include "io/srgb.hpp"
 #include "radiosity/io.hpp"
 
@@ -31,13 +32,8 @@ inline namespace v1 {
 
 void write_png(const Image& image, const std::filesystem::path& path, const PngOptions& options) {
   const std::string where = "write_png: '" + path.string() + "': ";
-  if (image.width <= 0 || image.height <= 0)
-    throw Error(ErrorCode::invalid_argument, where + "image size " + std::to_string(image.width) + " x " +
-                                                 std::to_string(image.height) + " is empty");
-  const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-  if (image.pixels.size() != n)
-    throw Error(ErrorCode::invalid_argument, where + "image has " + std::to_string(image.pixels.size()) +
-                                                 " pixels, width x height = " + std::to_string(n));
+  detail::check_image_size(image, where);
+  const std::size_t n = image.pixels.size();
   if (!(options.exposure >= 0.0f) || !std::isfinite(options.exposure))
     throw Error(ErrorCode::invalid_argument, where + "PngOptions::exposure must be finite and >= 0");
 
