@@ -16,10 +16,6 @@ namespace radiosity::detail {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z); }
 
 }  // namespace

@@ -18,10 +18,6 @@ namespace radiosity::detail {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 double sum3(const Rgb& c) { return static_cast<double>(c.x) + c.y + c.z; }
 
 }  // namespace

@@ -14,9 +14,7 @@ inline namespace v1 {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using detail::seconds_since;
 
 constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
 
