@@ -25,6 +25,8 @@
 namespace radiosity {
 inline namespace v1 {
 
+struct Material;  // scene.hpp
+
 /// Orthonormal frame (tangent, bitangent, normal) that maps world directions to the local shading
 /// frame of brdf.hpp (normal = +z, tangent = +x) and back. Right-handed: bitangent = normal x tangent.
 /// Thread safety: a plain value; const member functions may be called concurrently.
@@ -184,6 +186,20 @@ RADIOSITY_API std::unique_ptr<Brdf> make_mix(std::shared_ptr<const Brdf> first, 
 /// file for a short header, wrong dimensions or truncated data.
 /// Thread safety: may be called concurrently (reads only the given file).
 RADIOSITY_API std::unique_ptr<Brdf> load_measured(const std::filesystem::path& merl_binary);
+
+/// The reflection model of a scene material for the second pass: `material.brdf` when set,
+/// else one derived from its fields, energy-conserving whenever the material validates:
+/// - only a diffuse part: make_lambertian(reflectance);
+/// - specular with specular_exponent > 0: make_phong(reflectance, specular, exponent);
+/// - specular with exponent 0: an ideal mirror mixed with the diffuse part (mixture weights
+///   proportional to the two parts' largest channels, so the sum of both albedos is kept);
+/// - transmittance > 0: make_dielectric(ior, transmittance), mixed with the diffuse and
+///   specular parts in the same way when they are non-zero.
+/// Diffuse transmittance is not a BRDF; pass 1 carries it. Material::two_sided is the
+/// renderer's business (it flips the frame). Throws Error{invalid_argument} when the fields are
+/// not energy-conserving (diffuse + specular > 1 in a channel). Thread safety: may be called
+/// concurrently.
+RADIOSITY_API std::shared_ptr<const Brdf> make_brdf(const Material& material);
 
 /// Unpolarised Fresnel reflectance of a smooth dielectric interface, in [0, 1].
 /// `cos_theta_i` in [-1, 1] is the cosine between the incident direction and the normal; negative

@@ -11,6 +11,7 @@
 
 #include "brdf/brdf_test_util.hpp"
 #include "radiosity/brdf.hpp"
+#include "radiosity/scene.hpp"
 
 using namespace brdf_test;
 using radiosity::ErrorCode;
@@ -283,5 +284,40 @@ TEST_SUITE("brdf") {
     const auto p = radiosity::ShadingFrame::from_normal_tangent(glm::vec3(0, 0, 1), glm::vec3(0, 0, 3));
     CHECK(std::abs(glm::dot(p.tangent, p.normal)) < 1e-6f);
     CHECK_THROWS_AS(radiosity::ShadingFrame::from_normal(glm::vec3(0.0f)), radiosity::Error);
+  }
+}
+
+TEST_CASE("make_brdf derives the second-pass model from a material's fields") {
+  using namespace radiosity;
+  const glm::vec3 wo = glm::normalize(glm::vec3(0.3f, -0.2f, 0.9f));
+  SUBCASE("diffuse only is Lambertian") {
+    Material m;
+    m.reflectance = Rgb(0.2f, 0.4f, 0.6f);
+    const auto b = make_brdf(m);
+    const Rgb f = b->eval(wo, glm::vec3(0, 0, 1));
+    CHECK(f.y == doctest::Approx(0.4f / 3.14159265f).epsilon(1e-6));
+  }
+  SUBCASE("a mirror keeps both albedos") {
+    Material m;
+    m.reflectance = Rgb(0.1f, 0.2f, 0.3f);
+    m.specular = Rgb(0.6f);
+    const auto b = make_brdf(m);
+    const Rgb a = b->albedo(wo);
+    CHECK(a.x == doctest::Approx(0.7f).epsilon(0.01));
+    CHECK(a.z == doctest::Approx(0.9f).epsilon(0.01));
+  }
+  SUBCASE("glass is a dielectric that conserves energy") {
+    Material m;
+    m.reflectance = Rgb(0.0f);
+    m.transmittance = Rgb(1.0f);
+    m.ior = 1.5f;
+    const auto b = make_brdf(m);
+    CHECK(b->is_delta());
+    CHECK(b->albedo(wo).y == doctest::Approx(1.0f).epsilon(1e-4));
+  }
+  SUBCASE("a set brdf wins") {
+    Material m;
+    m.brdf = make_mirror(Rgb(0.5f));
+    CHECK(make_brdf(m) == m.brdf);
   }
 }
