@@ -9,7 +9,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -19,12 +21,17 @@
 
 namespace {
 
+radiosity::FormFactorMethod g_estimator = radiosity::FormFactorMethod::monte_carlo;
+std::uint32_t g_rays = 0;
+
 int run(std::size_t target_patches, radiosity::SolverMethod method, const char* name) {
   const radiosity::Scene scene = radiosity::cornell_box();
   radiosity::SolveOptions opt;
   opt.method = method;
   opt.tolerance = 1e-3;
   opt.threads = 2;
+  opt.form_factors.method = g_estimator;
+  opt.form_factors.hemisphere_rays = g_rays;
   // Patches are at most this large, so there are somewhat more than target_patches of them.
   opt.mesh.max_patch_area = static_cast<float>(scene.total_area() / static_cast<double>(target_patches));
   opt.mesh.max_element_area = opt.mesh.max_patch_area;
@@ -42,11 +49,85 @@ int run(std::size_t target_patches, radiosity::SolverMethod method, const char* 
   return 0;
 }
 
+double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+/// Accuracy of the Monte Carlo estimator: Gauss-Seidel solutions on one mesh with the accurate
+/// ray-cast factors and with monte_carlo at several ray counts; prints the area-weighted relative
+/// RMS difference of element radiosity (summed over channels) and the largest difference of a
+/// group's mean. Emitters are left out (their emission dominates).
+void compare(std::size_t target_patches) {
+  const radiosity::Scene scene = radiosity::cornell_box();
+  radiosity::SolveOptions opt;
+  opt.tolerance = 1e-4;
+  opt.threads = 2;
+  opt.mesh.max_patch_area = static_cast<float>(scene.total_area() / static_cast<double>(target_patches));
+  opt.mesh.max_element_area = opt.mesh.max_patch_area;
+  opt.form_factors.method = radiosity::FormFactorMethod::ray_cast;
+  double c0 = cpu_seconds();
+  const radiosity::Solution ref = radiosity::solve(scene, opt);
+  std::printf("compare: %zu elements; ray_cast reference %.1f s CPU\n", ref.report().element_count,
+              cpu_seconds() - c0);
+  auto sum3 = [](const radiosity::Rgb& c) { return static_cast<double>(c.x) + c.y + c.z; };
+  for (std::uint32_t rays : {0u, 256u, 1024u, 4096u}) {
+    opt.form_factors.method = rays == 0 ? radiosity::FormFactorMethod::ray_cast : radiosity::FormFactorMethod::monte_carlo;
+    opt.seed = 2;
+    opt.form_factors.hemisphere_rays = rays;
+    c0 = cpu_seconds();
+    const radiosity::Solution mc = radiosity::solve(scene, opt);
+    const double cpu = cpu_seconds() - c0;
+    double num = 0.0, den = 0.0;
+    for (std::uint32_t e : ref.hierarchy().leaves()) {
+      const radiosity::Patch& patch = ref.hierarchy().patches()[ref.hierarchy().element(e).patch];
+      if (sum3(scene.material(scene.polygons()[patch.polygon].material).emission) > 0.0)
+        continue;
+      const double a = ref.hierarchy().element(e).area;
+      const double d = sum3(mc.radiosity()[e]) - sum3(ref.radiosity()[e]);
+      num += a * d * d;
+      den += a * sum3(ref.radiosity()[e]) * sum3(ref.radiosity()[e]);
+    }
+    if (std::getenv("BENCH_DEBUG")) {
+      std::vector<std::pair<double, std::uint32_t>> v;
+      for (std::uint32_t e : ref.hierarchy().leaves()) {
+        const double d = sum3(mc.radiosity()[e]) - sum3(ref.radiosity()[e]);
+        v.emplace_back(ref.hierarchy().element(e).area * d * d, e);
+      }
+      std::sort(v.rbegin(), v.rend());
+      for (int k = 0; k < 6; ++k) {
+        const auto e = v[static_cast<std::size_t>(k)].second;
+        const auto& el = ref.hierarchy().element(e);
+        std::printf("    %s (%.0f %.0f %.0f) ref %.3f mc %.3f\n", scene.groups()[ref.hierarchy().patches()[el.patch].group].c_str(),
+                    el.centroid.x, el.centroid.y, el.centroid.z, sum3(ref.radiosity()[e]), sum3(mc.radiosity()[e]));
+      }
+    }
+    double worst = 0.0;
+    for (const std::string& g : scene.groups())
+      worst = std::max(worst, std::fabs(sum3(mc.group_radiosity(g)) / sum3(ref.group_radiosity(g)) - 1.0));
+    std::printf("  monte_carlo %5u rays: reflectors' RMS difference / RMS radiosity %5.2f %%, worst group mean %5.2f %%, %.2f s CPU "
+                "(form factors %.2f s wall)\n",
+                rays, 100.0 * std::sqrt(num / den), 100.0 * worst, cpu, mc.report().seconds_form_factors);
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::size_t> sizes;
-  for (int i = 1; i < argc; ++i) sizes.push_back(std::strtoul(argv[i], nullptr, 10));
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--compare" && i + 1 < argc) {
+      compare(std::strtoul(argv[++i], nullptr, 10));
+      return 0;
+    }
+    if (arg == "--ray-cast") g_estimator = radiosity::FormFactorMethod::ray_cast;
+    else if (arg == "--rays" && i + 1 < argc) g_rays = static_cast<std::uint32_t>(std::strtoul(argv[++i], nullptr, 10));
+    else sizes.push_back(std::strtoul(arg.c_str(), nullptr, 10));
+  }
   if (sizes.empty()) sizes = {4000};
   const struct {
     radiosity::SolverMethod method;

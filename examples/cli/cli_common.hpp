@@ -82,6 +82,7 @@ struct SolveArgs {
   std::string scene;
   std::string method = "gauss-seidel";
   std::string form_factors = "ray-cast";
+  unsigned hemisphere_rays = 0;
   float max_patch_area = 0.0f;
   float max_element_area = 0.0f;
   double tolerance = 1e-3;
@@ -93,6 +94,20 @@ struct SolveArgs {
   int adaptive_passes = 3;
 };
 
+/// The estimator a `--form-factors` / `--method` name (as the CLI spells it) selects.
+inline rad::FormFactorMethod form_factor_method(const std::string& name) {
+  return name == "analytic"      ? rad::FormFactorMethod::analytic
+         : name == "hemicube"    ? rad::FormFactorMethod::hemicube
+         : name == "monte-carlo" ? rad::FormFactorMethod::monte_carlo
+                                 : rad::FormFactorMethod::ray_cast;
+}
+
+/// The names form_factor_method() accepts.
+inline const std::vector<std::string>& form_factor_names() {
+  static const std::vector<std::string> names = {"ray-cast", "hemicube", "analytic", "monte-carlo"};
+  return names;
+}
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
@@ -101,8 +116,10 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
   cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
-      ->check(CLI::IsMember({"ray-cast", "hemicube", "analytic"}))
+      ->check(CLI::IsMember(form_factor_names()))
       ->capture_default_str();
+  cmd.add_option("--hemisphere-rays", a.hemisphere_rays,
+                 "Monte Carlo estimator: rays per element, 16..1048576 (0 = default: 1024)");
   cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(CLI::NonNegativeNumber);
   cmd.add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
@@ -129,9 +146,8 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.method = a.method == "jacobi"        ? rad::SolverMethod::jacobi
              : a.method == "progressive" ? rad::SolverMethod::progressive
                                          : rad::SolverMethod::gauss_seidel;
-  o.form_factors.method = a.form_factors == "analytic"   ? rad::FormFactorMethod::analytic
-                           : a.form_factors == "hemicube" ? rad::FormFactorMethod::hemicube
-                                                          : rad::FormFactorMethod::ray_cast;
+  o.form_factors.method = form_factor_method(a.form_factors);
+  o.form_factors.hemisphere_rays = a.hemisphere_rays;
   o.mesh.max_patch_area = a.max_patch_area;
   o.mesh.max_element_area = a.max_element_area;
   o.tolerance = a.tolerance;

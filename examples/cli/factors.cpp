@@ -19,7 +19,7 @@ struct FactorsArgs {
   bool sparse = false;
   std::string output;
   std::string groups;
-  unsigned samples = 0, rays = 0, resolution = 0;
+  unsigned samples = 0, rays = 0, resolution = 0, hemisphere_rays = 0;
   std::uint64_t seed = 1;
   unsigned threads = 0;
   float max_patch_area = 0.0f, max_element_area = 0.0f;
@@ -39,9 +39,8 @@ int run_factors(const FactorsArgs& a) {
     rad::Scene scene = load(a.scene);
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
-    o.form_factors.method = a.method == "hemicube"   ? rad::FormFactorMethod::hemicube
-                            : a.method == "analytic" ? rad::FormFactorMethod::analytic
-                                                     : rad::FormFactorMethod::ray_cast;
+    o.form_factors.method = form_factor_method(a.method);
+    o.form_factors.hemisphere_rays = a.hemisphere_rays;
     o.form_factors.source_samples = a.samples;
     o.form_factors.visibility_rays = a.rays;
     o.form_factors.hemicube_resolution = a.resolution;
@@ -81,7 +80,7 @@ Command add_factors_command(CLI::App& app) {
       "factors", "Group-to-group view factors F(gi -> gk), area-weighted over each source group, as CSV or JSON");
   cmd->add_option("scene", a.scene, "OBJ file (default: the built-in Cornell box)");
   cmd->add_option("--method", a.method, "Form-factor estimator")
-      ->check(CLI::IsMember({"ray-cast", "hemicube", "analytic"}))
+      ->check(CLI::IsMember(form_factor_names()))
       ->capture_default_str();
   cmd->add_option("--format", a.format, "Output format")->check(CLI::IsMember({"csv", "json"}))->capture_default_str();
   cmd->add_flag("--sparse", a.sparse, "Only the non-zero factors (CSV: from,to,factor rows)");
@@ -92,6 +91,8 @@ Command add_factors_command(CLI::App& app) {
       ->check(CLI::Range(0u, 64u));
   cmd->add_option("--rays", a.rays, "Ray cast: occlusion rays per source point, 1..64 (0 = default: 4)")
       ->check(CLI::Range(0u, 64u));
+  cmd->add_option("--hemisphere-rays", a.hemisphere_rays,
+                  "Monte Carlo: rays per element, 16..1048576 (0 = default: 1024)");
   cmd->add_option("--resolution", a.resolution, "Hemicube: top-face resolution in pixels, 2..8192 (0 = 256)")
       ->check(CLI::Range(0u, 8192u));
   cmd->add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")

@@ -29,6 +29,14 @@ enum class FormFactorMethod {
   hemicube,
   /// The exact unoccluded factor only; ignores occlusion (validation, convex enclosures).
   analytic,
+  /// Monte Carlo ray shooting: from each element, hemisphere_rays cosine-distributed rays leave
+  /// stratified points, and F(e -> j) is the fraction that first hits patch j's front. Factors
+  /// to emitting patches, whose noise would show as blotchy direct light, are ray_cast's
+  /// accurate ones instead. Rows are sparse (at most hemisphere_rays entries plus the emitting
+  /// patches), so time and memory grow as elements x rays instead of elements x patches: the
+  /// method for meshes of thousands of patches and more. Unbiased; a row's sum is exact in a
+  /// closed enclosure, an entry's relative noise is about sqrt((1 - F) / (F hemisphere_rays)).
+  monte_carlo,
 };
 
 /// Options of the estimators. 0 means "use the default" where stated; every field has one.
@@ -49,9 +57,19 @@ struct FormFactorOptions {
   /// resolution x resolution/2. Memory: about 8 x resolution^2 bytes per thread plus
   /// 6 x resolution^2 bytes shared.
   std::uint32_t hemicube_resolution = 0;
+  /// Monte Carlo: rays per element (per patch when shooting a column, times the patch's
+  /// elements), in [16, 1 << 20]; 0 = 1024.
+  std::uint32_t hemisphere_rays = 0;
   /// Seeds every random stream (ray-cast samples, hemicube orientations).
   std::uint64_t seed = 1;
   unsigned threads = 0;  ///< 0 = all hardware threads; 1 = the calling thread only
+};
+
+/// The non-zero entries of one row (or column) of the form-factor matrix, indices increasing.
+/// Thread safety: a plain value.
+struct SparseFactors {
+  std::vector<std::uint32_t> index;  ///< patch ids (a row) or positions in the element list (a column)
+  std::vector<float> value;          ///< the factors, > 0
 };
 
 /// An estimator bound to one scene and hierarchy (whose geometry it captures at construction,
@@ -74,6 +92,31 @@ class RADIOSITY_API FormFactorEstimator {
   /// of the patch and the patches that may hide it (a shaft query), not full hemicubes.
   virtual void patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                             float* out) const = 0;
+
+  /// element_rows() with only the non-zero entries: out[k] (resized to elements.size()) is the
+  /// row of elements[k], indexed by patch id. The default compresses dense rows computed a few
+  /// hundred at a time.
+  virtual void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const;
+
+  /// patch_column() with only the non-zero entries, indexed by position in `elements`. The
+  /// default compresses the dense column.
+  virtual void sparse_patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
+                                   SparseFactors& out) const;
+
+  /// True when the estimator's rows are sparse by construction (monte_carlo): the solvers then
+  /// store F sparse, and the matrix methods' memory check uses max_row_entries().
+  virtual bool sparse() const;
+
+  /// An upper bound of the non-zero entries of any row; the patch count for dense estimators.
+  virtual std::size_t max_row_entries() const;
+
+ protected:
+  /// `patch_count`: the patches of the hierarchy, the length of a dense row.
+  explicit FormFactorEstimator(std::size_t patch_count) : patch_count_(patch_count) {}
+  std::size_t patch_count() const { return patch_count_; }
+
+ private:
+  std::size_t patch_count_;
 };
 
 /// Makes the estimator named by options.method. The scene and hierarchy must outlive it.

@@ -1,5 +1,7 @@
 // Choosing and configuring a form-factor estimator.
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "formfactor/estimators.hpp"
 
@@ -9,6 +11,10 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   FormFactorOptions o = options;
   if (o.source_samples == 0) o.source_samples = o.method == FormFactorMethod::analytic ? 16 : 4;
   if (o.visibility_rays == 0) o.visibility_rays = 4;
+  if (o.hemisphere_rays == 0) o.hemisphere_rays = 1024;
+  if (o.hemisphere_rays < 16 || o.hemisphere_rays > (1u << 20))
+    throw Error(ErrorCode::invalid_argument, "form_factors.hemisphere_rays must be in [16, 1048576] (0 = 1024), got " +
+                                                 std::to_string(o.hemisphere_rays));
   if (o.hemicube_resolution == 0) o.hemicube_resolution = 256;
   if (o.hemicube_resolution < 2 || o.hemicube_resolution > 8192)
     throw Error(ErrorCode::invalid_argument, "form_factors.hemicube_resolution must be in [2, 8192] (0 = 256), got " +
@@ -27,6 +33,47 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
 namespace radiosity {
 inline namespace v1 {
 
+void FormFactorEstimator::sparse_element_rows(const std::vector<std::uint32_t>& elements,
+                                              std::vector<SparseFactors>& out) const {
+  out.assign(elements.size(), SparseFactors{});
+  const std::size_t n = patch_count();
+  // A few hundred dense rows at a time bound the scratch memory.
+  const std::size_t chunk = std::max<std::size_t>(1, (std::size_t{64} << 20) / std::max<std::size_t>(n * sizeof(float), 1));
+  std::vector<float> dense;
+  std::vector<std::uint32_t> batch;
+  for (std::size_t begin = 0; begin < elements.size(); begin += chunk) {
+    const std::size_t end = std::min(elements.size(), begin + chunk);
+    batch.assign(elements.begin() + static_cast<std::ptrdiff_t>(begin), elements.begin() + static_cast<std::ptrdiff_t>(end));
+    dense.resize(batch.size() * n);
+    element_rows(batch, dense.data());
+    for (std::size_t k = begin; k < end; ++k) {
+      const float* row = dense.data() + (k - begin) * n;
+      for (std::size_t j = 0; j < n; ++j)
+        if (row[j] > 0.0f) {
+          out[k].index.push_back(static_cast<std::uint32_t>(j));
+          out[k].value.push_back(row[j]);
+        }
+    }
+  }
+}
+
+void FormFactorEstimator::sparse_patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
+                                              SparseFactors& out) const {
+  std::vector<float> dense(elements.size());
+  patch_column(patch, elements, dense.data());
+  out.index.clear();
+  out.value.clear();
+  for (std::size_t k = 0; k < dense.size(); ++k)
+    if (dense[k] > 0.0f) {
+      out.index.push_back(static_cast<std::uint32_t>(k));
+      out.value.push_back(dense[k]);
+    }
+}
+
+bool FormFactorEstimator::sparse() const { return false; }
+
+std::size_t FormFactorEstimator::max_row_entries() const { return patch_count_; }
+
 std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                                 const FormFactorOptions& options) {
   const FormFactorOptions o = detail::resolve(options);
@@ -34,8 +81,10 @@ std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& sce
     case FormFactorMethod::ray_cast: return detail::make_ray_cast_estimator(scene, hierarchy, o);
     case FormFactorMethod::analytic: return detail::make_analytic_estimator(scene, hierarchy, o);
     case FormFactorMethod::hemicube: return detail::make_hemicube_estimator(scene, hierarchy, o);
+    case FormFactorMethod::monte_carlo: return detail::make_monte_carlo_estimator(scene, hierarchy, o);
   }
-  throw Error(ErrorCode::invalid_argument, "form_factors.method is not one of ray_cast, hemicube, analytic (got " +
+  throw Error(ErrorCode::invalid_argument,
+              "form_factors.method is not one of ray_cast, hemicube, analytic, monte_carlo (got " +
                                                std::to_string(static_cast<int>(o.method)) + ")");
 }
 

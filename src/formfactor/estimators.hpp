@@ -23,6 +23,10 @@ std::unique_ptr<FormFactorEstimator> make_ray_cast_estimator(const Scene&, const
 std::unique_ptr<FormFactorEstimator> make_hemicube_estimator(const Scene&, const PatchHierarchy&,
                                                              const FormFactorOptions&);
 
+/// Monte Carlo ray shooting with ray_cast's factors for emitting patches (monte_carlo.cpp).
+std::unique_ptr<FormFactorEstimator> make_monte_carlo_estimator(const Scene&, const PatchHierarchy&,
+                                                                const FormFactorOptions&);
+
 /// point_to_polygon_factor() in float for up to 8 corners: about twice as fast, relative error
 /// ~1e-5 for the configurations of a patch hierarchy (falls back to double when x is a corner).
 float point_to_polygon_factor_fast(const glm::vec3& x, const glm::vec3& n, const glm::vec3* polygon, int vertex_count);

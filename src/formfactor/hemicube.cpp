@@ -121,7 +121,7 @@ struct Raster {
 class HemicubeEstimator final : public FormFactorEstimator {
  public:
   HemicubeEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options)
-      : hierarchy_(hierarchy), options_(options) {
+      : FormFactorEstimator(hierarchy.patches().size()), hierarchy_(hierarchy), options_(options) {
     const float diagonal = std::max(scene.bounds().diagonal(), 1e-6f);
     offset_ = 1e-5f * diagonal;
     near_ = 1e-7f * diagonal;

@@ -63,7 +63,10 @@ class SampledEstimator final : public FormFactorEstimator {
  public:
   SampledEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options,
                    bool with_visibility)
-      : hierarchy_(hierarchy), options_(options), visibility_(with_visibility) {
+      : FormFactorEstimator(hierarchy.patches().size()),
+        hierarchy_(hierarchy),
+        options_(options),
+        visibility_(with_visibility) {
     // Offsets keep ray end points off the surfaces they start and end on; the same length is
     // the shaft test's "touching" tolerance.
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);

@@ -55,6 +55,7 @@ const char* form_factor_name(FormFactorMethod m) {
     case FormFactorMethod::ray_cast: return "ray_cast";
     case FormFactorMethod::hemicube: return "hemicube";
     case FormFactorMethod::analytic: return "analytic";
+    case FormFactorMethod::monte_carlo: return "monte_carlo";
   }
   return "unknown";
 }

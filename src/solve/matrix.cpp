@@ -29,21 +29,25 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   result.H.assign(m, Rgb(0.0f));
 
   // Which leaves still need a row, and where it goes.
-  store.patches = n;
   if (store.slot.size() < ctx.hierarchy.elements().size()) store.slot.resize(ctx.hierarchy.elements().size(), kNone);
   std::vector<std::uint32_t> missing;
   for (std::uint32_t e : sys.leaves)
     if (store.slot[e] == kNone) missing.push_back(e);
-  const std::size_t slots_needed =
-      store.rows.size() / std::max<std::size_t>(n, 1) + (missing.size() > store.free_slots.size()
-                                                               ? missing.size() - store.free_slots.size()
-                                                               : 0);
-  const std::size_t bytes = slots_needed * n * sizeof(float);
+  // Memory, stated before anything is computed: dense rows hold a float per patch, sparse rows
+  // an index and a float per entry, at most max_row_entries() of them.
+  const bool sparse = ctx.estimator.sparse();
+  const std::size_t row_bytes =
+      sparse ? std::min(n, ctx.estimator.max_row_entries()) * 2 * sizeof(float) : n * sizeof(float);
+  std::size_t rows_held = 0;
+  for (const FactorVector& r : store.rows) rows_held += r.empty() ? 0 : 1;
+  const std::size_t bytes = (rows_held + missing.size()) * row_bytes;
   if (bytes > ctx.options.memory_budget_bytes) {
     std::ostringstream s;
-    s << "the form-factor matrix of " << m << " elements x " << n << " patches needs " << bytes / (1024.0 * 1024.0)
-      << " MiB, more than the memory budget of " << ctx.options.memory_budget_bytes / (1024.0 * 1024.0)
-      << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive or a coarser mesh";
+    s << "the form-factor matrix of " << m << " elements x " << n << " patches needs "
+      << (sparse ? "up to " : "") << bytes / (1024.0 * 1024.0) << " MiB, more than the memory budget of "
+      << ctx.options.memory_budget_bytes / (1024.0 * 1024.0)
+      << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive"
+      << (sparse ? "" : ", FormFactorMethod::monte_carlo (sparse rows)") << " or a coarser mesh";
     throw Error(ErrorCode::memory_budget, s.str());
   }
   std::vector<std::uint32_t> slots(missing.size());
@@ -52,25 +56,39 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       slots[k] = store.free_slots.back();
       store.free_slots.pop_back();
     } else {
-      slots[k] = static_cast<std::uint32_t>(store.rows.size() / std::max<std::size_t>(n, 1));
-      store.rows.resize(store.rows.size() + n);
+      slots[k] = static_cast<std::uint32_t>(store.rows.size());
+      store.rows.emplace_back();
     }
   }
-  result.form_factor_bytes = store.bytes();
 
   // Form factors, in chunks so that progress is reported and cancel is honoured.
   auto t0 = std::chrono::steady_clock::now();
   const std::size_t chunk = std::max<std::size_t>(64, missing.size() / 200);
   std::vector<std::uint32_t> rows;
+  std::vector<SparseFactors> sparse_rows;
   std::vector<float> buffer;
   for (std::size_t begin = 0; begin < missing.size(); begin += chunk) {
     std::size_t end = std::min(missing.size(), begin + chunk);
     rows.assign(missing.begin() + static_cast<std::ptrdiff_t>(begin), missing.begin() + static_cast<std::ptrdiff_t>(end));
-    buffer.resize(rows.size() * n);
-    ctx.estimator.element_rows(rows, buffer.data());
-    for (std::size_t k = begin; k < end; ++k) {
-      std::copy_n(buffer.data() + (k - begin) * n, n, store.rows.data() + std::size_t{slots[k]} * n);
-      store.slot[missing[k]] = slots[k];
+    if (sparse) {
+      ctx.estimator.sparse_element_rows(rows, sparse_rows);
+      for (std::size_t k = begin; k < end; ++k) {
+        FactorVector& r = store.rows[slots[k]];
+        r.index = std::move(sparse_rows[k - begin].index);
+        r.value = std::move(sparse_rows[k - begin].value);
+        r.index.shrink_to_fit();
+        r.value.shrink_to_fit();
+        store.slot[missing[k]] = slots[k];
+      }
+    } else {
+      buffer.resize(rows.size() * n);
+      ctx.estimator.element_rows(rows, buffer.data());
+      for (std::size_t k = begin; k < end; ++k) {
+        FactorVector& r = store.rows[slots[k]];
+        r.index.clear();
+        r.value.assign(buffer.data() + (k - begin) * n, buffer.data() + (k - begin + 1) * n);
+        store.slot[missing[k]] = slots[k];
+      }
     }
     Progress p;
     p.phase = Phase::form_factors;
@@ -82,11 +100,13 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         if (store.slot[missing[k]] == kNone) store.free_slots.push_back(slots[k]);
       result.status = SolveStatus::cancelled;
       result.seconds_form_factors = seconds_since(t0);
+      result.form_factor_bytes = store.bytes();
       return result;
     }
   }
   result.seconds_form_factors = seconds_since(t0);
-  auto row = [&](std::size_t i) { return store.row(sys.leaves[i]); };
+  result.form_factor_bytes = store.bytes();
+  auto row = [&](std::size_t i) -> const FactorVector& { return store.row(sys.leaves[i]); };
 
   // Sweeps. Residual: power that the last sweep changed, over the emitted power.
   std::vector<Rgb> patch_B, next(m);
@@ -99,10 +119,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       // Jacobi: every element from the previous sweep's patch radiosity; rows are independent.
       parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
-          const float* F = row(i);
-          Rgb gathered(0.0f);
-          for (std::size_t j = 0; j < n; ++j) gathered += F[j] * patch_B[j];
-          next[i] = sys.emission[i] + sys.reflectance[i] * gathered;
+          next[i] = sys.emission[i] + sys.reflectance[i] * row(i).dot(patch_B);
         }
       });
       for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * l1(next[i] - result.B[i]);
@@ -110,10 +127,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
     } else {
       // Gauss-Seidel: each element sees the patch means already updated by earlier elements.
       for (std::size_t i = 0; i < m; ++i) {
-        const float* F = row(i);
-        Rgb gathered(0.0f);
-        for (std::size_t j = 0; j < n; ++j) gathered += F[j] * patch_B[j];
-        Rgb b = sys.emission[i] + sys.reflectance[i] * gathered;
+        Rgb b = sys.emission[i] + sys.reflectance[i] * row(i).dot(patch_B);
         Rgb d = b - result.B[i];
         change += sys.area[i] * l1(d);
         patch_B[sys.patch[i]] += (sys.area[i] / sys.patch_area[sys.patch[i]]) * d;
@@ -144,12 +158,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   // Irradiance for the energy balance: H_e = sum_j F_ej B_j with the final radiosity.
   sys.patch_means(result.B, patch_B);
   parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const float* F = row(i);
-      Rgb h(0.0f);
-      for (std::size_t j = 0; j < n; ++j) h += F[j] * patch_B[j];
-      result.H[i] = h;
-    }
+    for (std::size_t i = begin; i < end; ++i) result.H[i] = row(i).dot(patch_B);
   });
   return result;
 }

@@ -35,10 +35,13 @@ SolverResult solve_progressive(const SolverContext& ctx) {
 
   // Columns are kept once computed while they fit the memory budget: a patch is usually shot
   // several times, and recomputing its column is the whole cost of a step.
-  std::vector<std::vector<float>> cache(n);
-  std::size_t cached_bytes = 0;
-  const std::size_t column_bytes = m * sizeof(float);
-  std::vector<float> scratch(m);
+  // Sparse estimators (monte_carlo) give sparse columns, so a step costs O(entries).
+  const bool sparse = ctx.estimator.sparse();
+  std::vector<FactorVector> cache(n);
+  std::vector<std::uint8_t> cached(n, 0);  // a column may be cached and empty (a patch that sees nothing)
+  std::size_t cached_bytes = 0, peak_scratch = 0;
+  FactorVector scratch;
+  SparseFactors sparse_column;
 
   // Ambient radiosity: the unshot power spread over the whole scene area and multiplied by the
   // interreflection factor (Cohen et al. 1988, eqs. 5-6). For display only; it tends to 0.
@@ -56,8 +59,9 @@ SolverResult solve_progressive(const SolverContext& ctx) {
 
   auto t0 = std::chrono::steady_clock::now();
   result.status = SolveStatus::iteration_cap;
-  for (int step = 1; step <= ctx.options.max_iterations; ++step) {
-    // The shooter: largest unshot power dB_i A_i (summed over channels).
+  for (int step = 1;; ++step) {
+    // One pass over the patches finds the shooter (largest unshot power dB_i A_i, summed over
+    // channels) and the residual left by the previous step.
     std::size_t shooter = 0;
     double best = -1.0, total_unshot = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
@@ -65,58 +69,69 @@ SolverResult solve_progressive(const SolverContext& ctx) {
       total_unshot += power;
       if (power > best) best = power, shooter = j;
     }
-    double residual = total_unshot / sys.emitted;
+    const double residual = total_unshot / sys.emitted;
+    if (step > 1) {
+      result.residual = residual;
+      result.residual_history.push_back(residual);
+      result.time_history.push_back(seconds_since(t0));
+      Progress p{Phase::solving, std::clamp(std::log(residual) / std::log(ctx.options.tolerance), 0.0, 1.0),
+                 step - 1, residual};
+      if (residual >= ctx.options.tolerance && !report(p, false)) {
+        result.status = SolveStatus::cancelled;
+        break;
+      }
+    }
     if (residual < ctx.options.tolerance) {
       result.residual = residual;
       result.status = SolveStatus::converged;
       report(Progress{Phase::solving, 1.0, result.iterations, residual}, true);
       break;
     }
+    if (step > ctx.options.max_iterations) break;
 
-    const float* F = nullptr;
-    if (!cache[shooter].empty()) {
-      F = cache[shooter].data();
-    } else {
+    const FactorVector* F = &cache[shooter];
+    if (!cached[shooter]) {
       auto tf = std::chrono::steady_clock::now();
-      const bool keep = cached_bytes + column_bytes <= ctx.options.memory_budget_bytes;
-      std::vector<float>& column = keep ? cache[shooter] : scratch;
-      column.resize(m);
-      ctx.estimator.patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, column.data());
-      if (keep) cached_bytes += column_bytes;
+      if (sparse) {
+        ctx.estimator.sparse_patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, sparse_column);
+        scratch.index = std::move(sparse_column.index);
+        scratch.value = std::move(sparse_column.value);
+        scratch.index.shrink_to_fit();
+        scratch.value.shrink_to_fit();
+      } else {
+        scratch.value.resize(m);
+        ctx.estimator.patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, scratch.value.data());
+      }
       result.seconds_form_factors += seconds_since(tf);
-      F = column.data();
+      if (cached_bytes + scratch.bytes() <= ctx.options.memory_budget_bytes) {
+        cached_bytes += scratch.bytes();
+        cache[shooter] = std::move(scratch);
+        cached[shooter] = 1;
+        scratch = FactorVector{};
+        F = &cache[shooter];
+      } else {
+        peak_scratch = std::max(peak_scratch, scratch.bytes());
+        F = &scratch;
+      }
     }
 
     const Rgb shot = unshot[shooter];
     unshot[shooter] = Rgb(0.0f);
-    for (std::size_t e = 0; e < m; ++e) {
-      if (F[e] <= 0.0f) continue;
-      const Rgb incident = shot * F[e];  // irradiance arriving at e from this shot
+    F->for_each([&](std::size_t e, float f) {
+      if (f <= 0.0f) return;
+      const Rgb incident = shot * f;  // irradiance arriving at e from this shot
       const Rgb dB = sys.reflectance[e] * incident;
       result.H[e] += incident;
       result.B[e] += dB;
       unshot[sys.patch[e]] += (sys.area[e] / sys.patch_area[sys.patch[e]]) * dB;
-    }
+    });
 
     result.iterations = step;
-    // The residual after this step (the loop's test uses the same sum at the next step).
-    double after = 0.0;
-    for (std::size_t j = 0; j < n; ++j) after += sum3(unshot[j]) * sys.patch_area[j];
-    residual = after / sys.emitted;
-    result.residual = residual;
-    result.residual_history.push_back(residual);
-    result.time_history.push_back(seconds_since(t0));
-    Progress p{Phase::solving, std::clamp(std::log(residual) / std::log(ctx.options.tolerance), 0.0, 1.0), step,
-               residual};
-    if (!report(p, false)) {
-      result.status = SolveStatus::cancelled;
-      break;
-    }
   }
   // The last allowed step may itself have reached the tolerance.
   if (result.status == SolveStatus::iteration_cap && result.residual < ctx.options.tolerance)
     result.status = SolveStatus::converged;
-  result.form_factor_bytes = cached_bytes + column_bytes;
+  result.form_factor_bytes = cached_bytes + peak_scratch;
   result.ambient = ambient();
   return result;
 }

@@ -75,17 +75,46 @@ struct SolverContext {
   ProgressGate& progress;
 };
 
+/// One row F(element -> patches) or column F(elements -> patch) of the form-factor matrix:
+/// dense (`index` empty, one value per patch / element) or sparse (the non-zero entries), as the
+/// estimator produces it (FormFactorEstimator::sparse()).
+struct FactorVector {
+  std::vector<std::uint32_t> index;
+  std::vector<float> value;
+
+  bool empty() const { return value.empty(); }
+  std::size_t bytes() const { return (index.capacity() + value.capacity()) * sizeof(float); }
+  /// Calls f(position, factor) for every entry that may be non-zero.
+  template <typename F>
+  void for_each(const F& f) const {
+    if (index.empty()) {
+      for (std::size_t k = 0; k < value.size(); ++k) f(k, value[k]);
+    } else {
+      for (std::size_t k = 0; k < index.size(); ++k) f(std::size_t{index[k]}, value[k]);
+    }
+  }
+  /// sum_j F_j x_j.
+  Rgb dot(const std::vector<Rgb>& x) const {
+    Rgb sum(0.0f);
+    for_each([&](std::size_t j, float f) { sum += f * x[j]; });
+    return sum;
+  }
+};
+
 /// Rows F(element -> every patch) kept across adaptive refinement passes, so a pass computes
 /// rows only for the elements it created. A subdivided element's row slot is reused by its
 /// first child.
 struct MatrixStore {
-  std::size_t patches = 0;
-  std::vector<float> rows;                 ///< slot-major, `patches` floats per slot
-  std::vector<std::uint32_t> slot;         ///< element id -> slot, kNone when it has no row
-  std::vector<std::uint32_t> free_slots;   ///< slots of elements that were subdivided
+  std::vector<FactorVector> rows;        ///< by slot
+  std::vector<std::uint32_t> slot;       ///< element id -> slot, kNone when it has no row
+  std::vector<std::uint32_t> free_slots; ///< slots of elements that were subdivided
 
-  std::size_t bytes() const { return rows.capacity() * sizeof(float); }
-  const float* row(std::uint32_t element) const { return rows.data() + std::size_t{slot[element]} * patches; }
+  std::size_t bytes() const {
+    std::size_t sum = rows.capacity() * sizeof(FactorVector);
+    for (const FactorVector& r : rows) sum += r.bytes();
+    return sum;
+  }
+  const FactorVector& row(std::uint32_t element) const { return rows[slot[element]]; }
 };
 
 /// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
