@@ -23,6 +23,7 @@ namespace {
 
 radiosity::FormFactorMethod g_estimator = radiosity::FormFactorMethod::monte_carlo;
 std::uint32_t g_rays = 0;
+std::string g_only;  // run only this method
 
 int run(std::size_t target_patches, radiosity::SolverMethod method, const char* name) {
   const radiosity::Scene scene = radiosity::cornell_box();
@@ -124,6 +125,10 @@ int main(int argc, char** argv) {
       compare(std::strtoul(argv[++i], nullptr, 10));
       return 0;
     }
+    if (arg == "--only" && i + 1 < argc) {
+      g_only = argv[++i];
+      continue;
+    }
     if (arg == "--ray-cast") g_estimator = radiosity::FormFactorMethod::ray_cast;
     else if (arg == "--rays" && i + 1 < argc) g_rays = static_cast<std::uint32_t>(std::strtoul(argv[++i], nullptr, 10));
     else sizes.push_back(std::strtoul(arg.c_str(), nullptr, 10));
@@ -139,6 +144,7 @@ int main(int argc, char** argv) {
               radiosity::version());
   for (std::size_t n : sizes)
     for (const auto& m : methods) {
+      if (!g_only.empty() && g_only != m.name) continue;
       std::fflush(stdout);  // the child must not inherit (and print again) buffered output
       const pid_t pid = fork();
       if (pid == 0) {

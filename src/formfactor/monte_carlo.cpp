@@ -14,9 +14,14 @@
 // most `hemisphere_rays` entries and costs O(rays), not O(patches).
 //
 // Small factors to bright patches are where this noise shows (a light seen from the floor is hit
-// by a handful of rays). Factors to emitting patches are therefore taken from the accurate
-// ray-cast estimator, and rays that land on an emitting patch are not counted (a split like the
-// next-event estimation of path tracing): the row stays unbiased and the direct light is smooth.
+// by a handful of rays). Factors to emitting patches are therefore computed apart, and rays that
+// land on an emitting patch are not counted (a split like the next-event estimation of path
+// tracing): F(e -> j) = F_unoccluded(e -> j) x V(e, P), the exact contour-integral factor of the
+// analytic estimator times the visible fraction of j's whole polygon P, estimated by shadow rays
+// between stratified points of e and P weighted by the point-to-point kernel (none when a shaft
+// test shows that nothing can come between). One visibility per (element, emitting polygon)
+// instead of per (element, emitting patch) is what keeps this cheap on fine meshes; an emitting
+// polygon's patches have nearly equal radiosity, so sharing its visible fraction costs little.
 //
 // A column F(. -> i) (progressive refinement) is shot from patch i instead: with the same
 // reasoning F(i -> e) is a hit fraction, and reciprocity gives F(e -> i) = F(i -> e) A_i / A_e.
@@ -38,6 +43,7 @@
 #include "detail/rng.hpp"
 #include "formfactor/estimators.hpp"
 #include "formfactor/sampling.hpp"
+#include "formfactor/shaft.hpp"
 #include "geometry/ray_scene.hpp"
 
 namespace radiosity::detail {
@@ -81,11 +87,21 @@ class HitCounter {
   /// Appends (target, scale x count) in increasing target order and clears.
   template <typename Scale>
   void drain(std::vector<std::uint32_t>& index, std::vector<float>& value, const Scale& scale) {
-    std::sort(touched_.begin(), touched_.end());
-    for (std::uint32_t t : touched_) {
-      index.push_back(t);
-      value.push_back(scale(t, count_[t]));
-      count_[t] = 0;
+    // Many distinct targets: walking the counts in order is cheaper than sorting.
+    if (touched_.size() * 64 > count_.size()) {
+      for (std::uint32_t t = 0; t < count_.size(); ++t)
+        if (count_[t] != 0) {
+          index.push_back(t);
+          value.push_back(scale(t, count_[t]));
+          count_[t] = 0;
+        }
+    } else {
+      std::sort(touched_.begin(), touched_.end());
+      for (std::uint32_t t : touched_) {
+        index.push_back(t);
+        value.push_back(scale(t, count_[t]));
+        count_[t] = 0;
+      }
     }
     touched_.clear();
   }
@@ -95,22 +111,47 @@ class HitCounter {
   std::vector<std::uint32_t> touched_;
 };
 
+FormFactorOptions serial(FormFactorOptions o) {
+  o.threads = 1;
+  return o;
+}
+
 class MonteCarloEstimator final : public FormFactorEstimator {
  public:
   MonteCarloEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options)
       : FormFactorEstimator(hierarchy.patches().size()),
         hierarchy_(hierarchy),
         options_(options),
-        accurate_(make_ray_cast_estimator(scene, hierarchy, options)) {
+        analytic_(make_analytic_estimator(scene, hierarchy, options)),
+        analytic_serial_(make_analytic_estimator(scene, hierarchy, serial(options))) {
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
+    const auto& polygons = scene.polygons();
     exact_.assign(patches.size(), 0);
+    emitter_of_.assign(patches.size(), kNone);
+    std::vector<std::uint32_t> polygon_slot(polygons.size(), kNone);
     for (std::uint32_t j = 0; j < patches.size(); ++j) {
-      const Rgb e = scene.material(scene.polygons()[patches[j].polygon].material).emission;
-      if (std::max(e.x, std::max(e.y, e.z)) > 0.0f) {
-        exact_[j] = 1;
-        emitters_.push_back(j);
+      const PolygonId pid = patches[j].polygon;
+      const Rgb e = scene.material(polygons[pid].material).emission;
+      if (std::max(e.x, std::max(e.y, e.z)) <= 0.0f) continue;
+      exact_[j] = 1;
+      emitters_.push_back(j);
+      if (polygon_slot[pid] == kNone) {
+        polygon_slot[pid] = static_cast<std::uint32_t>(lights_.size());
+        lights_.emplace_back(pid, polygons[pid]);
       }
+      emitter_of_[j] = polygon_slot[pid];
+    }
+    if (!lights_.empty()) {
+      shadow_rays_.emplace(RayScene::from_polygons(scene));
+      std::vector<std::vector<glm::vec3>> corners;
+      std::vector<glm::vec3> normals;
+      for (const Polygon& p : polygons) {
+        corners.push_back(p.vertices);
+        normals.push_back(p.normal);
+      }
+      occluders_ = ShaftCuller(corners, normals);
+      visible_.resize(lights_.size());
     }
   }
 
@@ -123,37 +164,47 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
     const std::size_t m = elements.size();
     out.assign(m, SparseFactors{});
-    // The accurate part: one ray-cast column per emitting patch (parallel inside).
-    std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(m);
-    if (!emitters_.empty()) {
-      std::vector<float> column(m);
-      for (std::uint32_t j : emitters_) {
-        accurate_->patch_column(j, elements, column.data());
-        for (std::size_t k = 0; k < m; ++k)
-          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
-      }
-    }
-    const std::shared_ptr<const RayScene> rays = leaf_scene();
+    const std::shared_ptr<const LeafRays> rays = leaf_scene();
     const std::uint32_t N = options_.hemisphere_rays;
     const float per_ray = 1.0f / static_cast<float>(N);
-    parallel_for(options_.threads, m, 16, [&](std::size_t begin, std::size_t end) {
+    // One parallel loop does everything for a run of elements; the analytic estimator used
+    // inside is single-threaded, so no nested parallel region is opened per emitting patch.
+    parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
       HitCounter counter(hierarchy_.patches().size());
       Scratch scratch(N);
-      std::vector<std::uint32_t> index;
-      std::vector<float> value;
+      std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
+                                             elements.begin() + static_cast<std::ptrdiff_t>(end));
+      std::vector<float> value, column(run.size()), fraction(lights_.size());
+      // Emitting patches: unoccluded factors, column by column over the run...
+      std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(run.size());
+      for (std::uint32_t j : emitters_) {
+        analytic_serial_->patch_column(j, run, column.data());
+        for (std::size_t k = 0; k < run.size(); ++k)
+          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
+      }
       for (std::size_t k = begin; k < end; ++k) {
+        // ... times the element's visible fraction of each emitting polygon it faces.
+        auto& own = exact[k - begin];
+        std::fill(fraction.begin(), fraction.end(), -1.0f);
+        for (auto& [j, f] : own) {
+          float& v = fraction[emitter_of_[j]];
+          if (v < 0.0f) v = static_cast<float>(visibility(elements[k], emitter_of_[j]));
+          f *= v;
+        }
+        own.erase(std::remove_if(own.begin(), own.end(), [](const auto& x) { return !(x.second > 0.0f); }),
+                  own.end());
+        // Everything else: the hit fractions of the rays.
         const std::uint32_t e = elements[k];
         const Element& el = hierarchy_.element(e);
         const Patch& source = hierarchy_.patches()[el.patch];
         Rng rng(options_.seed, e, 0x300000000ull);
-        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t leaf) {
-          const std::uint32_t j = hierarchy_.element(leaf).patch;
+        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t, std::uint32_t j) {
           if (!exact_[j]) counter.add(j);
         });
         index.clear();
         value.clear();
         counter.drain(index, value, [&](std::uint32_t, std::uint32_t c) { return static_cast<float>(c) * per_ray; });
-        merge(index, value, exact[k], out[k]);
+        merge(index, value, own, out[k]);
       }
     });
   }
@@ -172,10 +223,16 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     out.index.clear();
     out.value.clear();
     if (exact_[patch]) {
-      FormFactorEstimator::sparse_patch_column(patch, elements, out);
+      std::vector<float> column(elements.size());
+      emitter_column(patch, elements, column.data());
+      for (std::size_t k = 0; k < column.size(); ++k)
+        if (column[k] > 0.0f) {
+          out.index.push_back(static_cast<std::uint32_t>(k));
+          out.value.push_back(column[k]);
+        }
       return;
     }
-    const std::shared_ptr<const RayScene> rays = leaf_scene();
+    const std::shared_ptr<const LeafRays> rays = leaf_scene();
     // Position of each element in `elements`, so hits on leaves map to output indices.
     std::vector<std::uint32_t> position(hierarchy_.elements().size(), kNone);
     for (std::size_t k = 0; k < elements.size(); ++k) position[elements[k]] = static_cast<std::uint32_t>(k);
@@ -194,7 +251,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       for (std::size_t c = begin; c < end; ++c) {
         const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
         Rng rng(options_.seed, patch, 0x400000000ull + c);
-        shoot(*rays, root, source, count, rng, scratch, [&](std::uint32_t leaf) {
+        shoot(*rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t) {
           if (position[leaf] != kNone) hits[c].push_back(position[leaf]);
         });
       }
@@ -210,7 +267,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   void patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
     if (exact_[patch]) {
-      accurate_->patch_column(patch, elements, out);
+      emitter_column(patch, elements, out);
       return;
     }
     SparseFactors column;
@@ -220,6 +277,105 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   }
 
  private:
+  /// The current leaves as an Embree scene (ids: element ids), with each triangle's patch and
+  /// polygon in compact arrays.
+  struct LeafRays {
+    RayScene scene;
+    std::vector<std::uint32_t> patch, polygon;  ///< per triangle
+  };
+
+  /// An emitting polygon, as a target of shadow rays: area-uniform points from a fan of triangles.
+  struct Light {
+    Light(PolygonId polygon_id, const Polygon& source)
+        : polygon(polygon_id), vertices(source.vertices), normal(source.normal) {
+      double total = 0.0;
+      for (std::size_t k = 1; k + 1 < vertices.size(); ++k) {
+        total += 0.5 * glm::length(glm::cross(vertices[k] - vertices[0], vertices[k + 1] - vertices[0]));
+        cdf.push_back(static_cast<float>(total));
+      }
+      for (float& c : cdf) c = static_cast<float>(c / total);
+      cdf.back() = 1.0f;
+    }
+    /// Area-uniform for u uniform; the first coordinate picks the triangle and is then rescaled,
+    /// so strata of u stay compact.
+    glm::vec3 sample(glm::vec2 u) const {
+      const std::size_t t = std::min<std::size_t>(
+          static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin()), cdf.size() - 1);
+      const float lo = t == 0 ? 0.0f : cdf[t - 1];
+      const float a = std::clamp((u.x - lo) / std::max(cdf[t] - lo, 1e-12f), 0.0f, 1.0f);
+      const float su = std::sqrt(a);
+      return (1.0f - su) * vertices[0] + (su * (1.0f - u.y)) * vertices[t + 1] + (su * u.y) * vertices[t + 2];
+    }
+    PolygonId polygon;
+    std::vector<glm::vec3> vertices;
+    glm::vec3 normal;
+    std::vector<float> cdf;  ///< cumulative area fraction of the fan's triangles
+  };
+
+  /// F(e -> emitting patch) for each element: unoccluded factor times the element's visible
+  /// fraction of the patch's polygon, the latter kept per element for later columns.
+  void emitter_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
+    analytic_->patch_column(patch, elements, out);
+    const std::uint32_t light = emitter_of_[patch];
+    std::lock_guard<std::mutex> lock(visible_mutex_);
+    std::vector<float>& cache = visible_[light];
+    if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
+    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        if (!(out[k] > 0.0f)) continue;
+        float& v = cache[elements[k]];
+        if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light));
+        out[k] *= v;
+      }
+    });
+  }
+
+  /// Kernel-weighted fraction of shadow rays from element e to light polygon `light` that are
+  /// clear: 1 without rays when a shaft test shows nothing can come between. 64 rays, and 256
+  /// more in a penumbra (some blocked, some clear). Its own random stream per pair, so the value
+  /// does not depend on the caller.
+  double visibility(std::uint32_t e, std::uint32_t light) const {
+    const Light& L = lights_[light];
+    const Element& el = hierarchy_.element(e);
+    const Patch& patch = hierarchy_.patches()[el.patch];
+    std::array<glm::vec3, 4> corners{};
+    for (int k = 0; k < el.corner_count(); ++k)
+      corners[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
+    if (L.vertices.size() <= 4) {
+      Shaft shaft;
+      if (!shaft.build(corners.data(), el.corner_count(), patch.normal, L.vertices.data(),
+                       static_cast<int>(L.vertices.size()), L.normal, epsilon_) ||
+          !occluders_.any(shaft, patch.polygon, L.polygon))
+        return 1.0;
+    }
+    const CellSampler sampler(corners.data(), el.corner_count());
+    Rng rng(options_.seed, e, 0x500000000ull + light);
+    std::array<glm::vec2, 256> from, to;
+    double weight = 0.0, clear_weight = 0.0;
+    std::uint32_t clear = 0, blocked = 0;
+    auto pass = [&](std::uint32_t count) {
+      stratified(count, rng, true, from.data());
+      stratified(count, rng, true, to.data());
+      for (std::uint32_t i = count; i > 1; --i) std::swap(to[i - 1], to[rng.next() % i]);
+      for (std::uint32_t r = 0; r < count; ++r) {
+        const glm::vec3 x = sampler(from[r]) + epsilon_ * patch.normal;
+        const glm::vec3 d = (L.sample(to[r]) + epsilon_ * L.normal) - x;
+        const float r2 = glm::dot(d, d);
+        if (!(r2 > 0.0f)) continue;
+        const float w = std::max(0.0f, glm::dot(d, patch.normal)) * std::max(0.0f, -glm::dot(d, L.normal)) / (r2 * r2);
+        const bool visible = !shadow_rays_->occluded(x, d, 0.0f, 1.0f - 1e-4f);
+        (visible ? clear : blocked) += 1;
+        weight += w;
+        clear_weight += visible ? w : 0.0f;
+      }
+    };
+    pass(64);
+    if (clear > 0 && blocked > 0) pass(256);
+    if (blocked == 0) return 1.0;
+    if (clear == 0) return 0.0;
+    return weight > 0.0 ? clear_weight / weight : static_cast<double>(clear) / (clear + blocked);
+  }
+
   /// Per-thread sample buffers.
   struct Scratch {
     explicit Scratch(std::uint32_t n) : points(n), directions(n) {}
@@ -227,10 +383,10 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   };
 
   /// Casts `count` cosine-distributed rays from stratified points of element `from` (of patch
-  /// `source`) and calls hit(leaf) for each ray that first hits the front of another
+  /// `source`) and calls hit(leaf, patch) for each ray that first hits the front of another
   /// polygon's element.
   template <typename Hit>
-  void shoot(const RayScene& rays, std::uint32_t from, const Patch& source, std::uint32_t count, Rng& rng,
+  void shoot(const LeafRays& rays, std::uint32_t from, const Patch& source, std::uint32_t count, Rng& rng,
              Scratch& scratch, const Hit& hit) const {
     if (scratch.points.size() < count) scratch = Scratch(count);
     stratified(count, rng, true, scratch.points.data());
@@ -250,13 +406,12 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       const glm::vec3 x = sampler(scratch.points[r]) + epsilon_ * n;
       const glm::vec3 local = cosine_direction(scratch.directions[r]);
       const glm::vec3 w = local.x * t + local.y * b + local.z * n;
-      const std::optional<RayScene::Hit> h = rays.intersect(x, w, 0.0f, std::numeric_limits<float>::infinity());
+      const std::optional<RayScene::Hit> h = rays.scene.intersect(x, w, 0.0f, std::numeric_limits<float>::infinity());
       if (!h) continue;  // escaped (an open scene)
-      const Element& target = hierarchy_.element(h->id);
-      const Patch& receiver = hierarchy_.patches()[target.patch];
       // The back of a one-sided surface absorbs; a hit on the source's own plane is rounding.
-      if (glm::dot(w, receiver.normal) >= 0.0f || receiver.polygon == source.polygon) continue;
-      hit(h->id);
+      // (Per-triangle arrays and Embree's normal: the hierarchy's structs are cache misses.)
+      if (glm::dot(w, h->geometric_normal) >= 0.0f || rays.polygon[h->triangle] == source.polygon) continue;
+      hit(h->id, rays.patch[h->triangle]);
     }
   }
 
@@ -287,10 +442,16 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   /// The Embree scene of the current leaves (element ids), rebuilt after the hierarchy was
   /// refined: a column must land on the leaves that exist now.
-  std::shared_ptr<const RayScene> leaf_scene() const {
+  std::shared_ptr<const LeafRays> leaf_scene() const {
     std::lock_guard<std::mutex> lock(leaf_mutex_);
     if (!leaf_rays_ || leaf_count_ != hierarchy_.leaves().size()) {
-      leaf_rays_ = std::make_shared<const RayScene>(RayScene::from_leaves(hierarchy_));
+      RayScene scene = RayScene::from_leaves(hierarchy_);
+      std::vector<std::uint32_t> patch, polygon;
+      for (std::uint32_t e : scene.triangle_ids()) {
+        patch.push_back(hierarchy_.element(e).patch);
+        polygon.push_back(hierarchy_.patches()[patch.back()].polygon);
+      }
+      leaf_rays_ = std::make_shared<const LeafRays>(LeafRays{std::move(scene), std::move(patch), std::move(polygon)});
       leaf_count_ = hierarchy_.leaves().size();
     }
     return leaf_rays_;
@@ -298,12 +459,19 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   const PatchHierarchy& hierarchy_;
   FormFactorOptions options_;
-  std::unique_ptr<FormFactorEstimator> accurate_;
-  std::vector<std::uint8_t> exact_;     ///< per patch: 1 when its factors come from accurate_
-  std::vector<std::uint32_t> emitters_;  ///< the patches with exact_ set, increasing
+  std::unique_ptr<FormFactorEstimator> analytic_;  ///< unoccluded factors to emitting patches
+  std::unique_ptr<FormFactorEstimator> analytic_serial_;  ///< the same on the calling thread only
+  std::vector<std::uint8_t> exact_;                ///< per patch: 1 when it emits (no ray counts)
+  std::vector<std::uint32_t> emitters_;            ///< the patches with exact_ set, increasing
+  std::vector<std::uint32_t> emitter_of_;          ///< per patch: index into lights_, or kNone
+  std::vector<Light> lights_;                      ///< the emitting polygons
+  std::optional<RayScene> shadow_rays_;            ///< the scene's polygons, for shadow rays
+  ShaftCuller occluders_;
+  mutable std::mutex visible_mutex_;
+  mutable std::vector<std::vector<float>> visible_;  ///< per light, per element id: V, or -1 = not yet
   float epsilon_ = 0.0f;
   mutable std::mutex leaf_mutex_;
-  mutable std::shared_ptr<const RayScene> leaf_rays_;
+  mutable std::shared_ptr<const LeafRays> leaf_rays_;
   mutable std::size_t leaf_count_ = 0;
 };
 

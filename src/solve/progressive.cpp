@@ -59,15 +59,17 @@ SolverResult solve_progressive(const SolverContext& ctx) {
 
   auto t0 = std::chrono::steady_clock::now();
   result.status = SolveStatus::iteration_cap;
+  // Unshot power per patch, dB_j A_j summed over channels, kept up to date as patches receive,
+  // so choosing the shooter is a scan of one array. Its sum (the residual's numerator) is
+  // recomputed in that scan, so no error accumulates.
+  std::vector<double> power(n);
+  for (std::size_t j = 0; j < n; ++j) power[j] = sum3(unshot[j]) * sys.patch_area[j];
   for (int step = 1;; ++step) {
-    // One pass over the patches finds the shooter (largest unshot power dB_i A_i, summed over
-    // channels) and the residual left by the previous step.
     std::size_t shooter = 0;
     double best = -1.0, total_unshot = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
-      double power = sum3(unshot[j]) * sys.patch_area[j];
-      total_unshot += power;
-      if (power > best) best = power, shooter = j;
+      total_unshot += power[j];
+      if (power[j] > best) best = power[j], shooter = j;
     }
     const double residual = total_unshot / sys.emitted;
     if (step > 1) {
@@ -117,13 +119,16 @@ SolverResult solve_progressive(const SolverContext& ctx) {
 
     const Rgb shot = unshot[shooter];
     unshot[shooter] = Rgb(0.0f);
+    power[shooter] = 0.0;
     F->for_each([&](std::size_t e, float f) {
       if (f <= 0.0f) return;
       const Rgb incident = shot * f;  // irradiance arriving at e from this shot
       const Rgb dB = sys.reflectance[e] * incident;
       result.H[e] += incident;
       result.B[e] += dB;
-      unshot[sys.patch[e]] += (sys.area[e] / sys.patch_area[sys.patch[e]]) * dB;
+      const std::uint32_t j = sys.patch[e];
+      unshot[j] += (sys.area[e] / sys.patch_area[j]) * dB;
+      power[j] = sum3(unshot[j]) * sys.patch_area[j];
     });
 
     result.iterations = step;
