@@ -103,6 +103,11 @@ class RADIOSITY_API FormFactorEstimator {
   virtual void sparse_patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                                    SparseFactors& out) const;
 
+  /// sparse_patch_column() for several patches (out[k] for patches[k]), which an estimator may
+  /// compute in parallel; the default calls sparse_patch_column() for each in turn.
+  virtual void sparse_patch_columns(const std::vector<std::uint32_t>& patches, const std::vector<std::uint32_t>& elements,
+                                    std::vector<SparseFactors>& out) const;
+
   /// True when the estimator's rows are sparse by construction (monte_carlo): the solvers then
   /// store F sparse, and the matrix methods' memory check uses max_row_entries().
   virtual bool sparse() const;

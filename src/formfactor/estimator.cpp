@@ -70,6 +70,13 @@ void FormFactorEstimator::sparse_patch_column(std::uint32_t patch, const std::ve
     }
 }
 
+void FormFactorEstimator::sparse_patch_columns(const std::vector<std::uint32_t>& patches,
+                                               const std::vector<std::uint32_t>& elements,
+                                               std::vector<SparseFactors>& out) const {
+  out.assign(patches.size(), SparseFactors{});
+  for (std::size_t k = 0; k < patches.size(); ++k) sparse_patch_column(patches[k], elements, out[k]);
+}
+
 bool FormFactorEstimator::sparse() const { return false; }
 
 std::size_t FormFactorEstimator::max_row_entries() const { return patch_count_; }

@@ -233,35 +233,25 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       return;
     }
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
-    // Position of each element in `elements`, so hits on leaves map to output indices.
-    std::vector<std::uint32_t> position(hierarchy_.elements().size(), kNone);
-    for (std::size_t k = 0; k < elements.size(); ++k) position[elements[k]] = static_cast<std::uint32_t>(k);
+    shot_column(patch, elements, positions(elements), *rays, options_.threads, out);
+  }
 
-    const Patch& source = hierarchy_.patches()[patch];
-    const std::uint32_t root = source.root;
-    // As many rays as the patch's elements would shoot for their rows, in chunks that run in
-    // parallel with their own random streams; the counts are integers, so the sum does not
-    // depend on the order.
-    const std::uint64_t total = std::uint64_t{options_.hemisphere_rays} * leaves_under(root);
-    constexpr std::uint32_t kChunk = 4096;
-    const auto chunks = static_cast<std::size_t>((total + kChunk - 1) / kChunk);
-    std::vector<std::vector<std::uint32_t>> hits(chunks);
-    parallel_for(options_.threads, chunks, 1, [&](std::size_t begin, std::size_t end) {
-      Scratch scratch(kChunk);
-      for (std::size_t c = begin; c < end; ++c) {
-        const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
-        Rng rng(options_.seed, patch, 0x400000000ull + c);
-        shoot(*rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t) {
-          if (position[leaf] != kNone) hits[c].push_back(position[leaf]);
-        });
-      }
-    });
-    HitCounter counter(elements.size());
-    for (const auto& h : hits)
-      for (std::uint32_t k : h) counter.add(k);
-    const double scale = static_cast<double>(source.area) / static_cast<double>(total);
-    counter.drain(out.index, out.value, [&](std::uint32_t k, std::uint32_t c) {
-      return static_cast<float>(scale * c / static_cast<double>(hierarchy_.element(elements[k]).area));
+  void sparse_patch_columns(const std::vector<std::uint32_t>& patches, const std::vector<std::uint32_t>& elements,
+                            std::vector<SparseFactors>& out) const override {
+    out.assign(patches.size(), SparseFactors{});
+    std::vector<std::size_t> shot;
+    for (std::size_t k = 0; k < patches.size(); ++k) {
+      if (exact_[patches[k]])
+        sparse_patch_column(patches[k], elements, out[k]);  // parallel inside
+      else
+        shot.push_back(k);
+    }
+    if (shot.empty()) return;
+    // One column per task: small columns cannot use two threads each, several at once can.
+    const std::shared_ptr<const LeafRays> rays = leaf_scene();
+    const std::vector<std::uint32_t> position = positions(elements);
+    parallel_for(options_.threads, shot.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) shot_column(patches[shot[i]], elements, position, *rays, 1, out[shot[i]]);
     });
   }
 
@@ -374,6 +364,46 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     if (blocked == 0) return 1.0;
     if (clear == 0) return 0.0;
     return weight > 0.0 ? clear_weight / weight : static_cast<double>(clear) / (clear + blocked);
+  }
+
+  /// Element id -> position in `elements` (kNone elsewhere), so hits on leaves map to indices.
+  std::vector<std::uint32_t> positions(const std::vector<std::uint32_t>& elements) const {
+    std::vector<std::uint32_t> position(hierarchy_.elements().size(), kNone);
+    for (std::size_t k = 0; k < elements.size(); ++k) position[elements[k]] = static_cast<std::uint32_t>(k);
+    return position;
+  }
+
+  /// The column of a non-emitting patch, shot from it: as many rays as its elements would shoot
+  /// for their rows, in chunks with their own random streams (on up to `threads` threads); the
+  /// counts are integers, so the result does not depend on the thread count.
+  void shot_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
+                   const std::vector<std::uint32_t>& position, const LeafRays& rays, unsigned threads,
+                   SparseFactors& out) const {
+    out.index.clear();
+    out.value.clear();
+    const Patch& source = hierarchy_.patches()[patch];
+    const std::uint32_t root = source.root;
+    const std::uint64_t total = std::uint64_t{options_.hemisphere_rays} * leaves_under(root);
+    constexpr std::uint32_t kChunk = 1024;
+    const auto chunks = static_cast<std::size_t>((total + kChunk - 1) / kChunk);
+    std::vector<std::vector<std::uint32_t>> hits(chunks);
+    parallel_for(threads, chunks, 1, [&](std::size_t begin, std::size_t end) {
+      Scratch scratch(kChunk);
+      for (std::size_t c = begin; c < end; ++c) {
+        const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
+        Rng rng(options_.seed, patch, 0x400000000ull + c);
+        shoot(rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t) {
+          if (position[leaf] != kNone) hits[c].push_back(position[leaf]);
+        });
+      }
+    });
+    HitCounter counter(elements.size());
+    for (const auto& h : hits)
+      for (std::uint32_t k : h) counter.add(k);
+    const double scale = static_cast<double>(source.area) / static_cast<double>(total);
+    counter.drain(out.index, out.value, [&](std::uint32_t k, std::uint32_t c) {
+      return static_cast<float>(scale * c / static_cast<double>(hierarchy_.element(elements[k]).area));
+    });
   }
 
   /// Per-thread sample buffers.

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "detail/parallel.hpp"
 #include "solve/system.hpp"
 
 namespace radiosity::detail {
@@ -41,7 +42,9 @@ SolverResult solve_progressive(const SolverContext& ctx) {
   std::vector<std::uint8_t> cached(n, 0);  // a column may be cached and empty (a patch that sees nothing)
   std::size_t cached_bytes = 0, peak_scratch = 0;
   FactorVector scratch;
-  SparseFactors sparse_column;
+  std::vector<std::uint32_t> batch, candidates;
+  std::vector<SparseFactors> fetched;
+  const std::size_t prefetch = 8 * static_cast<std::size_t>(thread_count(ctx.options.threads));
 
   // Ambient radiosity: the unshot power spread over the whole scene area and multiplied by the
   // interreflection factor (Cohen et al. 1988, eqs. 5-6). For display only; it tends to 0.
@@ -51,6 +54,7 @@ SolverResult solve_progressive(const SolverContext& ctx) {
     return Rgb(sum / sys.total_area) * sys.interreflection;
   };
   auto report = [&](Progress p, bool force) {
+    if (!ctx.progress.due(p.phase, force)) return true;  // the ambient term is an O(n) sum
     p.hierarchy = &ctx.hierarchy;
     p.leaf_radiosity = result.B.data();
     p.ambient = ambient();
@@ -65,12 +69,25 @@ SolverResult solve_progressive(const SolverContext& ctx) {
   std::vector<double> power(n);
   for (std::size_t j = 0; j < n; ++j) power[j] = sum3(unshot[j]) * sys.patch_area[j];
   for (int step = 1;; ++step) {
-    std::size_t shooter = 0;
-    double best = -1.0, total_unshot = 0.0;
-    for (std::size_t j = 0; j < n; ++j) {
-      total_unshot += power[j];
-      if (power[j] > best) best = power[j], shooter = j;
+    // Four independent partial sums and maxima keep the scan from waiting on one add chain;
+    // ties go to the lowest index, as in a plain scan.
+    double sum4[4] = {0.0, 0.0, 0.0, 0.0}, best4[4] = {-1.0, -1.0, -1.0, -1.0};
+    std::size_t arg4[4] = {0, 0, 0, 0};
+    std::size_t j = 0;
+    for (; j + 4 <= n; j += 4)
+      for (std::size_t l = 0; l < 4; ++l) {
+        sum4[l] += power[j + l];
+        if (power[j + l] > best4[l]) best4[l] = power[j + l], arg4[l] = j + l;
+      }
+    for (; j < n; ++j) {
+      sum4[j & 3] += power[j];
+      if (power[j] > best4[j & 3]) best4[j & 3] = power[j], arg4[j & 3] = j;
     }
+    std::size_t shooter = arg4[0];
+    double best = best4[0];
+    for (std::size_t l = 1; l < 4; ++l)
+      if (best4[l] > best || (best4[l] == best && arg4[l] < shooter)) best = best4[l], shooter = arg4[l];
+    const double total_unshot = (sum4[0] + sum4[1]) + (sum4[2] + sum4[3]);
     const double residual = total_unshot / sys.emitted;
     if (step > 1) {
       result.residual = residual;
@@ -95,26 +112,51 @@ SolverResult solve_progressive(const SolverContext& ctx) {
     if (!cached[shooter]) {
       auto tf = std::chrono::steady_clock::now();
       if (sparse) {
-        ctx.estimator.sparse_patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, sparse_column);
-        scratch.index = std::move(sparse_column.index);
-        scratch.value = std::move(sparse_column.value);
-        scratch.index.shrink_to_fit();
-        scratch.value.shrink_to_fit();
+        // Sparse columns are cheap to keep: fetch the shooter's together with those of the next
+        // brightest patches whose columns are missing, so that the estimator can compute them in
+        // parallel. Columns do not depend on which batch computes them.
+        batch.assign(1, static_cast<std::uint32_t>(shooter));
+        if (cached_bytes < ctx.options.memory_budget_bytes / 2) {
+          candidates.clear();
+          for (std::size_t c = 0; c < n; ++c)
+            if (!cached[c] && c != shooter && power[c] > 0.0) candidates.push_back(static_cast<std::uint32_t>(c));
+          const std::size_t extra = std::min(candidates.size(), prefetch - 1);
+          std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(extra), candidates.end(),
+                           [&](std::uint32_t a, std::uint32_t b) { return power[a] > power[b] || (power[a] == power[b] && a < b); });
+          batch.insert(batch.end(), candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(extra));
+        }
+        ctx.estimator.sparse_patch_columns(batch, sys.leaves, fetched);
+        for (std::size_t k = 0; k < batch.size(); ++k) {
+          FactorVector column;
+          column.index = std::move(fetched[k].index);
+          column.value = std::move(fetched[k].value);
+          column.index.shrink_to_fit();
+          column.value.shrink_to_fit();
+          if (cached_bytes + column.bytes() <= ctx.options.memory_budget_bytes) {
+            cached_bytes += column.bytes();
+            cache[batch[k]] = std::move(column);
+            cached[batch[k]] = 1;
+          } else if (k == 0) {
+            scratch = std::move(column);
+            peak_scratch = std::max(peak_scratch, scratch.bytes());
+          }
+        }
+        F = cached[shooter] ? &cache[shooter] : &scratch;
       } else {
         scratch.value.resize(m);
         ctx.estimator.patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, scratch.value.data());
+        if (cached_bytes + scratch.bytes() <= ctx.options.memory_budget_bytes) {
+          cached_bytes += scratch.bytes();
+          cache[shooter] = std::move(scratch);
+          scratch = FactorVector{};
+          cached[shooter] = 1;
+          F = &cache[shooter];
+        } else {
+          peak_scratch = std::max(peak_scratch, scratch.bytes());
+          F = &scratch;
+        }
       }
       result.seconds_form_factors += seconds_since(tf);
-      if (cached_bytes + scratch.bytes() <= ctx.options.memory_budget_bytes) {
-        cached_bytes += scratch.bytes();
-        cache[shooter] = std::move(scratch);
-        cached[shooter] = 1;
-        scratch = FactorVector{};
-        F = &cache[shooter];
-      } else {
-        peak_scratch = std::max(peak_scratch, scratch.bytes());
-        F = &scratch;
-      }
     }
 
     const Rgb shot = unshot[shooter];
@@ -126,9 +168,9 @@ SolverResult solve_progressive(const SolverContext& ctx) {
       const Rgb dB = sys.reflectance[e] * incident;
       result.H[e] += incident;
       result.B[e] += dB;
-      const std::uint32_t j = sys.patch[e];
-      unshot[j] += (sys.area[e] / sys.patch_area[j]) * dB;
-      power[j] = sum3(unshot[j]) * sys.patch_area[j];
+      const std::uint32_t p = sys.patch[e];
+      unshot[p] += (sys.area[e] / sys.patch_area[p]) * dB;
+      power[p] = sum3(unshot[p]) * sys.patch_area[p];
     });
 
     result.iterations = step;

@@ -58,6 +58,9 @@ class ProgressGate {
  public:
   explicit ProgressGate(const ProgressFn& fn) : fn_(fn) {}
   bool report(const Progress& p, bool force = false);
+  /// Whether report() would call the callback now: lets a caller skip building an expensive
+  /// Progress that would be dropped.
+  bool due(Phase phase, bool force = false) const;
 
  private:
   const ProgressFn& fn_;
