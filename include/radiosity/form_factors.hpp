@@ -60,6 +60,14 @@ struct FormFactorOptions {
   /// Monte Carlo: rays per element (per patch when shooting a column, times the patch's
   /// elements), in [16, 1 << 20]; 0 = 1024.
   std::uint32_t hemisphere_rays = 0;
+  /// Monte Carlo only: extended form factors (Wallace, Cohen & Greenberg 1987) carry light
+  /// between diffuse surfaces through up to this many specular events: reflections in ideal
+  /// mirrors (Material::specular with specular_exponent 0, weighted by the specular reflectance
+  /// averaged over channels) and passages through windows (Material::transmittance with ior 1,
+  /// straight on, weighted by the mean transmittance). 0 = classic radiosity: specular parts are
+  /// ignored and every polygon is opaque. Refracting glass (ior != 1) and glossy lobes stay
+  /// opaque here; the second pass (and its photon map) carries them. In [0, 16].
+  std::uint32_t specular_depth = 0;
   /// Seeds every random stream (ray-cast samples, hemicube orientations).
   std::uint64_t seed = 1;
   unsigned threads = 0;  ///< 0 = all hardware threads; 1 = the calling thread only

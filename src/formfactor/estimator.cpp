@@ -25,6 +25,12 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   if (o.visibility_rays > 64)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.visibility_rays must be in [1, 64] (0 = 4), got " + std::to_string(o.visibility_rays));
+  if (o.specular_depth > 16)
+    throw Error(ErrorCode::invalid_argument,
+                "form_factors.specular_depth must be in [0, 16], got " + std::to_string(o.specular_depth));
+  if (o.specular_depth > 0 && o.method != FormFactorMethod::monte_carlo)
+    throw Error(ErrorCode::invalid_argument,
+                "form_factors.specular_depth > 0 (mirror and window form factors) needs FormFactorMethod::monte_carlo");
   return o;
 }
 

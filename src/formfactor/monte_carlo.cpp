@@ -77,37 +77,39 @@ void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
   b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
 }
 
-/// Hit counts per target, with the touched targets listed so that clearing costs O(hits).
+/// Hit weights per target, with the touched targets listed so that clearing costs O(hits).
+/// Weights are > 0 (1 for a plain hit, less after mirrors and windows).
 class HitCounter {
  public:
-  explicit HitCounter(std::size_t targets) : count_(targets, 0) {}
-  void add(std::uint32_t target) {
-    if (count_[target]++ == 0) touched_.push_back(target);
+  explicit HitCounter(std::size_t targets) : sum_(targets, 0.0f) {}
+  void add(std::uint32_t target, float weight) {
+    if (sum_[target] == 0.0f) touched_.push_back(target);
+    sum_[target] += weight;
   }
-  /// Appends (target, scale x count) in increasing target order and clears.
+  /// Appends (target, scale(target, sum)) in increasing target order and clears.
   template <typename Scale>
   void drain(std::vector<std::uint32_t>& index, std::vector<float>& value, const Scale& scale) {
-    // Many distinct targets: walking the counts in order is cheaper than sorting.
-    if (touched_.size() * 64 > count_.size()) {
-      for (std::uint32_t t = 0; t < count_.size(); ++t)
-        if (count_[t] != 0) {
+    // Many distinct targets: walking the sums in order is cheaper than sorting.
+    if (touched_.size() * 64 > sum_.size()) {
+      for (std::uint32_t t = 0; t < sum_.size(); ++t)
+        if (sum_[t] != 0.0f) {
           index.push_back(t);
-          value.push_back(scale(t, count_[t]));
-          count_[t] = 0;
+          value.push_back(scale(t, sum_[t]));
+          sum_[t] = 0.0f;
         }
     } else {
       std::sort(touched_.begin(), touched_.end());
       for (std::uint32_t t : touched_) {
         index.push_back(t);
-        value.push_back(scale(t, count_[t]));
-        count_[t] = 0;
+        value.push_back(scale(t, sum_[t]));
+        sum_[t] = 0.0f;
       }
     }
     touched_.clear();
   }
 
  private:
-  std::vector<std::uint32_t> count_;
+  std::vector<float> sum_;
   std::vector<std::uint32_t> touched_;
 };
 
@@ -127,6 +129,14 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
     const auto& polygons = scene.polygons();
+    specular_depth_ = options.specular_depth;
+    specular_.resize(polygons.size());
+    for (std::size_t p = 0; p < polygons.size(); ++p) {
+      const Material& m = scene.material(polygons[p].material);
+      auto mean = [](const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; };
+      if (m.specular_exponent <= 0.0f) specular_[p].mirror = mean(m.specular);
+      if (m.ior == 1.0f) specular_[p].window = mean(m.transmittance);
+    }
     exact_.assign(patches.size(), 0);
     emitter_of_.assign(patches.size(), kNone);
     std::vector<std::uint32_t> polygon_slot(polygons.size(), kNone);
@@ -198,12 +208,13 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         const Element& el = hierarchy_.element(e);
         const Patch& source = hierarchy_.patches()[el.patch];
         Rng rng(options_.seed, e, 0x300000000ull);
-        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t, std::uint32_t j) {
-          if (!exact_[j]) counter.add(j);
+        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, std::uint32_t events) {
+          // Emitting patches reached directly are in the exact part.
+          if (events > 0 || !exact_[j]) counter.add(j, w);
         });
         index.clear();
         value.clear();
-        counter.drain(index, value, [&](std::uint32_t, std::uint32_t c) { return static_cast<float>(c) * per_ray; });
+        counter.drain(index, value, [&](std::uint32_t, float c) { return c * per_ray; });
         merge(index, value, own, out[k]);
       }
     });
@@ -233,7 +244,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       return;
     }
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
-    shot_column(patch, elements, positions(elements), *rays, options_.threads, out);
+    shot_column(patch, elements, positions(elements), *rays, options_.threads, 0, out);
   }
 
   void sparse_patch_columns(const std::vector<std::uint32_t>& patches, const std::vector<std::uint32_t>& elements,
@@ -251,7 +262,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
     const std::vector<std::uint32_t> position = positions(elements);
     parallel_for(options_.threads, shot.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) shot_column(patches[shot[i]], elements, position, *rays, 1, out[shot[i]]);
+      for (std::size_t i = begin; i < end; ++i)
+        shot_column(patches[shot[i]], elements, position, *rays, 1, 0, out[shot[i]]);
     });
   }
 
@@ -307,17 +319,26 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   void emitter_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
     analytic_->patch_column(patch, elements, out);
     const std::uint32_t light = emitter_of_[patch];
-    std::lock_guard<std::mutex> lock(visible_mutex_);
-    std::vector<float>& cache = visible_[light];
-    if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k) {
-        if (!(out[k] > 0.0f)) continue;
-        float& v = cache[elements[k]];
-        if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light));
-        out[k] *= v;
-      }
-    });
+    {
+      std::lock_guard<std::mutex> lock(visible_mutex_);
+      std::vector<float>& cache = visible_[light];
+      if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
+      parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          if (!(out[k] > 0.0f)) continue;
+          float& v = cache[elements[k]];
+          if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light));
+          out[k] *= v;
+        }
+      });
+    }
+    if (specular_depth_ > 0) {
+      // What the patch sends through mirrors and windows is shot like any other patch's.
+      SparseFactors extra;
+      const std::shared_ptr<const LeafRays> rays = leaf_scene();
+      shot_column(patch, elements, positions(elements), *rays, options_.threads, 1, extra);
+      for (std::size_t i = 0; i < extra.index.size(); ++i) out[extra.index[i]] += extra.value[i];
+    }
   }
 
   /// Kernel-weighted fraction of shadow rays from element e to light polygon `light` that are
@@ -376,9 +397,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   /// The column of a non-emitting patch, shot from it: as many rays as its elements would shoot
   /// for their rows, in chunks with their own random streams (on up to `threads` threads); the
   /// counts are integers, so the result does not depend on the thread count.
+  /// `min_events`: arrivals with fewer specular events are left out (1 for an emitting patch,
+  /// whose direct factors are computed exactly).
   void shot_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                    const std::vector<std::uint32_t>& position, const LeafRays& rays, unsigned threads,
-                   SparseFactors& out) const {
+                   std::uint32_t min_events, SparseFactors& out) const {
     out.index.clear();
     out.value.clear();
     const Patch& source = hierarchy_.patches()[patch];
@@ -386,22 +409,22 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::uint64_t total = std::uint64_t{options_.hemisphere_rays} * leaves_under(root);
     constexpr std::uint32_t kChunk = 1024;
     const auto chunks = static_cast<std::size_t>((total + kChunk - 1) / kChunk);
-    std::vector<std::vector<std::uint32_t>> hits(chunks);
+    std::vector<std::vector<std::pair<std::uint32_t, float>>> hits(chunks);
     parallel_for(threads, chunks, 1, [&](std::size_t begin, std::size_t end) {
       Scratch scratch(kChunk);
       for (std::size_t c = begin; c < end; ++c) {
         const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
         Rng rng(options_.seed, patch, 0x400000000ull + c);
-        shoot(rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t) {
-          if (position[leaf] != kNone) hits[c].push_back(position[leaf]);
+        shoot(rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t, float w, std::uint32_t events) {
+          if (position[leaf] != kNone && events >= min_events) hits[c].emplace_back(position[leaf], w);
         });
       }
     });
     HitCounter counter(elements.size());
     for (const auto& h : hits)
-      for (std::uint32_t k : h) counter.add(k);
+      for (const auto& [k, w] : h) counter.add(k, w);
     const double scale = static_cast<double>(source.area) / static_cast<double>(total);
-    counter.drain(out.index, out.value, [&](std::uint32_t k, std::uint32_t c) {
+    counter.drain(out.index, out.value, [&](std::uint32_t k, float c) {
       return static_cast<float>(scale * c / static_cast<double>(hierarchy_.element(elements[k]).area));
     });
   }
@@ -413,8 +436,14 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   };
 
   /// Casts `count` cosine-distributed rays from stratified points of element `from` (of patch
-  /// `source`) and calls hit(leaf, patch) for each ray that first hits the front of another
-  /// polygon's element.
+  /// `source`) and calls hit(leaf, patch, weight, events) for each diffuse arrival: a ray that
+  /// hits the front of another polygon's element arrives with weight 1 and no specular events.
+  /// With FormFactorOptions::specular_depth > 0 a ray that arrives at an ideal mirror also
+  /// reflects (weight times the mirror's mean specular reflectance) and one that reaches a
+  /// window (a transmitting polygon whose ior is 1) passes straight through either face (times
+  /// its mean transmittance), each such event counted, until the depth is used up: Wallace,
+  /// Cohen & Greenberg's mirror and window form factors, traced instead of built from virtual
+  /// mirror worlds (for planar mirrors the reflected ray is the ray to the virtual image).
   template <typename Hit>
   void shoot(const LeafRays& rays, std::uint32_t from, const Patch& source, std::uint32_t count, Rng& rng,
              Scratch& scratch, const Hit& hit) const {
@@ -432,16 +461,49 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     for (int k = 0; k < el.corner_count(); ++k)
       corners[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
     const CellSampler sampler(corners.data(), el.corner_count());  // as sample_point, constants hoisted
+    constexpr float kInfinity = std::numeric_limits<float>::infinity();
     for (std::uint32_t r = 0; r < count; ++r) {
-      const glm::vec3 x = sampler(scratch.points[r]) + epsilon_ * n;
+      glm::vec3 x = sampler(scratch.points[r]) + epsilon_ * n;
       const glm::vec3 local = cosine_direction(scratch.directions[r]);
-      const glm::vec3 w = local.x * t + local.y * b + local.z * n;
-      const std::optional<RayScene::Hit> h = rays.scene.intersect(x, w, 0.0f, std::numeric_limits<float>::infinity());
+      glm::vec3 w = local.x * t + local.y * b + local.z * n;
+      std::optional<RayScene::Hit> h = rays.scene.intersect(x, w, 0.0f, kInfinity);
       if (!h) continue;  // escaped (an open scene)
-      // The back of a one-sided surface absorbs; a hit on the source's own plane is rounding.
-      // (Per-triangle arrays and Embree's normal: the hierarchy's structs are cache misses.)
-      if (glm::dot(w, h->geometric_normal) >= 0.0f || rays.polygon[h->triangle] == source.polygon) continue;
-      hit(h->id, rays.patch[h->triangle]);
+      // The common case, fast: one-sided surfaces absorb at their back, and a hit on the
+      // source's own plane is rounding. (Per-triangle arrays and Embree's normal, because the
+      // hierarchy's structs would be cache misses.)
+      if (specular_depth_ == 0) {
+        if (glm::dot(w, h->geometric_normal) >= 0.0f || rays.polygon[h->triangle] == source.polygon) continue;
+        hit(h->id, rays.patch[h->triangle], 1.0f, 0u);
+        continue;
+      }
+      float weight = 1.0f;
+      std::uint32_t events = 0, last = source.polygon;
+      for (;;) {
+        const std::uint32_t polygon = rays.polygon[h->triangle];
+        const bool front = glm::dot(w, h->geometric_normal) < 0.0f;
+        const SpecularSurface& surface = specular_[polygon];
+        // A ray cannot meet the plane it left (the source's, or the mirror's or window's it just
+        // passed): such a hit is rounding.
+        if (polygon == last) break;
+        if (front) hit(h->id, rays.patch[h->triangle], weight, events);
+        if (events >= specular_depth_) break;
+        const glm::vec3 p = x + h->t * w;
+        const glm::vec3 ng = glm::normalize(h->geometric_normal);
+        if (front && surface.mirror > 0.0f) {
+          w = w - 2.0f * glm::dot(w, ng) * ng;
+          weight *= surface.mirror;
+          x = p + epsilon_ * ng;
+        } else if (surface.window > 0.0f) {
+          weight *= surface.window;
+          x = p + epsilon_ * w;  // straight on, through either face
+        } else {
+          break;  // absorbed (the diffuse part was counted above)
+        }
+        ++events;
+        last = polygon;
+        h = rays.scene.intersect(x, w, 0.0f, kInfinity);
+        if (!h) break;
+      }
     }
   }
 
@@ -491,6 +553,13 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   FormFactorOptions options_;
   std::unique_ptr<FormFactorEstimator> analytic_;  ///< unoccluded factors to emitting patches
   std::unique_ptr<FormFactorEstimator> analytic_serial_;  ///< the same on the calling thread only
+  /// Per polygon, for extended form factors: mean reflectance of an ideal mirror, mean
+  /// transmittance of a window (0 = neither).
+  struct SpecularSurface {
+    float mirror = 0.0f, window = 0.0f;
+  };
+  std::vector<SpecularSurface> specular_;
+  std::uint32_t specular_depth_ = 0;
   std::vector<std::uint8_t> exact_;                ///< per patch: 1 when it emits (no ray counts)
   std::vector<std::uint32_t> emitters_;            ///< the patches with exact_ set, increasing
   std::vector<std::uint32_t> emitter_of_;          ///< per patch: index into lights_, or kNone

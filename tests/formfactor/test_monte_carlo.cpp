@@ -258,3 +258,74 @@ TEST_SUITE("solve") {
     CHECK(sol.report().form_factor_bytes <= o.memory_budget_bytes);
   }
 }
+
+namespace {
+
+/// A mirror floor (y = 0, facing up, 8 x 8), a diffuse ceiling tile C and a light L beside it
+/// (both at y = 1, facing down, 1 x 1 each, 1.5 apart). Open: rays that miss everything escape.
+rad::Scene mirror_room(float mirror) {
+  rad::Scene s;
+  rad::Material floor;
+  floor.reflectance = rad::Rgb(0.0f);
+  floor.specular = rad::Rgb(mirror);
+  rad::Material tile;
+  tile.reflectance = rad::Rgb(0.5f);
+  rad::Material light;
+  light.reflectance = rad::Rgb(0.0f);
+  light.emission = rad::Rgb(1.0f);
+  const rad::MaterialId f = s.add_material(floor), c = s.add_material(tile), l = s.add_material(light);
+  s.add_polygon({{-3, 0, -3}, {-3, 0, 5}, {5, 0, 5}, {5, 0, -3}}, f, "floor");
+  s.add_polygon({{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, c, "tile");
+  s.add_polygon({{1.5f, 1, 0}, {2.5f, 1, 0}, {2.5f, 1, 1}, {1.5f, 1, 1}}, l, "light");
+  return s;
+}
+
+}  // namespace
+
+TEST_SUITE("solve") {
+  TEST_CASE("mirror form factors: a tile above a mirror floor gets rho x r x F(tile -> mirrored light) x E") {
+    // The reference: the factor to the light's mirror image, by the analytic estimator.
+    rad::Scene image;
+    const rad::MaterialId m = image.add_material(rad::Material{});
+    image.add_polygon({{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, m, "tile");
+    image.add_polygon({{1.5f, -1, 0}, {1.5f, -1, 1}, {2.5f, -1, 1}, {2.5f, -1, 0}}, m, "light_image");
+    rad::ViewFactorOptions vo;
+    vo.form_factors.method = rad::FormFactorMethod::analytic;
+    const double F = rad::view_factors(image, vo).at(0, 1);
+    REQUIRE(F > 0.01);
+
+    rad::SolveOptions o;
+    o.form_factors = monte_carlo(16384);
+    o.form_factors.specular_depth = 1;
+    o.mesh = mesh(0.0625f, 0.0625f);  // 16 elements on the tile
+    o.tolerance = 1e-6;
+    const double rays = 16.0 * 16384.0;
+    for (rad::SolverMethod method : {rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      o.method = method;
+      const double r = 0.9;
+      const rad::Solution mirror = rad::solve(mirror_room(static_cast<float>(r)), o);
+      const double expected = 0.5 * r * F * 1.0;
+      const double got = mirror.group_radiosity("tile").y;
+      INFO("F(tile -> mirrored light) = ", F, ": expected B = ", expected, ", got ", got);
+      CHECK(std::fabs(got - expected) <= 0.5 * r * four_sigma(F, rays));
+      // A black, non-reflecting floor leaves the tile dark: it sees nothing else.
+      const rad::Solution black = rad::solve(mirror_room(0.0f), o);
+      CHECK(black.group_radiosity("tile").y == 0.0f);
+      // Without extended form factors the mirror is just a black floor.
+      rad::SolveOptions classic = o;
+      classic.form_factors.specular_depth = 0;
+      CHECK(rad::solve(mirror_room(static_cast<float>(r)), classic).group_radiosity("tile").y == 0.0f);
+    }
+  }
+
+  TEST_CASE("specular_depth needs the monte_carlo estimator and at most 16 events") {
+    const rad::Scene s = mirror_room(0.9f);
+    rad::SolveOptions o;
+    o.form_factors.specular_depth = 1;
+    CHECK_THROWS_WITH_AS(rad::solve(s, o), doctest::Contains("needs FormFactorMethod::monte_carlo"), rad::Error);
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.specular_depth = 17;
+    CHECK_THROWS_WITH_AS(rad::solve(s, o), doctest::Contains("form_factors.specular_depth"), rad::Error);
+  }
+}
