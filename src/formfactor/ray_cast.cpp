@@ -3,7 +3,9 @@
 // SIGGRAPH 1989 (sampling the source, visibility by rays); Baum, Rushmeier & Winget, SIGGRAPH 1989
 // (the exact point-to-polygon factor for the unoccluded part); Haines & Wallace, "Shaft culling
 // for efficient ray-traced radiosity", Eurographics Workshop on Rendering 1991 (rays only where
-// an occluder may be); Cohen & Wallace, "Radiosity and Realistic Image Synthesis" (1993), ch. 4.
+// an occluder may be); Cohen & Wallace, "Radiosity and Realistic Image Synthesis" (1993), ch. 4;
+// Wald, Slusallek, Benthin & Wagner, "Interactive rendering with coherent ray tracing",
+// Eurographics 2001 (tracing coherent rays as packets).
 //
 // F(e -> j) = 1/A_e  integral over e of  F(dx -> j) V(x, j) dx.
 // For points x on the element, F(dx -> j) is evaluated exactly by the contour integral (so
@@ -13,6 +15,7 @@
 // that no other polygon can shadow (shaft test) cast no rays, so in an unoccluded configuration
 // the estimate is the exact factor up to the quadrature over e. Pairs whose first rays disagree
 // (a penumbra) are sampled again with more rays, in proportion to their unoccluded factor.
+// The rays of a pass all join one element to one patch and are traced together as packets.
 #include <algorithm>
 #include <array>
 #include <atomic>
