@@ -134,7 +134,8 @@ class RADIOSITY_API FormFactorEstimator {
 
 /// Makes the estimator named by options.method. The scene and hierarchy must outlive it.
 /// Throws Error{invalid_argument} naming the field for a sample count, ray count or resolution
-/// outside its range (0 selects the default) or an unknown method.
+/// outside its range (0 selects the default) or an unknown method, and Error{invalid_scene}
+/// naming two polygons when the scene has coincident or interpenetrating ones (find_overlaps()).
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(
     const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options);
@@ -182,7 +183,8 @@ struct GroupViewFactors {
 /// more than a few thousand element rows (memory O(rows x patches + groups^2), never
 /// elements x elements). The same scene, options and seed give bit-identical results at any
 /// thread count.
-/// Throws Error{invalid_scene} for a scene without polygons, Error{invalid_argument} for bad
+/// Throws Error{invalid_scene} for a scene without polygons or with coincident or
+/// interpenetrating ones (find_overlaps(), naming the first pair), Error{invalid_argument} for bad
 /// options (naming the field) or a group name that the scene does not have.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& options = {});

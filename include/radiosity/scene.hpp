@@ -119,6 +119,33 @@ class RADIOSITY_API Scene {
   std::vector<std::string> warnings_;
 };
 
+/// How two polygons of a scene conflict (find_overlaps()).
+enum class OverlapKind {
+  coincident,        ///< (nearly) coplanar and their interiors overlap with positive area
+  interpenetrating,  ///< their interiors cross: an edge of one passes through the other's interior
+};
+
+/// One conflicting pair of polygons, `first < second` (indices into Scene::polygons()).
+struct PolygonOverlap {
+  PolygonId first = 0;
+  PolygonId second = 0;
+  OverlapKind kind = OverlapKind::coincident;
+  glm::vec3 point{0.0f};  ///< a point where they meet: the middle of the shared region or crossing
+};
+
+/// Pairs of polygons that are coincident or interpenetrate, sorted by (first, second). Distances
+/// below 2e-5 of the scene's bounding-box diagonal (plus a polygon's own deviation from
+/// planarity) count as touching, so polygons that share edges or vertices, T-junctions, a block
+/// standing on a floor (touching it along its bottom edges) and the pieces of a triangulated
+/// polygon are not reported; two polygons stacked closer than that are (z-fighting).
+/// Form factors, view_factors() and solve() refuse such scenes with Error{invalid_scene}: rays
+/// and hemicubes cannot tell which of two coincident surfaces is in front, and a surface that
+/// passes through another sees and lights its back. Cost: a bounding-box hierarchy (Embree's
+/// collision query) and an exact test per nearby pair, about linear in the number of polygons.
+/// Throws Error{internal} if Embree cannot create a device.
+/// Thread safety: concurrent calls are safe.
+RADIOSITY_API std::vector<PolygonOverlap> find_overlaps(const Scene& scene);
+
 /// The Cornell box as published by the Cornell Program of Computer Graphics: geometry in mm,
 /// camera at (278, 273, -800) looking +z with a 39.3077 degree vertical field of view, measured
 /// white/red/green reflectances, light radiance (17, 12, 4) (so E = pi * L) and light reflectance

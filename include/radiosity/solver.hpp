@@ -129,7 +129,9 @@ RADIOSITY_API void validate(const SolveOptions& options);
 
 /// Meshes the scene, computes form factors and solves for radiosity. Throws Error for bad
 /// options or when the matrix methods would exceed memory_budget_bytes (the message gives the
-/// size and suggests progressive or a coarser mesh). A cancelled solve returns the last
+/// size and suggests progressive or a coarser mesh), and Error{invalid_scene} naming two
+/// polygons for coincident or interpenetrating surfaces (find_overlaps(); checked when the form
+/// factors are set up, so a scene that emits nothing returns B = 0 without the check). A cancelled solve returns the last
 /// consistent estimate with status cancelled.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});

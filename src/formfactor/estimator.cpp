@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "formfactor/estimators.hpp"
+#include "geometry/overlap.hpp"
 
 namespace radiosity::detail {
 
@@ -90,6 +91,8 @@ std::size_t FormFactorEstimator::max_row_entries() const { return patch_count_; 
 std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                                 const FormFactorOptions& options) {
   const FormFactorOptions o = detail::resolve(options);
+  // Coincident or interpenetrating surfaces would give factors that are wrong without a sign.
+  detail::check_no_overlaps(scene, "form factors");
   switch (o.method) {
     case FormFactorMethod::ray_cast: return detail::make_ray_cast_estimator(scene, hierarchy, o);
     case FormFactorMethod::analytic: return detail::make_analytic_estimator(scene, hierarchy, o);

@@ -3,7 +3,9 @@
 // SIGGRAPH 1989 (sampling the source, visibility by rays); Baum, Rushmeier & Winget, SIGGRAPH 1989
 // (the exact point-to-polygon factor for the unoccluded part); Haines & Wallace, "Shaft culling
 // for efficient ray-traced radiosity", Eurographics Workshop on Rendering 1991 (rays only where
-// an occluder may be); Cohen & Wallace, "Radiosity and Realistic Image Synthesis" (1993), ch. 4.
+// an occluder may be); Cohen & Wallace, "Radiosity and Realistic Image Synthesis" (1993), ch. 4;
+// Wald, Slusallek, Benthin & Wagner, "Interactive rendering with coherent ray tracing",
+// Eurographics 2001 (tracing coherent rays as packets).
 //
 // F(e -> j) = 1/A_e  integral over e of  F(dx -> j) V(x, j) dx.
 // For points x on the element, F(dx -> j) is evaluated exactly by the contour integral (so
@@ -13,12 +15,14 @@
 // that no other polygon can shadow (shaft test) cast no rays, so in an unoccluded configuration
 // the estimate is the exact factor up to the quadrature over e. Pairs whose first rays disagree
 // (a penumbra) are sampled again with more rays, in proportion to their unoccluded factor.
+// The rays of a pass all join one element to one patch and are traced together as packets.
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -58,6 +62,23 @@ namespace {
 
 // Gauss-Legendre 2x2 nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).
 constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.28867513459481287f;
+
+// The rays of one visibility pass; one per thread, reused (a pass has up to 256 x 64 rays).
+struct RayBatch {
+  std::vector<glm::vec3> source, origin, direction;
+  std::vector<std::uint8_t> blocked;
+  void resize(std::size_t rays) {
+    source.resize(std::max<std::size_t>(source.size(), 256));
+    origin.resize(rays);
+    direction.resize(rays);
+    blocked.resize(rays);
+  }
+};
+
+RayBatch& ray_batch() {
+  thread_local RayBatch batch;
+  return batch;
+}
 
 class SampledEstimator final : public FormFactorEstimator {
  public:
@@ -268,42 +289,16 @@ class SampledEstimator final : public FormFactorEstimator {
     const glm::vec3 nx = s.normal, ny = target.normal;
     const std::uint32_t ns = options_.source_samples, nv = options_.visibility_rays;
     Rng rng(options_.seed, s.element, 0x100000000ull + j);
-    std::array<glm::vec2, 64> target_uv;
-    double factor_sum = 0.0, visible_sum = 0.0, fraction_sum = 0.0;
-    std::uint32_t points = 0, clear = 0, blocked = 0;
-    auto cast_from = [&](const glm::vec3& x, std::uint32_t rays) {
-      stratified(rays, rng, true, target_uv.data());
-      const glm::vec3 origin = x + epsilon_ * nx;
-      double weight = 0.0, visible_weight = 0.0;
-      std::uint32_t visible_count = 0;
-      for (std::uint32_t t = 0; t < rays; ++t) {
-        const glm::vec3 y = poly.sampler(target_uv[t]);
-        const glm::vec3 d = (y + epsilon_ * ny) - origin;
-        const float r2 = glm::dot(d, d);
-        if (!(r2 > 0.0f)) continue;
-        const float w = std::max(0.0f, glm::dot(d, nx)) * std::max(0.0f, -glm::dot(d, ny)) / (r2 * r2);
-        const bool visible = !rays_->occluded(origin, d, 0.0f, 1.0f - 1e-4f);
-        visible_count += visible ? 1u : 0u;
-        weight += w;
-        visible_weight += visible ? w : 0.0f;
-      }
-      clear += visible_count;
-      blocked += rays - visible_count;
-      rays_cast += rays;
-      // All segments grazing (weight 0): the plain fraction of clear rays.
-      const double v = weight > 0.0 ? visible_weight / weight : static_cast<double>(visible_count) / rays;
-      const double f = glm::dot(x - target.centroid, ny) > 0.0f
-                           ? static_cast<double>(point_to_polygon_factor_fast(x, nx, poly.p.data(), poly.count))
-                           : 0.0;
-      factor_sum += f;
-      visible_sum += f * v;
-      fraction_sum += v;
-      ++points;
-    };
+    RayBatch& batch = ray_batch();
     // A pass of about `budget` rays: S = g^2 stratified source points, T = h^2 rays from each
-    // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays.
+    // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays. All rays of a pass
+    // are generated first (in the same random order as one source point at a time) and traced
+    // together: they run between the element and the patch, so Embree traces them as coherent
+    // packets, several times faster than one by one. Returns the number of clear rays.
+    std::uint32_t S = 0, T = 0;
     auto pass = [&](double budget) {
-      std::uint32_t S = ns, T = nv;
+      S = ns;
+      T = nv;
       if (budget > static_cast<double>(ns * nv)) {
         S = static_cast<std::uint32_t>(std::clamp(std::lround(std::sqrt(std::sqrt(budget))), 1l, 16l));
         S *= S;
@@ -311,8 +306,61 @@ class SampledEstimator final : public FormFactorEstimator {
         T = h * h;
       }
       std::array<glm::vec2, 256> uv;
+      std::array<glm::vec2, 64> target_uv;
       stratified(S, rng, true, uv.data());
-      for (std::uint32_t k = 0; k < S; ++k) cast_from(s.sampler(uv[k]), T);
+      const std::size_t count = static_cast<std::size_t>(S) * T;
+      batch.resize(count);
+      for (std::uint32_t k = 0; k < S; ++k) {
+        const glm::vec3 x = s.sampler(uv[k]);
+        batch.source[k] = x;
+        const glm::vec3 origin = x + epsilon_ * nx;
+        stratified(T, rng, true, target_uv.data());
+        for (std::uint32_t t = 0; t < T; ++t) {
+          const std::size_t r = static_cast<std::size_t>(k) * T + t;
+          batch.origin[r] = origin;
+          batch.direction[r] = (poly.sampler(target_uv[t]) + epsilon_ * ny) - origin;
+        }
+      }
+      rays_->occluded(count, batch.origin.data(), batch.direction.data(), 0.0f, 1.0f - 1e-4f, batch.blocked.data());
+      rays_cast += count;
+      std::uint32_t clear = 0;
+      for (std::size_t r = 0; r < count; ++r) {
+        const glm::vec3& d = batch.direction[r];
+        if (!(glm::dot(d, d) > 0.0f)) batch.blocked[r] = 1;  // a degenerate segment counts as blocked
+        clear += batch.blocked[r] == 0 ? 1u : 0u;
+      }
+      return clear;
+    };
+    // The sums of the ratio over the source points of the last pass. Only a pair whose rays
+    // disagree needs them: all clear is V = 1, all blocked V = 0, whatever the weights.
+    double factor_sum = 0.0, visible_sum = 0.0, fraction_sum = 0.0;
+    std::uint32_t points = 0;
+    auto weigh = [&] {
+      for (std::uint32_t k = 0; k < S; ++k) {
+        const glm::vec3 x = batch.source[k];
+        double weight = 0.0, visible_weight = 0.0;
+        std::uint32_t visible_count = 0;
+        for (std::uint32_t t = 0; t < T; ++t) {
+          const std::size_t r = static_cast<std::size_t>(k) * T + t;
+          const glm::vec3 d = batch.direction[r];
+          const float r2 = glm::dot(d, d);
+          if (!(r2 > 0.0f)) continue;
+          const float w = std::max(0.0f, glm::dot(d, nx)) * std::max(0.0f, -glm::dot(d, ny)) / (r2 * r2);
+          const bool visible = batch.blocked[r] == 0;
+          visible_count += visible ? 1u : 0u;
+          weight += w;
+          visible_weight += visible ? w : 0.0f;
+        }
+        // All segments grazing (weight 0): the plain fraction of clear rays.
+        const double v = weight > 0.0 ? visible_weight / weight : static_cast<double>(visible_count) / T;
+        const double f = glm::dot(x - target.centroid, ny) > 0.0f
+                             ? static_cast<double>(point_to_polygon_factor_fast(x, nx, poly.p.data(), poly.count))
+                             : 0.0;
+        factor_sum += f;
+        visible_sum += f * v;
+        fraction_sum += v;
+        ++points;
+      }
     };
     // The first pass grows with F too: a penumbra that blocks a fraction b of the pair escapes N
     // rays with probability (1 - b)^N, which costs at most about F / (e N) of the factor.
@@ -320,10 +368,12 @@ class SampledEstimator final : public FormFactorEstimator {
     auto rays_for = [&](double per_factor, double lo, double hi) {
       return std::max(lo, std::min(per_factor * base * unoccluded, hi));  // lo wins over hi
     };
-    pass(rays_for(256.0, base, 1024.0));
+    const std::uint32_t clear = pass(rays_for(256.0, base, 1024.0));
     if (clear == 0) return 0.0;
-    if (blocked > 0) pass(rays_for(1024.0, 4.0 * base, 4096.0));
-    if (blocked == 0) return 1.0;
+    if (clear == S * T) return 1.0;
+    weigh();
+    pass(rays_for(1024.0, 4.0 * base, 4096.0));
+    weigh();
     // No sampled point sees the receiver's front (a grazing pair): the plain mean of V(x).
     return factor_sum > 0.0 ? visible_sum / factor_sum : fraction_sum / points;
   }

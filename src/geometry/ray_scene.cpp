@@ -3,7 +3,9 @@
 // Ray Tracing", ACM TOG 33(4), 2014.
 #include "geometry/ray_scene.hpp"
 
+#include <algorithm>
 #include <cstring>
+#include <utility>
 #include <limits>
 #include <string>
 
@@ -49,6 +51,14 @@ RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<st
     rtcReleaseGeometry(geom);
   }
   rtcCommitScene(scene);
+  for (const auto& [property, width] : {std::pair{RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED, 16},
+                                        std::pair{RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED, 8},
+                                        std::pair{RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED, 4}}) {
+    if (rtcGetDeviceProperty(device, property) != 0) {
+      packet_width_ = width;
+      break;
+    }
+  }
   if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
     release();
     throw Error(ErrorCode::internal, "Embree: building the ray-query scene failed");
@@ -56,7 +66,11 @@ RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<st
 }
 
 RayScene::RayScene(RayScene&& other) noexcept
-    : device_(other.device_), scene_(other.scene_), ids_(std::move(other.ids_)), indices_(std::move(other.indices_)) {
+    : device_(other.device_),
+      scene_(other.scene_),
+      packet_width_(other.packet_width_),
+      ids_(std::move(other.ids_)),
+      indices_(std::move(other.indices_)) {
   other.device_ = nullptr;
   other.scene_ = nullptr;
 }
@@ -66,6 +80,7 @@ RayScene& RayScene::operator=(RayScene&& other) noexcept {
     release();
     device_ = other.device_;
     scene_ = other.scene_;
+    packet_width_ = other.packet_width_;
     ids_ = std::move(other.ids_);
     indices_ = std::move(other.indices_);
     other.device_ = nullptr;
@@ -132,6 +147,55 @@ bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tne
   ray.flags = 0;
   rtcOccluded1(as_scene(scene_), &context, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+namespace {
+
+// Segments [i, i + K) of the batch as one packet of K rays; lanes past `count` are switched off.
+template <int K, typename RayK, typename Occluded>
+void occluded_packets(RTCScene scene, std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear,
+                      float tfar, std::uint8_t* blocked, Occluded occluded) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  // The rays of a batch run between two nearby surfaces: Embree may trace them as a bundle.
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  RayK ray;
+  alignas(64) int valid[K];
+  for (std::size_t i = 0; i < count; i += K) {
+    const std::size_t n = std::min<std::size_t>(K, count - i);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(K); ++k) {
+      const std::size_t q = k < n ? i + k : i;
+      valid[k] = k < n ? -1 : 0;
+      ray.org_x[k] = origin[q].x;
+      ray.org_y[k] = origin[q].y;
+      ray.org_z[k] = origin[q].z;
+      ray.dir_x[k] = dir[q].x;
+      ray.dir_y[k] = dir[q].y;
+      ray.dir_z[k] = dir[q].z;
+      ray.tnear[k] = tnear;
+      ray.tfar[k] = tfar;
+      ray.time[k] = 0.0f;
+      ray.mask[k] = 0xffffffffu;
+      ray.id[k] = 0;
+      ray.flags[k] = 0;
+    }
+    occluded(valid, scene, &context, &ray);
+    for (std::size_t k = 0; k < n; ++k) blocked[i + k] = ray.tfar[k] < 0.0f ? 1 : 0;
+  }
+}
+
+}  // namespace
+
+void RayScene::occluded(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
+                        std::uint8_t* blocked) const {
+  RTCScene scene = as_scene(scene_);
+  switch (packet_width_) {
+    case 16: occluded_packets<16, RTCRay16>(scene, count, origin, dir, tnear, tfar, blocked, rtcOccluded16); return;
+    case 8: occluded_packets<8, RTCRay8>(scene, count, origin, dir, tnear, tfar, blocked, rtcOccluded8); return;
+    case 4: occluded_packets<4, RTCRay4>(scene, count, origin, dir, tnear, tfar, blocked, rtcOccluded4); return;
+    default:
+      for (std::size_t i = 0; i < count; ++i) blocked[i] = occluded(origin[i], dir[i], tnear, tfar) ? 1 : 0;
+  }
 }
 
 std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear,

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -186,15 +187,18 @@ TEST_SUITE("formfactor") {
     CHECK(same_thread);
   }
 
-  TEST_CASE("coincident, touching and interpenetrating polygons give finite factors in [0, 1] for every estimator") {
-    rad::Scene s;
-    const rad::MaterialId m = s.add_material({});
-    // Two coincident squares facing each other, a third crossing them at right angles through
-    // their middle, and one touching an edge at a grazing angle.
-    s.add_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, m, "up");
-    s.add_polygon({{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}, m, "down");
-    s.add_polygon({{0.5f, -0.5f, -0.5f}, {0.5f, 1.5f, -0.5f}, {0.5f, 1.5f, 0.5f}, {0.5f, -0.5f, 0.5f}}, m, "cross");
-    s.add_polygon({{1, 0, 0}, {2, 0, 1e-4f}, {2, 1, 1e-4f}, {1, 1, 0}}, m, "graze");
+  TEST_CASE("touching and grazing polygons give finite factors in [0, 1], coincident or crossing ones an error") {
+    // A square, a fin standing on it (touching along its bottom edge), and one sharing an edge
+    // at a grazing angle: legal, and every factor must be finite.
+    auto base = [] {
+      rad::Scene s;
+      const rad::MaterialId m = s.add_material({});
+      s.add_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, m, "up");
+      s.add_polygon({{0.5f, 0.2f, 0}, {0.5f, 0.8f, 0}, {0.5f, 0.8f, 0.5f}, {0.5f, 0.2f, 0.5f}}, m, "fin");
+      s.add_polygon({{1, 0, 0}, {2, 0, 1e-4f}, {2, 1, 1e-4f}, {1, 1, 0}}, m, "graze");
+      return s;
+    };
+    const rad::Scene s = base();
     for (const rad::FormFactorMethod method : kMethods) {
       rad::ViewFactorOptions o;
       o.form_factors.method = method;
@@ -211,6 +215,31 @@ TEST_SUITE("formfactor") {
           sum += f;
         }
         CHECK(sum <= 1.0 + 1e-3);
+      }
+    }
+    // A coincident back-to-back copy of the square, or a quad crossing it: refused by every
+    // estimator, naming the two polygons (tests/scene/test_overlap.cpp covers the geometry).
+    rad::Scene coincident = base();
+    coincident.add_polygon({{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}, 0, "down");
+    rad::Scene crossing = base();
+    crossing.add_polygon({{0.25f, -0.5f, -0.5f}, {0.25f, 1.5f, -0.5f}, {0.25f, 1.5f, 0.5f}, {0.25f, -0.5f, 0.5f}}, 0,
+                         "cross");
+    for (const rad::FormFactorMethod method : kMethods) {
+      rad::ViewFactorOptions o;
+      o.form_factors.method = method;
+      for (const auto& [scene, text] :
+           {std::pair<const rad::Scene*, const char*>{&coincident,
+                                                       "polygon 0 (group 'up') and polygon 3 (group 'down') are coincident"},
+            {&crossing, "polygon 0 (group 'up') and polygon 3 (group 'cross') interpenetrate"}}) {
+        bool thrown = false;
+        try {
+          rad::view_factors(*scene, o);
+        } catch (const rad::Error& e) {
+          thrown = true;
+          CHECK(e.code() == rad::ErrorCode::invalid_scene);
+          CHECK(std::string(e.what()).find(text) != std::string::npos);
+        }
+        CHECK(thrown);
       }
     }
   }
