@@ -83,6 +83,7 @@ struct SolveArgs {
   std::string method = "gauss-seidel";
   std::string form_factors = "ray-cast";
   unsigned hemisphere_rays = 0;
+  unsigned specular_depth = 0;
   float max_patch_area = 0.0f;
   float max_element_area = 0.0f;
   double tolerance = 1e-3;
@@ -120,6 +121,11 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
       ->capture_default_str();
   cmd.add_option("--hemisphere-rays", a.hemisphere_rays,
                  "Monte Carlo estimator: rays per element, 16..1048576 (0 = default: 1024)");
+  cmd.add_option("--specular-depth", a.specular_depth,
+                 "Monte Carlo estimator: mirror reflections and window passages carried between diffuse surfaces "
+                 "(extended form factors), 0..16")
+      ->check(CLI::Range(0u, 16u))
+      ->capture_default_str();
   cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(CLI::NonNegativeNumber);
   cmd.add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
@@ -148,6 +154,7 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
                                          : rad::SolverMethod::gauss_seidel;
   o.form_factors.method = form_factor_method(a.form_factors);
   o.form_factors.hemisphere_rays = a.hemisphere_rays;
+  o.form_factors.specular_depth = a.specular_depth;
   o.mesh.max_patch_area = a.max_patch_area;
   o.mesh.max_element_area = a.max_element_area;
   o.tolerance = a.tolerance;

@@ -431,8 +431,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   /// Per-thread sample buffers.
   struct Scratch {
-    explicit Scratch(std::uint32_t n) : points(n), directions(n) {}
+    explicit Scratch(std::uint32_t n) : points(n), directions(n), origin(n), dir(n), hits(n), found(n) {}
     std::vector<glm::vec2> points, directions;
+    std::vector<glm::vec3> origin, dir;
+    std::vector<RayScene::Hit> hits;
+    std::vector<std::uint8_t> found;
   };
 
   /// Casts `count` cosine-distributed rays from stratified points of element `from` (of patch
@@ -462,12 +465,18 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       corners[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
     const CellSampler sampler(corners.data(), el.corner_count());  // as sample_point, constants hoisted
     constexpr float kInfinity = std::numeric_limits<float>::infinity();
+    // The first segments of all rays, traced as packets (they share an origin region).
     for (std::uint32_t r = 0; r < count; ++r) {
-      glm::vec3 x = sampler(scratch.points[r]) + epsilon_ * n;
+      scratch.origin[r] = sampler(scratch.points[r]) + epsilon_ * n;
       const glm::vec3 local = cosine_direction(scratch.directions[r]);
-      glm::vec3 w = local.x * t + local.y * b + local.z * n;
-      std::optional<RayScene::Hit> h = rays.scene.intersect(x, w, 0.0f, kInfinity);
-      if (!h) continue;  // escaped (an open scene)
+      scratch.dir[r] = local.x * t + local.y * b + local.z * n;
+    }
+    rays.scene.intersect(count, scratch.origin.data(), scratch.dir.data(), 0.0f, kInfinity, scratch.hits.data(),
+                         scratch.found.data());
+    for (std::uint32_t r = 0; r < count; ++r) {
+      if (!scratch.found[r]) continue;  // escaped (an open scene)
+      glm::vec3 x = scratch.origin[r], w = scratch.dir[r];
+      std::optional<RayScene::Hit> h = scratch.hits[r];
       // The common case, fast: one-sided surfaces absorb at their back, and a hit on the
       // source's own plane is rounding. (Per-triangle arrays and Embree's normal, because the
       // hierarchy's structs would be cache misses.)

@@ -198,6 +198,76 @@ void RayScene::occluded(std::size_t count, const glm::vec3* origin, const glm::v
   }
 }
 
+namespace {
+
+template <int K, typename RayHitK, typename Intersect>
+void intersect_packets(RTCScene scene, const std::vector<std::uint32_t>& ids, std::size_t count,
+                       const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar, RayScene::Hit* hits,
+                       std::uint8_t* found, Intersect intersect) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RayHitK rh;
+  alignas(64) int valid[K];
+  for (std::size_t i = 0; i < count; i += K) {
+    const std::size_t n = std::min<std::size_t>(K, count - i);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(K); ++k) {
+      const std::size_t q = k < n ? i + k : i;
+      valid[k] = k < n ? -1 : 0;
+      rh.ray.org_x[k] = origin[q].x;
+      rh.ray.org_y[k] = origin[q].y;
+      rh.ray.org_z[k] = origin[q].z;
+      rh.ray.dir_x[k] = dir[q].x;
+      rh.ray.dir_y[k] = dir[q].y;
+      rh.ray.dir_z[k] = dir[q].z;
+      rh.ray.tnear[k] = tnear;
+      rh.ray.tfar[k] = tfar;
+      rh.ray.time[k] = 0.0f;
+      rh.ray.mask[k] = 0xffffffffu;
+      rh.ray.id[k] = 0;
+      rh.ray.flags[k] = 0;
+      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    intersect(valid, scene, &context, &rh);
+    for (std::size_t k = 0; k < n; ++k) {
+      found[i + k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+      if (!found[i + k]) continue;
+      RayScene::Hit& h = hits[i + k];
+      h.t = rh.ray.tfar[k];
+      h.triangle = rh.hit.primID[k];
+      h.id = ids[rh.hit.primID[k]];
+      h.u = rh.hit.u[k];
+      h.v = rh.hit.v[k];
+      h.geometric_normal = glm::vec3(rh.hit.Ng_x[k], rh.hit.Ng_y[k], rh.hit.Ng_z[k]);
+    }
+  }
+}
+
+}  // namespace
+
+void RayScene::intersect(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
+                         Hit* hits, std::uint8_t* found) const {
+  RTCScene scene = as_scene(scene_);
+  switch (packet_width_) {
+    case 16:
+      intersect_packets<16, RTCRayHit16>(scene, ids_, count, origin, dir, tnear, tfar, hits, found, rtcIntersect16);
+      return;
+    case 8:
+      intersect_packets<8, RTCRayHit8>(scene, ids_, count, origin, dir, tnear, tfar, hits, found, rtcIntersect8);
+      return;
+    case 4:
+      intersect_packets<4, RTCRayHit4>(scene, ids_, count, origin, dir, tnear, tfar, hits, found, rtcIntersect4);
+      return;
+    default:
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::optional<Hit> h = intersect(origin[i], dir[i], tnear, tfar);
+        found[i] = h ? 1 : 0;
+        if (h) hits[i] = *h;
+      }
+  }
+}
+
 std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear,
                                                  float tfar) const {
   RTCIntersectContext context;

@@ -56,6 +56,10 @@ class RayScene {
                 std::uint8_t* blocked) const;
   /// The nearest hit on the ray within (tnear, tfar).
   std::optional<Hit> intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
+  /// intersect() for `count` rays as packets of Embree's widest native size: found[i] = 1 and
+  /// hits[i] filled when ray i hits something, else found[i] = 0. Same answers as intersect().
+  void intersect(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar, Hit* hits,
+                 std::uint8_t* found) const;
 
   const std::vector<std::uint32_t>& triangle_ids() const { return ids_; }
   /// Vertex indices of a triangle (three entries).

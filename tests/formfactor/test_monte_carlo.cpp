@@ -329,3 +329,43 @@ TEST_SUITE("solve") {
     CHECK_THROWS_WITH_AS(rad::solve(s, o), doctest::Contains("form_factors.specular_depth"), rad::Error);
   }
 }
+
+TEST_SUITE("solve") {
+  TEST_CASE("window form factors: light through a clear pane of transmittance T reaches a tile T times as strongly") {
+    // Howell C-11 for the tile and the light (1 x 1, 2 apart), a 4 x 4 window halfway between.
+    const double F = test::parallel_rectangles(1, 1, 2);
+    auto room = [](float T) {
+      rad::Scene s;
+      rad::Material tile;
+      tile.reflectance = rad::Rgb(0.5f);
+      rad::Material pane;
+      pane.reflectance = rad::Rgb(0.0f);
+      pane.transmittance = rad::Rgb(T);
+      pane.ior = 1.0f;  // a window: no refraction
+      rad::Material light;
+      light.reflectance = rad::Rgb(0.0f);
+      light.emission = rad::Rgb(1.0f);
+      const rad::MaterialId t = s.add_material(tile), p = s.add_material(pane), l = s.add_material(light);
+      s.add_polygon({{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, t, "tile");
+      s.add_polygon({{-1.5f, 1, -1.5f}, {-1.5f, 1, 2.5f}, {2.5f, 1, 2.5f}, {2.5f, 1, -1.5f}}, p, "window");
+      s.add_polygon({{0, 2, 0}, {1, 2, 0}, {1, 2, 1}, {0, 2, 1}}, l, "light");
+      return s;
+    };
+    rad::SolveOptions o;
+    o.form_factors = monte_carlo(16384);
+    o.form_factors.specular_depth = 1;
+    o.mesh = mesh(0.0625f, 0.0625f);
+    o.tolerance = 1e-6;
+    const double rays = 16.0 * 16384.0;
+    for (float T : {1.0f, 0.6f}) {
+      CAPTURE(T);
+      const double got = rad::solve(room(T), o).group_radiosity("tile").y;
+      const double expected = 0.5 * T * F;
+      INFO("expected ", expected, ", got ", got);
+      CHECK(std::fabs(got - expected) <= 0.5 * T * four_sigma(F, rays));
+    }
+    // Classic radiosity: the pane is opaque and black.
+    o.form_factors.specular_depth = 0;
+    CHECK(rad::solve(room(1.0f), o).group_radiosity("tile").y == 0.0f);
+  }
+}
