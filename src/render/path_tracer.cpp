@@ -1,5 +1,5 @@
-// Brute-force path tracing of diffuse scenes: the reference the radiosity images are checked
-// against.
+// Brute-force path tracing with each material's reflection model: the reference that radiosity
+// and two-pass images are checked against.
 // Based on:
 //   J. T. Kajiya, "The rendering equation", SIGGRAPH 1986 (the path integral estimated here).
 //   E. Veach, "Robust Monte Carlo Methods for Light Transport Simulation", PhD thesis, Stanford
@@ -7,13 +7,17 @@
 //     (ch. 9, eq. 9.13), the area-to-solid-angle pdf conversion (eq. 8.10).
 //   J. Arvo & D. Kirk, "Particle transport and image synthesis", SIGGRAPH 1990 (Russian roulette).
 //   T. Duff et al., "Building an orthonormal basis, revisited", JCGT 6(1), 2017.
+//   E. Veach, ibid., ch. 5: radiance is not symmetric under refraction; it scales by
+//     (eta_o / eta_i)^2 across an interface, which is applied here for a camera path.
 //   M. Pharr, W. Jakob & G. Humphreys, "Physically Based Rendering", 3rd ed. 2016, sec. 13.6
-//     (cosine-weighted hemisphere sampling, Malley's method) and sec. 14.5 (path loop layout).
+//     (cosine-weighted hemisphere sampling, Malley's method) and sec. 14.5 (path loop layout;
+//     Russian roulette on the throughput with the refraction scale taken out, "etaScale").
 #include "radiosity/path_tracer.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,6 +27,7 @@
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
 #include "geometry/ray_scene.hpp"
+#include "radiosity/brdf.hpp"
 #include "render/camera.hpp"
 
 namespace radiosity {
@@ -63,11 +68,34 @@ std::size_t sample_cdf(const std::vector<float>& cdf, float u) {
 struct Surface {
   glm::vec3 normal{0.0f};
   glm::vec3 origin{0.0f};  ///< a vertex, to snap hit points onto the plane
-  Rgb emission{0.0f};      ///< exitance E, W/m^2
-  Rgb reflectance{0.0f};   ///< Lambertian albedo
+  Rgb emission{0.0f};      ///< exitance E, W/m^2, from the front only
+  std::uint32_t material = 0;
   /// Probability density per unit area with which next-event estimation picks a point here:
   /// P(choose this polygon) / area; 0 for non-emitters.
   float light_pdf_area = 0.0f;
+};
+
+/// How a material scatters, built once per render.
+struct Shading {
+  /// A plain Lambertian reflector (no specular, transmission, translucency or own BRDF): the
+  /// original diffuse code path, with no virtual calls, so diffuse scenes render exactly as
+  /// they did before materials had models.
+  bool lambertian = true;
+  Rgb reflectance{0.0f};  ///< the Lambertian albedo (lambertian only)
+  bool two_sided = false;  ///< hit from the back, flip the frame (never for refracting materials)
+  /// make_brdf(material) (not lambertian only), evaluated in the frame of the side hit.
+  std::shared_ptr<const Brdf> model;
+  bool model_delta = false;  ///< the model has no non-delta part: no light sampling for it
+  /// The model is known to be one-sided (derived from the fields, no specular transmission),
+  /// so calling it from the unflipped back is pointless.
+  bool model_one_sided = true;
+  float ior = 1.0f;  ///< index of the back side, for the radiance scale across a refraction
+  Rgb translucency{0.0f};  ///< Material::diffuse_transmittance: f = tau / pi on the far side
+  /// Probability of sampling the translucent lobe where the model also scatters, in proportion
+  /// to the two parts' largest albedos at normal incidence.
+  float translucent_share = 0.0f;
+  /// Seen from the back the surface is black and ends the path (as in the radiosity solver).
+  bool back_black = true;
 };
 
 /// An emitting polygon, fan-triangulated for uniform area sampling.
@@ -84,6 +112,8 @@ class PathTracer {
         camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
         rays_(detail::RayScene::from_polygons(scene)),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
+    // Each material's model is built once here; the render only reads it.
+    for (const Material& m : scene.materials()) shading_.push_back(make_shading(m));
     const auto& polygons = scene.polygons();
     surfaces_.resize(polygons.size());
     double total_power = 0.0;
@@ -94,7 +124,7 @@ class PathTracer {
       s.normal = poly.normal;
       s.origin = poly.vertices[0];
       s.emission = m.emission;
-      s.reflectance = m.reflectance;
+      s.material = poly.material;
       const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;
       if (!(power > 0.0)) continue;
       Emitter e;
@@ -152,6 +182,28 @@ class PathTracer {
   }
 
  private:
+  static Shading make_shading(const Material& m) {
+    Shading sh;
+    sh.two_sided = m.two_sided && !(max_component(m.transmittance) > 0.0f);
+    sh.translucency = m.diffuse_transmittance;
+    sh.lambertian = !m.brdf && !(max_component(m.specular) > 0.0f) && !(max_component(m.transmittance) > 0.0f) &&
+                    !(max_component(m.diffuse_transmittance) > 0.0f);
+    if (sh.lambertian) {
+      sh.reflectance = m.reflectance;
+      sh.back_black = !sh.two_sided;
+      return sh;
+    }
+    sh.model = make_brdf(m);
+    sh.model_delta = sh.model->is_delta();
+    sh.model_one_sided = !m.brdf && !(max_component(m.transmittance) > 0.0f);
+    sh.ior = m.ior;
+    const float a_model = max_component(sh.model->albedo(glm::vec3(0.0f, 0.0f, 1.0f)));
+    const float a_translucent = max_component(m.diffuse_transmittance);
+    if (a_translucent > 0.0f) sh.translucent_share = a_translucent / (a_translucent + a_model);
+    sh.back_black = !sh.two_sided && sh.model_one_sided && !(a_translucent > 0.0f);
+    return sh;
+  }
+
   /// Box-filtered mean of g x g jittered paths through the pixel, from the pixel's own stream.
   Rgb pixel(int x, int y) const {
     const std::uint64_t index = static_cast<std::uint64_t>(y) * options_.width + x;
@@ -175,21 +227,28 @@ class PathTracer {
     Rgb beta(1.0f);            // path throughput: product of f cos / pdf so far
     glm::vec3 prev_x = origin;  // the previous vertex (for the MIS weight of an emitter hit)
     float prev_pdf = 0.0f;     // solid-angle pdf of the bounce that produced `dir`
+    bool prev_delta = false;   // that bounce was a delta event, which light sampling cannot make
+    // Product of the (eta_i / eta_o)^2 radiance scales applied so far, divided out again for
+    // Russian roulette so that a path inside glass is not killed for its lower radiance.
+    float eta_scale = 1.0f;
     float tnear = 0.0f;
     for (int depth = 0;; ++depth) {
       const auto hit = rays_.intersect(origin, dir, tnear, std::numeric_limits<float>::infinity());
       if (!hit) break;
       const Surface& s = surfaces_[hit->id];
+      const Shading& sh = shading_[s.material];
       // One-sided surfaces: the back of a polygon absorbs, as in the radiosity solver.
       const float cos_in = -glm::dot(s.normal, dir);
-      if (cos_in <= 0.0f) break;
+      const bool front = cos_in > 0.0f;
+      if (!front && (sh.back_black || !(cos_in < 0.0f))) break;
       glm::vec3 x = origin + hit->t * dir;
       x -= s.normal * glm::dot(x - s.origin, s.normal);  // snap onto the polygon's plane
 
-      // Emission seen along the path: in full from the camera; after a bounce weighted against
-      // next-event estimation, which samples the same paths (Veach eq. 9.13).
-      if (s.light_pdf_area > 0.0f) {
-        if (depth == 0) {
+      // Emission (front only) seen along the path: in full from the camera or after a delta
+      // event (no light sample can produce those paths); after any other bounce weighted
+      // against next-event estimation, which samples the same paths (Veach eq. 9.13).
+      if (front && s.light_pdf_area > 0.0f) {
+        if (depth == 0 || prev_delta) {
           L += beta * s.emission * kInvPi;
         } else {
           const glm::vec3 w = x - prev_x;
@@ -198,46 +257,132 @@ class PathTracer {
         }
       }
       if (options_.max_depth > 0 && depth >= options_.max_depth) break;
-      if (max_component(s.reflectance) <= 0.0f) break;
 
-      const glm::vec3 n = s.normal;
-      const glm::vec3 offset_origin = x + epsilon_ * n;
-      if (!emitters_.empty()) L += beta * direct_light(x, offset_origin, n, s.reflectance, rng);
+      if (sh.lambertian) {
+        if (max_component(sh.reflectance) <= 0.0f) break;
+        const glm::vec3 n = front ? s.normal : -s.normal;  // a two-sided back reflects like a front
+        const glm::vec3 offset_origin = x + epsilon_ * n;
+        if (!emitters_.empty()) L += beta * direct_light(x, offset_origin, n, sh.reflectance, rng);
 
-      // Cosine-weighted bounce: f cos / pdf = (rho/pi) cos / (cos/pi) = rho.
-      const glm::vec2 u = rng.uniform2();
-      const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-      const float cz = std::sqrt(std::max(0.0f, 1.0f - u.x));
-      glm::vec3 t, b;
-      basis(n, t, b);
-      dir = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + cz * n);
-      prev_pdf = std::max(glm::dot(n, dir), 0.0f) * kInvPi;
-      beta *= s.reflectance;
+        // Cosine-weighted bounce: f cos / pdf = (rho/pi) cos / (cos/pi) = rho.
+        const glm::vec2 u = rng.uniform2();
+        const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+        const float cz = std::sqrt(std::max(0.0f, 1.0f - u.x));
+        glm::vec3 t, b;
+        basis(n, t, b);
+        dir = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + cz * n);
+        prev_pdf = std::max(glm::dot(n, dir), 0.0f) * kInvPi;
+        prev_delta = false;
+        beta *= sh.reflectance;
+        origin = offset_origin;
+      } else if (!scatter(s, sh, front, x, dir, rng, L, beta, prev_pdf, prev_delta, eta_scale, origin)) {
+        break;
+      }
 
       // Russian roulette (Arvo & Kirk 1990): survive with q = min(max beta, 0.95), reweight 1/q.
       if (depth + 1 >= kRouletteStart) {
-        const float q = std::min(max_component(beta), kMaxSurvival);
+        const float q = std::min(max_component(beta * eta_scale), kMaxSurvival);
         if (!(rng.uniform() < q)) break;
         beta /= q;
       }
       prev_x = x;
-      origin = offset_origin;
       tnear = 0.0f;
     }
     return L;
+  }
+
+  /// A vertex on a surface with a reflection model (and possibly translucency): adds the light
+  /// sample to L, draws the next direction into `dir`, updates the throughput and the MIS state,
+  /// and sets the next ray's `origin`. Returns false when the path ends here.
+  bool scatter(const Surface& s, const Shading& sh, bool front, const glm::vec3& x, glm::vec3& dir,
+               detail::Rng& rng, Rgb& L, Rgb& beta, float& prev_pdf, bool& prev_delta, float& eta_scale,
+               glm::vec3& origin) const {
+    // The shading frame: the geometric normal, flipped to the viewer's side for a two-sided
+    // surface. Unflipped, z > 0 is the front, whose medium has index 1 (the dielectric's "above").
+    ShadingFrame frame;
+    frame.normal = (!front && sh.two_sided) ? -s.normal : s.normal;
+    basis(frame.normal, frame.tangent, frame.bitangent);
+    const glm::vec3 wo = frame.to_local(-dir);
+    const bool model_on = wo.z > 0.0f || !sh.model_one_sided;
+    const float p_translucent = sh.translucent_share > 0.0f ? (model_on ? sh.translucent_share : 1.0f) : 0.0f;
+    if (!model_on && !(p_translucent > 0.0f)) return false;
+
+    if (!emitters_.empty() && (p_translucent > 0.0f || !sh.model_delta))
+      L += beta * direct_light(x, s.normal, frame, wo, sh, model_on, p_translucent, rng);
+
+    // Draw the next direction from the model or, with probability p_translucent, from the
+    // cosine lobe on the far side. The weight of a non-delta direction uses the whole BSDF and
+    // the whole pdf (one-sample MIS over the two parts), like Brdf mixtures do.
+    glm::vec3 wi;
+    Rgb weight(0.0f);
+    float pdf = 0.0f;
+    bool delta = false;
+    const bool pick_translucent =
+        p_translucent >= 1.0f || (p_translucent > 0.0f && rng.uniform() < p_translucent);
+    if (pick_translucent) {
+      const glm::vec2 u = rng.uniform2();
+      const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+      const float cz = std::sqrt(std::max(0.0f, 1.0f - u.x));
+      wi = glm::vec3(r * std::cos(phi), r * std::sin(phi), wo.z > 0.0f ? -cz : cz);
+      const Rgb f = sh.translucency * kInvPi + (model_on ? sh.model->eval(wo, wi) : Rgb(0.0f));
+      pdf = p_translucent * cz * kInvPi + (model_on ? (1.0f - p_translucent) * sh.model->pdf(wo, wi) : 0.0f);
+      if (!(pdf > 0.0f)) return false;
+      weight = f * (cz / pdf);
+    } else {
+      const std::optional<BrdfSample> b = sh.model->sample(wo, rng.uniform2());
+      if (!b) return false;
+      wi = b->wi;
+      if (b->delta) {
+        weight = b->weight / (1.0f - p_translucent);
+        delta = true;
+      } else if (!(p_translucent > 0.0f)) {
+        weight = b->weight;
+        pdf = b->pdf;
+      } else {
+        const bool across = wi.z * wo.z < 0.0f;
+        const Rgb f = sh.model->eval(wo, wi) + (across ? sh.translucency * kInvPi : Rgb(0.0f));
+        pdf = (1.0f - p_translucent) * b->pdf + (across ? p_translucent * std::abs(wi.z) * kInvPi : 0.0f);
+        weight = f * (std::abs(wi.z) / pdf);
+      }
+      if (!delta && !(pdf > 0.0f)) return false;
+    }
+    // A refraction carries radiance from the index of wi's side n_i into wo's side n_o, scaled
+    // by (n_o / n_i)^2 (Veach 1997, ch. 5). The models leave it out (brdf.hpp); a camera path
+    // applies it, so that an emitter inside glass is seen at its true radiance. On a path that
+    // enters and leaves glass the factors cancel.
+    if (delta && wi.z * wo.z < 0.0f) {
+      const float n_o = wo.z > 0.0f ? 1.0f : sh.ior, n_i = wi.z > 0.0f ? 1.0f : sh.ior;
+      const float scale = (n_o * n_o) / (n_i * n_i);
+      weight *= scale;
+      eta_scale /= scale;
+    }
+    if (!(max_component(weight) > 0.0f) || !std::isfinite(max_component(weight))) return false;
+
+    dir = glm::normalize(frame.to_world(wi));
+    beta *= weight;
+    prev_pdf = pdf;
+    prev_delta = delta;
+    origin = x + (glm::dot(dir, s.normal) > 0.0f ? epsilon_ : -epsilon_) * s.normal;
+    return true;
+  }
+
+  /// A uniform point on an emitter chosen by power, and that emitter.
+  const Surface& sample_light(detail::Rng& rng, glm::vec3& y) const {
+    const Emitter& e = emitters_[sample_cdf(emitter_cdf_, rng.uniform())];
+    const std::size_t tri = sample_cdf(e.cdf, rng.uniform());
+    // Uniform point in a triangle: barycentrics (1 - sqrt(u1), u2 sqrt(u1)).
+    const glm::vec2 u = rng.uniform2();
+    const float su = std::sqrt(u.x);
+    y = (1.0f - su) * e.a[tri] + (u.y * su) * e.b[tri] + (su * (1.0f - u.y)) * e.c[tri];
+    return surfaces_[e.polygon];
   }
 
   /// Next-event estimate of the light reflected at x towards the previous vertex, divided by
   /// the throughput: one point on one emitter, MIS-weighted against the cosine bounce.
   Rgb direct_light(const glm::vec3& x, const glm::vec3& offset_origin, const glm::vec3& n, const Rgb& rho,
                    detail::Rng& rng) const {
-    const Emitter& e = emitters_[sample_cdf(emitter_cdf_, rng.uniform())];
-    const std::size_t tri = sample_cdf(e.cdf, rng.uniform());
-    // Uniform point in a triangle: barycentrics (1 - sqrt(u1), u2 sqrt(u1)).
-    const glm::vec2 u = rng.uniform2();
-    const float su = std::sqrt(u.x);
-    const glm::vec3 y = (1.0f - su) * e.a[tri] + (u.y * su) * e.b[tri] + (su * (1.0f - u.y)) * e.c[tri];
-    const Surface& light = surfaces_[e.polygon];
+    glm::vec3 y;
+    const Surface& light = sample_light(rng, y);
 
     const glm::vec3 w = y - x;
     const float d2 = glm::dot(w, w);
@@ -259,6 +404,44 @@ class PathTracer {
     return rho * light.emission * (kInvPi * kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
   }
 
+  /// The same for a surface with a model: f = model (where it is on) + the translucent lobe on
+  /// the far side, MIS-weighted against scatter()'s sampling of both. Delta parts contribute
+  /// nothing here (a light sample never hits a delta direction) and block shadow rays.
+  Rgb direct_light(const glm::vec3& x, const glm::vec3& normal, const ShadingFrame& frame, const glm::vec3& wo,
+                   const Shading& sh, bool model_on, float p_translucent, detail::Rng& rng) const {
+    glm::vec3 y;
+    const Surface& light = sample_light(rng, y);
+
+    const glm::vec3 w = y - x;
+    const float d2 = glm::dot(w, w);
+    if (!(d2 > 0.0f)) return Rgb(0.0f);
+    const glm::vec3 wi = w / std::sqrt(d2);
+    const float cos_y = -glm::dot(light.normal, wi);
+    if (cos_y <= 0.0f) return Rgb(0.0f);
+    const glm::vec3 wi_local = frame.to_local(wi);
+    Rgb f(0.0f);
+    float pdf_bounce = 0.0f;
+    if (model_on) {
+      f = sh.model->eval(wo, wi_local);
+      pdf_bounce = (1.0f - p_translucent) * sh.model->pdf(wo, wi_local);
+    }
+    if (p_translucent > 0.0f && wi_local.z * wo.z < 0.0f) {
+      f += sh.translucency * kInvPi;
+      pdf_bounce += p_translucent * std::abs(wi_local.z) * kInvPi;
+    }
+    if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
+
+    // Shadow ray from the side of x that wi leaves from to the lit side of the emitter.
+    const float side = glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_;
+    const glm::vec3 start = x + side * normal;
+    const glm::vec3 sw = y + epsilon_ * light.normal - start;
+    const float dist = glm::length(sw);
+    if (rays_.occluded(start, sw / dist, 0.0f, dist)) return Rgb(0.0f);
+
+    const float pdf_light = light.light_pdf_area * d2 / cos_y;
+    return f * light.emission * (kInvPi * std::abs(wi_local.z) / pdf_light * power_heuristic(pdf_light, pdf_bounce));
+  }
+
   /// Orthonormal t, b completing the unit normal n (Duff et al. 2017).
   static void basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
     const float sign = std::copysign(1.0f, n.z);
@@ -274,6 +457,7 @@ class PathTracer {
   int g_;
   float epsilon_ = 0.0f;
   std::vector<Surface> surfaces_;
+  std::vector<Shading> shading_;  ///< by material id
   std::vector<Emitter> emitters_;
   std::vector<double> emitter_power_;
   std::vector<float> emitter_cdf_;
