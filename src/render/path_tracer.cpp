@@ -9,6 +9,9 @@
 //   T. Duff et al., "Building an orthonormal basis, revisited", JCGT 6(1), 2017.
 //   E. Veach, ibid., ch. 5: radiance is not symmetric under refraction; it scales by
 //     (eta_o / eta_i)^2 across an interface, which is applied here for a camera path.
+//   J. R. Wallace, M. F. Cohen & D. P. Greenberg, "A two-pass solution to the rendering
+//     equation: a synthesis of ray tracing and radiosity methods", SIGGRAPH 1987 (mirror images
+//     of the scene as virtual sources; here used to sample light through planar mirrors).
 //   M. Pharr, W. Jakob & G. Humphreys, "Physically Based Rendering", 3rd ed. 2016, sec. 13.6
 //     (cosine-weighted hemisphere sampling, Malley's method) and sec. 14.5 (path loop layout;
 //     Russian roulette on the throughput with the refraction scale taken out, "etaScale").
@@ -70,6 +73,7 @@ struct Surface {
   glm::vec3 origin{0.0f};  ///< a vertex, to snap hit points onto the plane
   Rgb emission{0.0f};      ///< exitance E, W/m^2, from the front only
   std::uint32_t material = 0;
+  std::int32_t mirror = -1;  ///< index into mirrors_ for a plain planar mirror, else -1
   /// Probability density per unit area with which next-event estimation picks a point here:
   /// P(choose this polygon) / area; 0 for non-emitters.
   float light_pdf_area = 0.0f;
@@ -105,6 +109,23 @@ struct Emitter {
   std::vector<float> cdf;          ///< over the triangles, by area
 };
 
+/// A polygon whose material is a plain one-sided ideal mirror (specular only, exponent 0), for
+/// light sampling through its mirror image.
+struct MirrorFace {
+  glm::vec3 normal{0.0f};
+  glm::vec3 origin{0.0f};
+  Rgb reflectance{0.0f};
+  std::vector<glm::vec3> vertices;  ///< counter-clockwise seen from the front
+};
+
+/// What the MIS weight of an emitter hit needs when the path reached it by one mirror
+/// reflection from a vertex that also sampled light through the mirrors.
+struct MirrorPath {
+  bool valid = false;
+  glm::vec3 x{0.0f};     ///< the non-delta vertex
+  float pdf_bsdf = 0.0f;  ///< solid-angle pdf of its bounce towards the mirror
+};
+
 class PathTracer {
  public:
   PathTracer(const Scene& scene, const PathTraceOptions& options)
@@ -125,6 +146,10 @@ class PathTracer {
       s.origin = poly.vertices[0];
       s.emission = m.emission;
       s.material = poly.material;
+      if (is_plain_mirror(m)) {
+        s.mirror = static_cast<std::int32_t>(mirrors_.size());
+        mirrors_.push_back(MirrorFace{poly.normal, poly.vertices[0], m.specular, poly.vertices});
+      }
       const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;
       if (!(power > 0.0)) continue;
       Emitter e;
@@ -182,6 +207,13 @@ class PathTracer {
   }
 
  private:
+  /// Exactly the materials for which make_brdf() returns make_mirror(specular).
+  static bool is_plain_mirror(const Material& m) {
+    return !m.brdf && !m.two_sided && max_component(m.specular) > 0.0f && m.specular_exponent <= 0.0f &&
+           !(max_component(m.reflectance) > 0.0f) && !(max_component(m.transmittance) > 0.0f) &&
+           !(max_component(m.diffuse_transmittance) > 0.0f);
+  }
+
   static Shading make_shading(const Material& m) {
     Shading sh;
     sh.two_sided = m.two_sided && !(max_component(m.transmittance) > 0.0f);
@@ -228,6 +260,10 @@ class PathTracer {
     glm::vec3 prev_x = origin;  // the previous vertex (for the MIS weight of an emitter hit)
     float prev_pdf = 0.0f;     // solid-angle pdf of the bounce that produced `dir`
     bool prev_delta = false;   // that bounce was a delta event, which light sampling cannot make
+    // The previous vertex also sampled light through the mirrors, and `dir` left it by a
+    // non-delta bounce; and, when `dir` leaves a mirror reached that way, that vertex's data.
+    bool mirror_sampled = false;
+    MirrorPath via_mirror;
     // Product of the (eta_i / eta_o)^2 radiance scales applied so far, divided out again for
     // Russian roulette so that a path inside glass is not killed for its lower radiance.
     float eta_scale = 1.0f;
@@ -248,8 +284,14 @@ class PathTracer {
       // event (no light sample can produce those paths); after any other bounce weighted
       // against next-event estimation, which samples the same paths (Veach eq. 9.13).
       if (front && s.light_pdf_area > 0.0f) {
-        if (depth == 0 || prev_delta) {
+        if (depth == 0 || (prev_delta && !via_mirror.valid)) {
           L += beta * s.emission * kInvPi;
+        } else if (prev_delta) {
+          // Reached by one mirror reflection: mirror_light() samples this path too, with the
+          // pdf of the emitter's image (path length through the mirror, 1/K for the face).
+          const float D = glm::length(prev_x - via_mirror.x) + glm::length(x - prev_x);
+          const float pdf_mirror = s.light_pdf_area * D * D / cos_in / static_cast<float>(mirrors_.size());
+          L += beta * s.emission * (kInvPi * power_heuristic(via_mirror.pdf_bsdf, pdf_mirror));
         } else {
           const glm::vec3 w = x - prev_x;
           const float pdf_light = s.light_pdf_area * glm::dot(w, w) / cos_in;
@@ -257,12 +299,29 @@ class PathTracer {
         }
       }
       if (options_.max_depth > 0 && depth >= options_.max_depth) break;
+      // This vertex is a mirror reached by a non-delta bounce from a vertex that sampled light
+      // through the mirrors: remember that vertex for the MIS weight of an emitter hit next.
+      MirrorPath next_via_mirror;
+      if (s.mirror >= 0 && front && mirror_sampled) next_via_mirror = MirrorPath{true, prev_x, prev_pdf};
+      // Light through a mirror makes a path two events longer than this vertex.
+      const bool sample_mirrors = !mirrors_.empty() && !emitters_.empty() &&
+                                  (options_.max_depth == 0 || depth + 2 <= options_.max_depth);
+      mirror_sampled = false;
 
       if (sh.lambertian) {
         if (max_component(sh.reflectance) <= 0.0f) break;
         const glm::vec3 n = front ? s.normal : -s.normal;  // a two-sided back reflects like a front
         const glm::vec3 offset_origin = x + epsilon_ * n;
         if (!emitters_.empty()) L += beta * direct_light(x, offset_origin, n, sh.reflectance, rng);
+        if (sample_mirrors) {
+          const Rgb f = sh.reflectance * kInvPi;
+          L += beta * mirror_light(x, n, rng, [&](const glm::vec3& wi, float& pdf, float& cos_x) {
+                 cos_x = glm::dot(n, wi);
+                 pdf = std::max(cos_x, 0.0f) * kInvPi;
+                 return cos_x > 0.0f ? f : Rgb(0.0f);
+               });
+          mirror_sampled = true;
+        }
 
         // Cosine-weighted bounce: f cos / pdf = (rho/pi) cos / (cos/pi) = rho.
         const glm::vec2 u = rng.uniform2();
@@ -275,9 +334,11 @@ class PathTracer {
         prev_delta = false;
         beta *= sh.reflectance;
         origin = offset_origin;
-      } else if (!scatter(s, sh, front, x, dir, rng, L, beta, prev_pdf, prev_delta, eta_scale, origin)) {
+      } else if (!scatter(s, sh, front, x, sample_mirrors, dir, rng, L, beta, prev_pdf, prev_delta, mirror_sampled,
+                          eta_scale, origin)) {
         break;
       }
+      via_mirror = next_via_mirror;
 
       // Russian roulette (Arvo & Kirk 1990): survive with q = min(max beta, 0.95), reweight 1/q.
       if (depth + 1 >= kRouletteStart) {
@@ -294,9 +355,9 @@ class PathTracer {
   /// A vertex on a surface with a reflection model (and possibly translucency): adds the light
   /// sample to L, draws the next direction into `dir`, updates the throughput and the MIS state,
   /// and sets the next ray's `origin`. Returns false when the path ends here.
-  bool scatter(const Surface& s, const Shading& sh, bool front, const glm::vec3& x, glm::vec3& dir,
-               detail::Rng& rng, Rgb& L, Rgb& beta, float& prev_pdf, bool& prev_delta, float& eta_scale,
-               glm::vec3& origin) const {
+  bool scatter(const Surface& s, const Shading& sh, bool front, const glm::vec3& x, bool sample_mirrors,
+               glm::vec3& dir, detail::Rng& rng, Rgb& L, Rgb& beta, float& prev_pdf, bool& prev_delta,
+               bool& mirror_sampled, float& eta_scale, glm::vec3& origin) const {
     // The shading frame: the geometric normal, flipped to the viewer's side for a two-sided
     // surface. Unflipped, z > 0 is the front, whose medium has index 1 (the dielectric's "above").
     ShadingFrame frame;
@@ -307,8 +368,27 @@ class PathTracer {
     const float p_translucent = sh.translucent_share > 0.0f ? (model_on ? sh.translucent_share : 1.0f) : 0.0f;
     if (!model_on && !(p_translucent > 0.0f)) return false;
 
-    if (!emitters_.empty() && (p_translucent > 0.0f || !sh.model_delta))
-      L += beta * direct_light(x, s.normal, frame, wo, sh, model_on, p_translucent, rng);
+    // The BSDF for light sampling: the model (where it is on) plus the translucent lobe on the
+    // far side, with the pdf of the sampling below; delta parts are 0 here.
+    const auto bsdf = [&](const glm::vec3& wi_world, float& pdf, float& cos_x) {
+      const glm::vec3 wi = frame.to_local(wi_world);
+      Rgb f(0.0f);
+      pdf = 0.0f;
+      if (model_on) {
+        f = sh.model->eval(wo, wi);
+        pdf = (1.0f - p_translucent) * sh.model->pdf(wo, wi);
+      }
+      if (p_translucent > 0.0f && wi.z * wo.z < 0.0f) {
+        f += sh.translucency * kInvPi;
+        pdf += p_translucent * std::abs(wi.z) * kInvPi;
+      }
+      cos_x = std::abs(wi.z);
+      return f;
+    };
+    const bool has_lobe = p_translucent > 0.0f || !sh.model_delta;
+    if (!emitters_.empty() && has_lobe) L += beta * direct_light(x, s.normal, rng, bsdf);
+    const bool mirrors_sampled_here = sample_mirrors && has_lobe;
+    if (mirrors_sampled_here) L += beta * mirror_light(x, s.normal, rng, bsdf);
 
     // Draw the next direction from the model or, with probability p_translucent, from the
     // cosine lobe on the far side. The weight of a non-delta direction uses the whole BSDF and
@@ -362,6 +442,7 @@ class PathTracer {
     beta *= weight;
     prev_pdf = pdf;
     prev_delta = delta;
+    mirror_sampled = mirrors_sampled_here && !delta;
     origin = x + (glm::dot(dir, s.normal) > 0.0f ? epsilon_ : -epsilon_) * s.normal;
     return true;
   }
@@ -404,11 +485,12 @@ class PathTracer {
     return rho * light.emission * (kInvPi * kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
   }
 
-  /// The same for a surface with a model: f = model (where it is on) + the translucent lobe on
-  /// the far side, MIS-weighted against scatter()'s sampling of both. Delta parts contribute
-  /// nothing here (a light sample never hits a delta direction) and block shadow rays.
-  Rgb direct_light(const glm::vec3& x, const glm::vec3& normal, const ShadingFrame& frame, const glm::vec3& wo,
-                   const Shading& sh, bool model_on, float p_translucent, detail::Rng& rng) const {
+  /// The same for a surface with a model: `bsdf(wi, pdf, cos_x)` returns f (model plus
+  /// translucency) for the world direction wi and sets scatter()'s pdf of wi and |cos|. Delta
+  /// parts contribute nothing here (a light sample never hits a delta direction) and block
+  /// shadow rays.
+  template <class Bsdf>
+  Rgb direct_light(const glm::vec3& x, const glm::vec3& normal, detail::Rng& rng, const Bsdf& bsdf) const {
     glm::vec3 y;
     const Surface& light = sample_light(rng, y);
 
@@ -418,28 +500,68 @@ class PathTracer {
     const glm::vec3 wi = w / std::sqrt(d2);
     const float cos_y = -glm::dot(light.normal, wi);
     if (cos_y <= 0.0f) return Rgb(0.0f);
-    const glm::vec3 wi_local = frame.to_local(wi);
-    Rgb f(0.0f);
-    float pdf_bounce = 0.0f;
-    if (model_on) {
-      f = sh.model->eval(wo, wi_local);
-      pdf_bounce = (1.0f - p_translucent) * sh.model->pdf(wo, wi_local);
-    }
-    if (p_translucent > 0.0f && wi_local.z * wo.z < 0.0f) {
-      f += sh.translucency * kInvPi;
-      pdf_bounce += p_translucent * std::abs(wi_local.z) * kInvPi;
-    }
+    float pdf_bounce = 0.0f, cos_x = 0.0f;
+    const Rgb f = bsdf(wi, pdf_bounce, cos_x);
     if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
 
     // Shadow ray from the side of x that wi leaves from to the lit side of the emitter.
-    const float side = glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_;
-    const glm::vec3 start = x + side * normal;
+    const glm::vec3 start = x + (glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
     const glm::vec3 sw = y + epsilon_ * light.normal - start;
     const float dist = glm::length(sw);
     if (rays_.occluded(start, sw / dist, 0.0f, dist)) return Rgb(0.0f);
 
     const float pdf_light = light.light_pdf_area * d2 / cos_y;
-    return f * light.emission * (kInvPi * std::abs(wi_local.z) / pdf_light * power_heuristic(pdf_light, pdf_bounce));
+    return f * light.emission * (kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
+  }
+
+  /// Light that reaches x by one reflection in a plain planar mirror, sampled through the
+  /// emitters' mirror images (the virtual sources of Wallace, Cohen & Greenberg 1987): a mirror
+  /// face chosen uniformly, a point y on an emitter as in direct_light(), and the direction to
+  /// y's image y' behind the mirror's plane. The path x -> p -> y exists when x and y are in
+  /// front of the mirror and the segment x y' crosses the mirror polygon at p; its length is
+  /// |x - y'|. MIS-weighted against BSDF sampling, which finds the same path when a bounce from
+  /// x hits the mirror and then the emitter (see trace()). Without it the light a mirror throws
+  /// onto diffuse surfaces is found only by BSDF sampling, which is far noisier.
+  template <class Bsdf>
+  Rgb mirror_light(const glm::vec3& x, const glm::vec3& normal, detail::Rng& rng, const Bsdf& bsdf) const {
+    const std::size_t k = static_cast<std::size_t>(rng.uniform() * static_cast<float>(mirrors_.size()));
+    const MirrorFace& m = mirrors_[std::min(k, mirrors_.size() - 1)];
+    glm::vec3 y;
+    const Surface& light = sample_light(rng, y);
+    const float hx = glm::dot(x - m.origin, m.normal), hy = glm::dot(y - m.origin, m.normal);
+    if (!(hx > 0.0f) || !(hy > 0.0f)) return Rgb(0.0f);
+
+    const glm::vec3 w = y - 2.0f * hy * m.normal - x;  // towards the image y'
+    const float d2 = glm::dot(w, w);
+    if (!(d2 > 0.0f)) return Rgb(0.0f);
+    const float D = std::sqrt(d2);
+    const glm::vec3 wi = w / D;
+    // The segment crosses the plane where it has descended hx of its hx + hy.
+    const glm::vec3 p = x + (D * hx / (hx + hy)) * wi;
+    const std::size_t n = m.vertices.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::vec3& a = m.vertices[i];
+      if (glm::dot(glm::cross(m.vertices[(i + 1) % n] - a, p - a), m.normal) < 0.0f) return Rgb(0.0f);
+    }
+    const glm::vec3 wr = wi - 2.0f * glm::dot(wi, m.normal) * m.normal;  // from p towards y
+    const float cos_y = -glm::dot(light.normal, wr);
+    if (cos_y <= 0.0f) return Rgb(0.0f);
+    float pdf_bounce = 0.0f, cos_x = 0.0f;
+    const Rgb f = bsdf(wi, pdf_bounce, cos_x);
+    if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
+
+    // Both legs unoccluded: x to just in front of p, and from there to the emitter.
+    const glm::vec3 start = x + (glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
+    const glm::vec3 at_mirror = p + epsilon_ * m.normal;
+    const glm::vec3 leg1 = at_mirror - start, leg2 = y + epsilon_ * light.normal - at_mirror;
+    const float l1 = glm::length(leg1), l2 = glm::length(leg2);
+    if (!(l1 > 0.0f) || !(l2 > 0.0f)) return Rgb(0.0f);
+    if (rays_.occluded(start, leg1 / l1, 0.0f, l1) || rays_.occluded(at_mirror, leg2 / l2, 0.0f, l2))
+      return Rgb(0.0f);
+
+    const float pdf_light = light.light_pdf_area * d2 / cos_y / static_cast<float>(mirrors_.size());
+    return f * m.reflectance * light.emission *
+           (kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
   }
 
   /// Orthonormal t, b completing the unit normal n (Duff et al. 2017).
@@ -459,6 +581,7 @@ class PathTracer {
   std::vector<Surface> surfaces_;
   std::vector<Shading> shading_;  ///< by material id
   std::vector<Emitter> emitters_;
+  std::vector<MirrorFace> mirrors_;
   std::vector<double> emitter_power_;
   std::vector<float> emitter_cdf_;
 };
