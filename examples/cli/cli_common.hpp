@@ -168,8 +168,17 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   return o;
 }
 
+/// Help text for the SCENE argument of every command.
+constexpr const char* kSceneHelp =
+    "OBJ file, or a built-in scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
+    "block, glass short block), cornell-mirror, cornell-glass";
+
+/// A built-in scene by name, else the OBJ file at `path`.
 inline rad::Scene load(const std::string& path) {
-  if (path.empty() || path == "cornell-box") return rad::cornell_box();
+  if (path.empty() || path == "cornell" || path == "cornell-box") return rad::cornell_box();
+  if (path == "cornell-specular") return rad::cornell_box_specular();
+  if (path == "cornell-mirror") return rad::cornell_box_specular(rad::CornellSpecular::mirror);
+  if (path == "cornell-glass") return rad::cornell_box_specular(rad::CornellSpecular::glass);
   return rad::load_scene(path);
 }
 

@@ -18,8 +18,9 @@ struct PathTraceOptions {
   /// Paths per pixel, > 0, on a stratified jittered g x g grid with a box filter; rounded up to
   /// a square (g = ceil(sqrt(spp))). Noise falls as 1/sqrt(spp).
   int spp = 64;
-  /// Most reflections a path may have, >= 0: 1 = direct lighting only, 2 = one indirect bounce,
-  /// ... 0 = unlimited, ended only by Russian roulette (unbiased).
+  /// Most scattering events (reflections and refractions, delta ones included) a path may have,
+  /// >= 0: 1 = direct lighting only, 2 = one indirect bounce, ... 0 = unlimited, ended only by
+  /// Russian roulette (unbiased).
   int max_depth = 0;
   std::optional<Camera> camera;  ///< default: the scene's camera
   unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
@@ -40,21 +41,41 @@ RADIOSITY_API void validate(const PathTraceOptions& options);
 /// pixel. A diffuse surface of radiosity B shows B/pi; an emitter of exitance E shows E/pi plus
 /// the light it reflects.
 ///
-/// Light transport is the radiosity method's: every surface is a one-sided Lambertian reflector
-/// with albedo Material::reflectance and a Lambertian emitter of exitance Material::emission.
-/// A ray that reaches the back of a polygon sees black and ends (the back absorbs), as in the
-/// radiosity solver; Material::two_sided, the specular, transmission and translucency fields and
-/// Material::brdf are ignored for now (issue #5 / the two-pass issue will extend this).
+/// Materials: each material's reflection model is make_brdf(material) (brdf.hpp), built once
+/// per render: Lambertian, Phong, mirror, glass (dielectric) or mixtures of them from the
+/// fields, or Material::brdf when set. Emission is Lambertian, from the front only.
+/// - One-sided (the default): a ray that reaches the back of a polygon sees black and the path
+///   ends, as in the radiosity solver. Material::two_sided flips the shading frame to the side
+///   hit, so the back reflects like the front (ignored for materials with transmittance > 0).
+/// - Glass (transmittance > 0): the front faces the outside (index 1), the back the inside
+///   (Material::ior); closed objects are polygons facing outwards. Across a refraction the
+///   radiance is scaled by (n_from / n_to)^2, which the models leave out; it cancels on every
+///   path that enters and leaves the glass, and makes an emitter inside glass appear at its
+///   physical radiance (T / n^2 of it at normal incidence). A Material::brdf that refracts
+///   must have Material::ior set to its index.
+/// - Material::diffuse_transmittance tau adds a Lambertian transmission lobe f = tau/pi on the
+///   side away from the viewer, from either side (the back of a one-sided surface then
+///   transmits but does not reflect).
+/// A scene of one-sided Lambertian materials (no specular, transmission, translucency or own
+/// BRDF) takes the original diffuse code path and renders bit-identically to earlier versions.
 ///
 /// The estimator is unbiased for max_depth == 0: next-event estimation (emitters chosen by power
-/// E*A summed over channels, a uniform point on the polygon) and cosine-weighted bounces,
-/// combined by multiple importance sampling (power heuristic), and Russian roulette after three
-/// reflections. Pixels use counter-based random streams keyed by (seed, pixel), so the image is
-/// bit-identical at any thread count. A scene without emitters renders black.
+/// E*A summed over channels, a uniform point on the polygon) for every non-delta part, combined
+/// with BSDF sampling by multiple importance sampling (power heuristic); delta events (mirror,
+/// refraction, Fresnel reflection) continue the path without a light sample, and an emitter
+/// reached right after one counts in full. Delta surfaces block shadow rays. Light reflected
+/// once by a plain planar mirror (a material with only `specular`, exponent 0, one-sided) is
+/// also sampled through the emitters' mirror images and MIS-weighted against BSDF sampling;
+/// other caustics (through glass, off several mirrors) are found by BSDF sampling alone and
+/// converge more slowly.
+/// Russian roulette after three scattering events, on the throughput with the refraction
+/// scales divided out. Pixels use counter-based random streams keyed by (seed, pixel), so the
+/// image is bit-identical at any thread count. A scene without emitters renders black.
 ///
-/// Cost: two rays per reflection; the 64 x 64 Cornell box at 1024 spp (4 M paths) takes about
-/// 4 s on 2 cores (Release). Noise falls as 1/sqrt(spp): the same image has about 2.5 % relative
-/// RMSE at 1024 spp and 0.25 % at 65536.
+/// Cost: about two rays per scattering event; the 64 x 64 Cornell box at 1024 spp (4 M paths)
+/// takes about 4 s on 2 free cores (Release). Noise falls as 1/sqrt(spp): the same image has
+/// about 2.5 % relative RMSE at 1024 spp and 0.25 % at 65536; the mirror and glass Cornell boxes
+/// (cornell_box_specular()) have about 2.6 % and 6 % at 1024 spp (the glass box's caustics).
 ///
 /// Throws Error{invalid_argument} as validate() does, Error{internal} if Embree fails; an
 /// exception thrown by on_progress propagates after the workers have stopped.

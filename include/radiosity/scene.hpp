@@ -153,5 +153,22 @@ RADIOSITY_API std::vector<PolygonOverlap> find_overlaps(const Scene& scene);
 /// The ceiling has a hole where the light sits, so no two surfaces overlap.
 RADIOSITY_API Scene cornell_box();
 
+/// Which blocks of cornell_box_specular() are specular; the other one stays white.
+enum class CornellSpecular {
+  mirror_and_glass,  ///< tall block a mirror, short block glass
+  mirror,            ///< tall block a mirror, short block white ("the mirror Cornell box")
+  glass,             ///< short block glass, tall block white ("the glass Cornell box")
+};
+
+/// cornell_box() with specular blocks, for the two-pass compositor and its path-traced
+/// references: the tall block an ideal mirror (material "mirror": reflectance 0, specular 0.95,
+/// specular_exponent 0), the short block clear glass (material "glass": reflectance 0,
+/// transmittance 1, ior 1.5). Same geometry, groups, camera and other materials, in the same
+/// order; the specular materials are added after "light". The blocks have no bottom face: they
+/// stand on the floor, which closes the glass block. Also shipped as
+/// examples/scenes/cornell_specular.obj (mirror and glass).
+/// Thread safety: may be called concurrently.
+RADIOSITY_API Scene cornell_box_specular(CornellSpecular blocks = CornellSpecular::mirror_and_glass);
+
 }  // namespace v1
 }  // namespace radiosity
