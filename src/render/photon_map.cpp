@@ -157,14 +157,21 @@ Rgb PhotonMap::irradiance(const glm::vec3& x, const glm::vec3& n, int k, float m
     index = heap_index.data();
     d2 = heap_d2.data();
   }
+  // k nearest within max_radius: nanoflann's k-NN result set prunes against its last slot, so
+  // seeding that slot with max_radius^2 stops the search from visiting farther photons (most
+  // queries land where photons are sparse, and an unbounded k-NN search there is slow).
+  const float r2_max = max_radius * max_radius;
+  nanoflann::KNNResultSet<float, std::uint32_t> result(want);
+  result.init(index, d2);
+  d2[want - 1] = r2_max;
   const float query[3] = {x.x, x.y, x.z};
-  const std::size_t found = tree_->index.knnSearch(query, want, index, d2);
+  tree_->index.findNeighbors(result, query, nanoflann::SearchParams());
+  const std::size_t found = result.size();
   if (found == 0) return Rgb(0.0f);
 
-  // The disc holding the photons: out to the k-th, but never beyond max_radius (then it is a
-  // fixed-radius estimate over the photons inside).
-  const float r2_max = max_radius * max_radius;
-  const float r2 = (found == static_cast<std::size_t>(k) && d2[found - 1] <= r2_max) ? d2[found - 1] : r2_max;
+  // The disc holding the photons: out to the k-th, or max_radius when fewer lie within it (then
+  // it is a fixed-radius estimate over the photons inside).
+  const float r2 = found == static_cast<std::size_t>(k) ? d2[found - 1] : r2_max;
   if (!(r2 > 0.0f)) return Rgb(0.0f);
   Rgb sum(0.0f);
   for (std::size_t i = 0; i < found; ++i) {

@@ -174,18 +174,25 @@ class TwoPassRenderer {
     return h.b0 * values[h.triangle[0]] + h.b1 * values[h.triangle[1]] + h.b2 * values[h.triangle[2]];
   }
 
-  Rgb caustic_radiance(const SurfaceHit& h) const {
-    if (!caustics_ || max_channel(h.surface->diffuse) <= 0.0f) return Rgb(0.0f);
+  /// Diffuse reflection of the photon map's irradiance at `h`, times `weight` (0 skips the
+  /// lookup: only some camera rays of a pixel look photons up; see Strata::caustic_weight).
+  Rgb caustic_radiance(const SurfaceHit& h, float weight) const {
+    if (!caustics_ || weight == 0.0f || max_channel(h.surface->diffuse) <= 0.0f) return Rgb(0.0f);
     const PhotonOptions& c = options_.caustics;
-    return h.surface->diffuse * kInvPi * photon_map_.irradiance(h.x, h.surface->normal, c.nearest, max_radius_, c.filter);
+    return h.surface->diffuse * (weight * kInvPi) *
+           photon_map_.irradiance(h.x, h.surface->normal, c.nearest, max_radius_, c.filter);
   }
 
   /// Stratification of the first scattering event of a pixel's camera rays: sample `index` of
   /// `count` gets the stratum index/count of [0,1) in its first dimension, rotated by `shift`.
+  /// `caustic_weight` is count / lookups for the camera rays that look photons up and 0 for the
+  /// others: a k-NN search costs more than the rest of a ray, and the estimate is smooth over a
+  /// pixel, so a few lookups per pixel, reweighted, give the same expected value.
   struct Strata {
     int index = 0;
     int count = 1;
     float shift = 0.0f;
+    float caustic_weight = 1.0f;
   };
 
   /// Scatters a ray that arrived along `dir` at `h` through the surface's specular part: `samples`
@@ -207,27 +214,27 @@ class TwoPassRenderer {
       if (!(max_channel(throughput) > 0.0f)) continue;
       const glm::vec3 wi = glm::normalize(frame.to_world(sample->wi));
       const glm::vec3 origin = h.x + scene_.epsilon() * (glm::dot(wi, s.normal) > 0.0f ? s.normal : -s.normal);
-      trace_specular(origin, wi, throughput, depth + 1, rng, out);
+      trace_specular(origin, wi, throughput, depth + 1, strata.caustic_weight, rng, out);
     }
   }
 
   /// Light reached after `depth` >= 1 specular events with throughput beta: pass 1's radiosity
   /// (emission included) and the caustic term where the ray lands, then its specular part.
-  void trace_specular(const glm::vec3& origin, const glm::vec3& dir, const Rgb& beta, int depth, detail::Rng& rng,
-                      Radiance& out) const {
+  void trace_specular(const glm::vec3& origin, const glm::vec3& dir, const Rgb& beta, int depth, float caustic_weight,
+                      detail::Rng& rng, Radiance& out) const {
     SurfaceHit h;
     if (!intersect(origin, dir, h)) return;
     const detail::SplitSurface& s = *h.surface;
     if (h.front) {
       if (s.uses_pass1) {
         out.layer[kSpecular] += beta * interpolate(vertex_B_, h) * kInvPi;
-        out.layer[kCaustic] += beta * caustic_radiance(h);
+        out.layer[kCaustic] += beta * caustic_radiance(h, caustic_weight);
       } else {
         out.layer[kSpecular] += beta * s.emission * kInvPi;
       }
     }
     if (!s.specular || depth >= options_.max_specular_depth) return;
-    scatter(h, dir, beta, depth, 1, Strata{0, 1, 0.0f}, rng, out);
+    scatter(h, dir, beta, depth, 1, Strata{0, 1, 0.0f, caustic_weight}, rng, out);
   }
 
   /// One camera ray: its four layers.
@@ -250,7 +257,7 @@ class TwoPassRenderer {
         }
         if (options_.content != TwoPassContent::direct_only)
           out.layer[kIndirect] = (interpolate(vertex_B_, h) - direct_part) * kInvPi;
-        out.layer[kCaustic] = caustic_radiance(h);
+        out.layer[kCaustic] = caustic_radiance(h, strata.caustic_weight);
       } else {
         out.layer[kDirect] = s.emission * kInvPi;
       }
@@ -268,10 +275,15 @@ class TwoPassRenderer {
     const std::uint64_t index = static_cast<std::uint64_t>(y) * options_.width + x;
     detail::Rng rng(options_.seed, index, 0x7e11);
     detail::Rng path_rng(options_.seed, index, 0x2a55'0001ull);
-    Strata strata{0, g_ * g_, path_rng.uniform()};
+    const int count = g_ * g_;
+    const int lookups = std::min(count, options_.caustics.lookups_per_pixel);
+    Strata strata{0, count, path_rng.uniform(), 0.0f};
     Radiance sum;
     for (int i = 0; i < g_; ++i)
       for (int j = 0; j < g_; ++j) {
+        // Exactly `lookups` of the count rays, spread evenly over the pixel's strata.
+        const bool lookup = (strata.index + 1) * lookups / count > strata.index * lookups / count;
+        strata.caustic_weight = lookup ? static_cast<float>(count) / static_cast<float>(lookups) : 0.0f;
         const glm::vec2 u = rng.uniform2();
         const float sx = (static_cast<float>(x) + (static_cast<float>(i) + u.x) / g_) / options_.width;
         const float sy = (static_cast<float>(y) + (static_cast<float>(j) + u.y) / g_) / options_.height;
@@ -310,6 +322,8 @@ void validate(const TwoPassOptions& options) {
   const PhotonOptions& c = options.caustics;
   if (c.max_bounces < 1) bad_option("caustics.max_bounces must be >= 1, got " + std::to_string(c.max_bounces));
   if (c.nearest < 1) bad_option("caustics.nearest must be >= 1, got " + std::to_string(c.nearest));
+  if (c.lookups_per_pixel < 1)
+    bad_option("caustics.lookups_per_pixel must be >= 1, got " + std::to_string(c.lookups_per_pixel));
   if (!std::isfinite(c.max_radius) || c.max_radius < 0.0f)
     bad_option("caustics.max_radius must be finite and >= 0, got " + std::to_string(c.max_radius));
   if (options.camera) {
