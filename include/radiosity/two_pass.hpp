@@ -54,7 +54,7 @@ struct PhotonOptions {
   /// Camera rays per pixel that look the photon map up, >= 1 (capped at the rays per pixel);
   /// their caustic term is weighted by rays / lookups. A lookup (a k-NN search) costs more than
   /// the rest of a ray, and the estimate varies little within a pixel.
-  int lookups_per_pixel = 4;
+  int lookups_per_pixel = 2;
   /// Set this when pass 1 already carries light that reached a diffuse surface through exactly
   /// one specular event (mirror and window form factors of the extended first pass): photons
   /// are then stored only after two or more specular events, so nothing is counted twice.
