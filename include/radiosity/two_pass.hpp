@@ -40,6 +40,7 @@ enum class PhotonFilter {
 };
 
 /// The caustic photon map (Jensen 1996). Every field has a default.
+/// Thread safety: a plain value.
 struct PhotonOptions {
   /// Photons emitted from the emitters (chosen by power), >= 0; 0 turns caustics off. Only the
   /// photons whose first hit is specular cost more than one ray.
@@ -63,6 +64,7 @@ struct PhotonOptions {
 };
 
 /// How render_two_pass() samples the image. Every field has a default.
+/// Thread safety: a plain value; render_two_pass() only reads it.
 struct TwoPassOptions {
   int width = 512;   ///< pixels, > 0
   int height = 512;  ///< pixels, > 0
@@ -83,8 +85,8 @@ struct TwoPassOptions {
   /// Directions sampled from a glossy lobe where a camera ray first meets it, >= 1 (one at
   /// later events). Each reads pass 1's radiosity where it lands (Wallace et al. 1987).
   int glossy_samples = 4;
-  /// Shadow-ray samples per leaf element for splitting pass 1 into its direct and indirect
-  /// parts, >= 1.
+  /// Shadow rays per leaf element (on a stratified grid, rounded up to a square) for splitting
+  /// pass 1 into its direct and indirect parts, >= 1.
   int direct_samples = 64;
   PhotonOptions caustics;
   /// Called on the calling thread after each band of rows (Phase::rendering, fraction = rows
@@ -92,7 +94,7 @@ struct TwoPassOptions {
   ProgressFn on_progress;
 };
 
-/// Times and counts of one render_two_pass() call.
+/// Times and counts of one render_two_pass() call. Thread safety: a plain value.
 struct TwoPassReport {
   std::size_t photons_emitted = 0;
   std::size_t photons_stored = 0;
@@ -127,7 +129,9 @@ RADIOSITY_API void validate(const TwoPassOptions& options);
 ///   surface the camera reaches, directly or through specular chains.
 /// The four layers sum to the RGB image (up to float rounding). With no specular material and
 /// DiffuseShading::pass1, the image equals render() with the same size, spp, camera, seed and
-/// ambient setting.
+/// ambient setting. A material with its own Material::brdf cannot be split into a diffuse and a
+/// specular part: pass 2 samples all of it. The approximations (pass 1 carries no diffuse ->
+/// specular -> diffuse light, glass is opaque to pass 1, ...) are listed in docs/TWO_PASS.md.
 ///
 /// Throws Error{invalid_argument} as validate() does or when `pass1` was not solved from
 /// `scene`, Error{internal} if Embree fails; an exception thrown by on_progress propagates.
