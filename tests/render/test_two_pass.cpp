@@ -277,6 +277,28 @@ TEST_SUITE("two_pass") {
     MESSAGE("floor flux / lamp power = " << on_floor.x / P.x << ", expected " << expected);
   }
 
+  TEST_CASE("with pass 1 carrying single specular bounces only photons with two or more are stored") {
+    // The mirror room: the only specular surface is the planar floor, so every caustic photon
+    // has exactly one specular event (a photon cannot meet a plane twice).
+    const rad::Scene scene = mirror_room(true, 0.8f, 0.0f);
+    const rad::PatchHierarchy hierarchy(scene, rad::MeshOptions{1.0f, 1.0f});
+    const rad::detail::SpecularScene specular(scene, hierarchy);
+    rad::PhotonOptions po;
+    po.photons = 20000;
+    const auto all = rad::detail::shoot_caustic_photons(specular, po, 0, 3);
+    REQUIRE(!all.photons.empty());
+    rad::Rgb stored(0.0f);
+    for (const auto& p : all.photons) {
+      CHECK(p.specular_bounces == 1);
+      stored += p.power;
+    }
+    // The mirror passes on at most r of what reaches it, and not all the lamp's light does.
+    CHECK(stored.x < 0.8f * all.emitted_power.x);
+    po.pass1_carries_single_specular = true;
+    const auto rest = rad::detail::shoot_caustic_photons(specular, po, 0, 3);
+    CHECK(rest.photons.empty());
+  }
+
   TEST_CASE("the photon density estimate of a uniformly lit plane recovers its irradiance") {
     // Photons uniform on the unit square of the plane z = 0, total power E x area.
     const rad::Rgb E(2.0f, 3.0f, 4.0f);
