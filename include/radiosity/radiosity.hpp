@@ -12,4 +12,5 @@
 #include "radiosity/render.hpp"
 #include "radiosity/scene.hpp"
 #include "radiosity/solver.hpp"
+#include "radiosity/two_pass.hpp"
 #include "radiosity/version.hpp"
