@@ -11,39 +11,16 @@
 
 #include <radiosity/radiosity.hpp>
 
-namespace {
-
-/// The built-in Cornell box with the tall block made a mirror and the short block clear glass.
-radiosity::Scene cornell_specular() {
-  const radiosity::Scene base = radiosity::cornell_box();
-  radiosity::Scene scene;
-  std::vector<radiosity::MaterialId> ids;
-  for (const radiosity::Material& m : base.materials()) ids.push_back(scene.add_material(m));
-  radiosity::Material mirror, glass;
-  mirror.name = "mirror";
-  mirror.reflectance = radiosity::Rgb(0.0f);  // no diffuse part: pass 1 sees it black
-  mirror.specular = radiosity::Rgb(0.9f);     // specular_exponent 0 = ideal mirror
-  glass.name = "glass";
-  glass.reflectance = radiosity::Rgb(0.0f);
-  glass.transmittance = radiosity::Rgb(1.0f);
-  glass.ior = 1.5f;
-  const radiosity::MaterialId mirror_id = scene.add_material(mirror), glass_id = scene.add_material(glass);
-  for (const radiosity::Polygon& p : base.polygons()) {
-    const std::string& group = base.groups()[p.group];
-    scene.add_polygon(p.vertices, group == "tall_block" ? mirror_id : group == "short_block" ? glass_id : ids[p.material],
-                      group);
-  }
-  scene.set_camera(base.camera());
-  return scene;
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
   const std::filesystem::path folder = argc > 1 ? argv[1] : ".";
   std::filesystem::create_directories(folder);
-  const radiosity::Scene scene = cornell_specular();
-  const radiosity::Solution pass1 = radiosity::solve(scene);  // the diffuse first pass
+  const radiosity::Scene scene = radiosity::cornell_box_specular();
+  // Pass 1, extended as in Wallace, Cohen & Greenberg: radiosity with mirror form factors (one
+  // specular bounce between diffuse surfaces), from the Monte Carlo estimator that traces them.
+  radiosity::SolveOptions so;
+  so.form_factors.method = radiosity::FormFactorMethod::monte_carlo;
+  so.form_factors.specular_depth = 1;
+  const radiosity::Solution pass1 = radiosity::solve(scene, so);
 
   const struct {
     radiosity::TwoPassContent content;

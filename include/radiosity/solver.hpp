@@ -67,6 +67,10 @@ struct SolveReport {
   std::size_t refined_elements = 0;      ///< leaves split by adaptive subdivision
   int refinement_passes = 0;
   std::size_t form_factor_bytes = 0;     ///< memory held by form factors at the peak
+  /// FormFactorOptions::specular_depth of the factors: how many mirror reflections and window
+  /// passages the solution carries between diffuse surfaces (0: classic radiosity). The
+  /// two-pass compositor reads it so that its photon map leaves those paths out.
+  std::uint32_t specular_depth = 0;
   Rgb emitted_power{0.0f};               ///< sum A E, W per channel
   Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance
   double seconds_meshing = 0.0;

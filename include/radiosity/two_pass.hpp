@@ -56,11 +56,6 @@ struct PhotonOptions {
   /// their caustic term is weighted by rays / lookups. A lookup (a k-NN search) costs more than
   /// the rest of a ray, and the estimate varies little within a pixel.
   int lookups_per_pixel = 2;
-  /// Set this when pass 1 already carries light that reached a diffuse surface through exactly
-  /// one specular event (mirror and window form factors of the extended first pass): photons
-  /// are then stored only after two or more specular events, so nothing is counted twice.
-  /// The ordinary solve() carries no specular paths, so the default is false.
-  bool pass1_carries_single_specular = false;
 };
 
 /// How render_two_pass() samples the image. Every field has a default.

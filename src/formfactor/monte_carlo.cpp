@@ -45,6 +45,7 @@
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
 #include "geometry/ray_scene.hpp"
+#include "scene/specular_transport.hpp"
 
 namespace radiosity::detail {
 
@@ -133,9 +134,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     specular_.resize(polygons.size());
     for (std::size_t p = 0; p < polygons.size(); ++p) {
       const Material& m = scene.material(polygons[p].material);
-      auto mean = [](const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; };
-      if (m.specular_exponent <= 0.0f) specular_[p].mirror = mean(m.specular);
-      if (m.ior == 1.0f) specular_[p].window = mean(m.transmittance);
+      specular_[p].mirror = pass1_mirror(m);
+      specular_[p].window = pass1_window(m);
     }
     exact_.assign(patches.size(), 0);
     emitter_of_.assign(patches.size(), kNone);

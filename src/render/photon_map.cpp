@@ -43,8 +43,8 @@ glm::vec3 cosine_direction(const glm::vec3& n, const glm::vec2& u) {
 }
 
 /// Traces photon `index` and appends its landings to `out`.
-void trace_photon(const SpecularScene& scene, const PhotonOptions& options, std::uint64_t seed, std::size_t index,
-                  std::vector<Photon>& out) {
+void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth, std::uint64_t seed,
+                  std::size_t index, std::vector<Photon>& out) {
   Rng rng(seed, index, 0xca05'7100ull);
   const float u_emitter = rng.uniform();
   const glm::vec2 u_point = rng.uniform2();
@@ -55,6 +55,9 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, std:
   glm::vec3 dir = cosine_direction(y.normal, rng.uniform2());
   glm::vec3 origin = y.position + scene.epsilon() * y.normal;
   const RayScene& rays = scene.rays();
+  // Whether every specular event so far is one that pass 1 carries (mirror reflection, window
+  // passage); with at most `pass1_depth` of them, pass 1 already has this landing.
+  bool pass1_kind = true;
   for (int specular = 0;;) {
     const auto hit = rays.intersect(origin, dir, 0.0f, std::numeric_limits<float>::infinity());
     if (!hit) return;
@@ -64,9 +67,8 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, std:
     x -= s.normal * glm::dot(x - s.origin, s.normal);
     const bool front = glm::dot(s.normal, dir) < 0.0f;
 
-    // An L S+ D landing: the caustic map's business (pass 1 has no specular paths), unless pass 1
-    // already carries the single-bounce ones.
-    const bool counted_by_pass1 = options.pass1_carries_single_specular && specular == 1;
+    // An L S+ D landing: the caustic map's business, unless the extended pass 1 carries it.
+    const bool counted_by_pass1 = pass1_kind && specular <= pass1_depth;
     if (specular >= 1 && front && s.uses_pass1 && max_channel(s.diffuse) > 0.0f && !counted_by_pass1)
       out.push_back(Photon{x, s.normal, power, polygon, static_cast<std::uint16_t>(specular)});
 
@@ -80,6 +82,8 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, std:
     const float q = std::min(1.0f, max_channel(sample->weight));
     if (!(q > 0.0f) || !(rng.uniform() < q)) return;
     power *= sample->weight / q;
+    const bool reflected = sample->wi.z > 0.0f;
+    pass1_kind = pass1_kind && sample->delta && (reflected ? s.pass1_mirror : s.pass1_window);
     dir = glm::normalize(frame.to_world(sample->wi));
     origin = x + scene.epsilon() * (glm::dot(dir, s.normal) > 0.0f ? s.normal : -s.normal);
     ++specular;
@@ -88,8 +92,8 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, std:
 
 }  // namespace
 
-PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, unsigned threads,
-                                  std::uint64_t seed) {
+PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth,
+                                  unsigned threads, std::uint64_t seed) {
   PhotonShoot result;
   result.emitted_power = scene.emitted_power();
   if (options.photons == 0 || !scene.has_emitters() || !scene.has_specular()) return result;
@@ -99,7 +103,7 @@ PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOption
   parallel_for(threads, blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const std::size_t last = std::min(options.photons, (b + 1) * kPhotonBlock);
-      for (std::size_t k = b * kPhotonBlock; k < last; ++k) trace_photon(scene, options, seed, k, stored[b]);
+      for (std::size_t k = b * kPhotonBlock; k < last; ++k) trace_photon(scene, options, pass1_depth, seed, k, stored[b]);
     }
   });
   std::size_t total = 0;

@@ -35,11 +35,12 @@ struct PhotonShoot {
 /// and keeps those that reach a front-facing surface with a diffuse part after at least one
 /// specular event: every such landing is stored, and the photon goes on along the surface's
 /// specular part (Russian roulette by the event's weight) until `options.max_bounces` specular
-/// events. With `options.pass1_carries_single_specular`, landings after exactly one specular
-/// event are not stored (pass 1 already has them). Photon k uses the stream (seed, k), so the
-/// result does not depend on `threads`.
-PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, unsigned threads,
-                                  std::uint64_t seed);
+/// events. Landings that the extended pass 1 already carries are not stored: those reached
+/// through at most `pass1_depth` (SolveReport::specular_depth) specular events, all of them
+/// mirror reflections or window passages (scene/specular_transport.hpp). Photon k uses the
+/// stream (seed, k), so the result does not depend on `threads`.
+PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth,
+                                  unsigned threads, std::uint64_t seed);
 
 /// A kd-tree over photons (nanoflann) and the density estimate of their irradiance.
 /// Thread safety: immutable after construction; irradiance() may be called concurrently.

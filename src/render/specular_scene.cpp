@@ -16,6 +16,8 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include "scene/specular_transport.hpp"
+
 namespace radiosity::detail {
 
 namespace {
@@ -69,6 +71,8 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
     s.specular = specular[poly.material];
     s.specular_is_delta = s.specular && s.specular->is_delta();
     s.two_sided = m.two_sided;
+    s.pass1_mirror = pass1_mirror(m) > 0.0f;
+    s.pass1_window = pass1_window(m) > 0.0f;
     if (s.specular) has_specular_ = true;
 
     const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;

@@ -33,6 +33,9 @@ struct SplitSurface {
   bool specular_is_delta = false;  ///< specular->is_delta()
   bool two_sided = false;
   bool uses_pass1 = true;  ///< false for a material with its own Brdf
+  /// What the extended first pass (FormFactorOptions::specular_depth > 0) carries through this
+  /// surface: ideal-mirror reflection and straight window passage (scene/specular_transport.hpp).
+  bool pass1_mirror = false, pass1_window = false;
 };
 
 /// A uniform point on an emitter and the density with which it was chosen.

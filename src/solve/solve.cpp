@@ -65,6 +65,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   report.seconds_meshing = seconds_since(t0);
   report.patch_count = hierarchy.patches().size();
   report.element_count = hierarchy.leaves().size();
+  report.specular_depth = o.form_factors.specular_depth;
   if (o.max_iterations == 0)
     o.max_iterations = o.method == SolverMethod::progressive ? static_cast<int>(100 * report.patch_count) : 1000;
 

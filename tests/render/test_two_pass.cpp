@@ -100,7 +100,7 @@ TEST_SUITE("two_pass") {
   }
 
   TEST_CASE("the four layers are non-negative and sum to the image of the specular Cornell box") {
-    const rad::Scene scene = test::cornell_specular();
+    const rad::Scene scene = rad::cornell_box_specular();
     const rad::Solution sol = coarse_solve(scene, 20000.0f);
     rad::TwoPassOptions to;
     to.width = 32;
@@ -253,7 +253,7 @@ TEST_SUITE("two_pass") {
     rad::PhotonOptions po;
     po.photons = 100000;
     po.max_bounces = 12;
-    const auto shot = rad::detail::shoot_caustic_photons(specular, po, 0, 3);
+    const auto shot = rad::detail::shoot_caustic_photons(specular, po, 0, 0, 3);
     const rad::GroupId floor_group = *scene.find_group("floor");
     rad::Rgb on_floor(0.0f), stored(0.0f);
     for (const auto& p : shot.photons) {
@@ -277,7 +277,7 @@ TEST_SUITE("two_pass") {
     MESSAGE("floor flux / lamp power = " << on_floor.x / P.x << ", expected " << expected);
   }
 
-  TEST_CASE("with pass 1 carrying single specular bounces only photons with two or more are stored") {
+  TEST_CASE("photons that the extended pass 1 carries through the mirror are not stored again") {
     // The mirror room: the only specular surface is the planar floor, so every caustic photon
     // has exactly one specular event (a photon cannot meet a plane twice).
     const rad::Scene scene = mirror_room(true, 0.8f, 0.0f);
@@ -285,7 +285,7 @@ TEST_SUITE("two_pass") {
     const rad::detail::SpecularScene specular(scene, hierarchy);
     rad::PhotonOptions po;
     po.photons = 20000;
-    const auto all = rad::detail::shoot_caustic_photons(specular, po, 0, 3);
+    const auto all = rad::detail::shoot_caustic_photons(specular, po, 0, 0, 3);
     REQUIRE(!all.photons.empty());
     rad::Rgb stored(0.0f);
     for (const auto& p : all.photons) {
@@ -294,8 +294,8 @@ TEST_SUITE("two_pass") {
     }
     // The mirror passes on at most r of what reaches it, and not all the lamp's light does.
     CHECK(stored.x < 0.8f * all.emitted_power.x);
-    po.pass1_carries_single_specular = true;
-    const auto rest = rad::detail::shoot_caustic_photons(specular, po, 0, 3);
+    // Pass 1 with specular_depth 1 carries light reflected once by the mirror.
+    const auto rest = rad::detail::shoot_caustic_photons(specular, po, 1, 0, 3);
     CHECK(rest.photons.empty());
   }
 
@@ -338,7 +338,7 @@ TEST_SUITE("two_pass") {
   }
 
   TEST_CASE("the two-pass image with caustics is identical at 1 and 2 threads") {
-    const rad::Scene scene = test::cornell_specular();
+    const rad::Scene scene = rad::cornell_box_specular();
     const rad::Solution sol = coarse_solve(scene, 20000.0f);
     rad::TwoPassOptions to;
     to.width = 24;

@@ -1,0 +1,22 @@
+// Which specular events the extended first pass carries (FormFactorOptions::specular_depth):
+// one rule shared by the Monte Carlo form factors, which carry them, and the photon map of the
+// second pass, which must then leave them out so that nothing is counted twice.
+#pragma once
+
+#include "radiosity/scene.hpp"
+
+namespace radiosity::detail {
+
+inline float channel_mean(const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; }
+
+/// The mean reflectance with which pass 1 reflects off `m` as an ideal mirror, or 0: the
+/// material's specular part when it is ideal (specular_exponent 0). Glossy lobes are not
+/// carried.
+inline float pass1_mirror(const Material& m) { return m.specular_exponent <= 0.0f ? channel_mean(m.specular) : 0.0f; }
+
+/// The mean transmittance with which pass 1 passes straight through `m` as a window, or 0:
+/// transmitting materials with ior 1 (thin panes, no refraction). Refracting glass is left to
+/// the second pass.
+inline float pass1_window(const Material& m) { return m.ior == 1.0f ? channel_mean(m.transmittance) : 0.0f; }
+
+}  // namespace radiosity::detail

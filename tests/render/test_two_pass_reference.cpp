@@ -1,0 +1,81 @@
+// Issue #6 accuracy: the two-pass image of the specular Cornell boxes against their path-traced
+// references (tests/data/cornell_{mirror,glass}_path_64.exr, see tests/data/README.md), 64 x 64,
+// published camera. Pass 1 is extended radiosity (Monte Carlo form factors with one mirror
+// bounce); pass 2 traces the specular chains and adds the caustic photon map.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include <radiosity/radiosity.hpp>
+
+namespace rad = radiosity;
+
+namespace {
+
+/// Relative RMSE as issue #4 uses it: sqrt(mean over pixels and channels of (R - P)^2) divided
+/// by the mean of P.
+double relative_rmse(const rad::Image& r, const rad::Image& p) {
+  double se = 0.0, sum = 0.0;
+  for (std::size_t i = 0; i < p.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double d = static_cast<double>(r.pixels[i][c]) - p.pixels[i][c];
+      se += d * d;
+      sum += p.pixels[i][c];
+    }
+  const double n = 3.0 * static_cast<double>(p.pixels.size());
+  return std::sqrt(se / n) / (sum / n);
+}
+
+double mean_ratio(const rad::Image& r, const rad::Image& p) {
+  double a = 0.0, b = 0.0;
+  for (std::size_t i = 0; i < p.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      a += r.pixels[i][c];
+      b += p.pixels[i][c];
+    }
+  return a / b;
+}
+
+rad::Image two_pass_64(rad::CornellSpecular variant, rad::Solution& pass1_out) {
+  const rad::Scene scene = rad::cornell_box_specular(variant);
+  rad::SolveOptions so;
+  so.form_factors.method = rad::FormFactorMethod::monte_carlo;
+  so.form_factors.specular_depth = 1;
+  so.mesh.max_patch_area = 20000.0f;  // mm^2, as the diffuse Cornell box test
+  so.mesh.max_element_area = 625.0f;
+  so.tolerance = 1e-4;
+  pass1_out = rad::solve(scene, so);
+  rad::TwoPassOptions to;
+  to.width = to.height = 64;
+  to.spp = 256;
+  if (const char* e = std::getenv("TP_PHOTONS")) to.caustics.photons = std::strtoul(e, nullptr, 10);
+  if (const char* e = std::getenv("TP_NEAREST")) to.caustics.nearest = std::atoi(e);
+  if (const char* e = std::getenv("TP_LOOKUPS")) to.caustics.lookups_per_pixel = std::atoi(e);
+  return rad::render_two_pass(scene, pass1_out, to);
+}
+
+}  // namespace
+
+TEST_SUITE("two_pass") {
+  TEST_CASE("two-pass mirror Cornell box within 8% relative RMSE of its path-traced reference") {
+    const rad::Image P = rad::read_exr(RADIOSITY_TEST_DATA "/cornell_mirror_path_64.exr");
+    rad::Solution pass1;
+    const rad::Image R = two_pass_64(rad::CornellSpecular::mirror, pass1);
+    const double rmse = relative_rmse(R, P), ratio = mean_ratio(R, P);
+    MESSAGE("mirror Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
+    CHECK(rmse < 0.08);
+    CHECK(std::fabs(ratio - 1.0) < 0.03);
+  }
+
+  TEST_CASE("two-pass glass Cornell box within 12% relative RMSE of its path-traced reference") {
+    const rad::Image P = rad::read_exr(RADIOSITY_TEST_DATA "/cornell_glass_path_64.exr");
+    rad::Solution pass1;
+    const rad::Image R = two_pass_64(rad::CornellSpecular::glass, pass1);
+    const double rmse = relative_rmse(R, P), ratio = mean_ratio(R, P);
+    MESSAGE("glass Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
+    CHECK(rmse < 0.12);
+    CHECK(std::fabs(ratio - 1.0) < 0.05);
+  }
+}
