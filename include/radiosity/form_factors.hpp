@@ -61,12 +61,14 @@ struct FormFactorOptions {
   /// elements), in [16, 1 << 20]; 0 = 1024.
   std::uint32_t hemisphere_rays = 0;
   /// Monte Carlo only: extended form factors (Wallace, Cohen & Greenberg 1987) carry light
-  /// between diffuse surfaces through up to this many specular events: reflections in ideal
-  /// mirrors (Material::specular with specular_exponent 0, weighted by the specular reflectance
-  /// averaged over channels) and passages through windows (Material::transmittance with ior 1,
-  /// straight on, weighted by the mean transmittance). 0 = classic radiosity: specular parts are
-  /// ignored and every polygon is opaque. Refracting glass (ior != 1) and glossy lobes stay
-  /// opaque here; the second pass (and its photon map) carries them. In [0, 16].
+  /// between diffuse surfaces through ideal mirrors (Material::specular with specular_exponent
+  /// 0; at most this many reflections on a path, weighted by the mean specular reflectance) and
+  /// through transmitting polygons, straight on: windows (ior 1, weighted by the mean
+  /// transmittance) and refracting glass (ior != 1, also weighted by the Fresnel transmission of
+  /// each interface; only light that left a non-emitting surface, since the second pass's photon
+  /// map carries emitted light through glass as sharp caustics). 0 = classic radiosity:
+  /// specular parts are ignored and every polygon is opaque. Glossy lobes are not carried. In
+  /// [0, 16].
   std::uint32_t specular_depth = 0;
   /// Seeds every random stream (ray-cast samples, hemicube orientations).
   std::uint64_t seed = 1;

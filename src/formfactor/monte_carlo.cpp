@@ -42,6 +42,7 @@
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
 #include "formfactor/estimators.hpp"
+#include "radiosity/brdf.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
 #include "geometry/ray_scene.hpp"
@@ -136,6 +137,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       const Material& m = scene.material(polygons[p].material);
       specular_[p].mirror = pass1_mirror(m);
       specular_[p].window = pass1_window(m);
+      specular_[p].glass = pass1_glass(m);
+      specular_[p].ior = m.ior;
     }
     exact_.assign(patches.size(), 0);
     emitter_of_.assign(patches.size(), kNone);
@@ -208,9 +211,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         const Element& el = hierarchy_.element(e);
         const Patch& source = hierarchy_.patches()[el.patch];
         Rng rng(options_.seed, e, 0x300000000ull);
-        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, std::uint32_t events) {
-          // Emitting patches reached directly are in the exact part.
-          if (events > 0 || !exact_[j]) counter.add(j, w);
+        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
+          // Emitting patches reached directly are in the exact part, through glass in the photon map.
+          if (!exact_[j] || path == Path::specular) counter.add(j, w);
         });
         index.clear();
         value.clear();
@@ -244,7 +247,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       return;
     }
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
-    shot_column(patch, elements, positions(elements), *rays, options_.threads, 0, out);
+    shot_column(patch, elements, positions(elements), *rays, options_.threads, false, out);
   }
 
   void sparse_patch_columns(const std::vector<std::uint32_t>& patches, const std::vector<std::uint32_t>& elements,
@@ -263,7 +266,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::vector<std::uint32_t> position = positions(elements);
     parallel_for(options_.threads, shot.size(), 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i)
-        shot_column(patches[shot[i]], elements, position, *rays, 1, 0, out[shot[i]]);
+        shot_column(patches[shot[i]], elements, position, *rays, 1, false, out[shot[i]]);
     });
   }
 
@@ -336,7 +339,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       // What the patch sends through mirrors and windows is shot like any other patch's.
       SparseFactors extra;
       const std::shared_ptr<const LeafRays> rays = leaf_scene();
-      shot_column(patch, elements, positions(elements), *rays, options_.threads, 1, extra);
+      shot_column(patch, elements, positions(elements), *rays, options_.threads, true, extra);
       for (std::size_t i = 0; i < extra.index.size(); ++i) out[extra.index[i]] += extra.value[i];
     }
   }
@@ -397,11 +400,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   /// The column of a non-emitting patch, shot from it: as many rays as its elements would shoot
   /// for their rows, in chunks with their own random streams (on up to `threads` threads); the
   /// counts are integers, so the result does not depend on the thread count.
-  /// `min_events`: arrivals with fewer specular events are left out (1 for an emitting patch,
-  /// whose direct factors are computed exactly).
+  /// `emitter`: only arrivals through mirrors and windows count (an emitting patch's direct
+  /// factors are computed exactly, its light through glass is the photon map's).
   void shot_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                    const std::vector<std::uint32_t>& position, const LeafRays& rays, unsigned threads,
-                   std::uint32_t min_events, SparseFactors& out) const {
+                   bool emitter, SparseFactors& out) const {
     out.index.clear();
     out.value.clear();
     const Patch& source = hierarchy_.patches()[patch];
@@ -415,8 +418,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       for (std::size_t c = begin; c < end; ++c) {
         const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
         Rng rng(options_.seed, patch, 0x400000000ull + c);
-        shoot(rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t, float w, std::uint32_t events) {
-          if (position[leaf] != kNone && events >= min_events) hits[c].emplace_back(position[leaf], w);
+        shoot(rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t, float w, Path path) {
+          if (position[leaf] != kNone && (!emitter || path == Path::specular)) hits[c].emplace_back(position[leaf], w);
         });
       }
     });
@@ -429,6 +432,10 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     });
   }
 
+  /// How a ray reached the surface it reports: straight, through mirrors and windows only, or
+  /// through refracting glass (and maybe mirrors and windows too).
+  enum class Path : std::uint8_t { direct, specular, glass };
+
   /// Per-thread sample buffers.
   struct Scratch {
     explicit Scratch(std::uint32_t n) : points(n), directions(n), origin(n), dir(n), hits(n), found(n) {}
@@ -439,14 +446,15 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   };
 
   /// Casts `count` cosine-distributed rays from stratified points of element `from` (of patch
-  /// `source`) and calls hit(leaf, patch, weight, events) for each diffuse arrival: a ray that
-  /// hits the front of another polygon's element arrives with weight 1 and no specular events.
-  /// With FormFactorOptions::specular_depth > 0 a ray that arrives at an ideal mirror also
-  /// reflects (weight times the mirror's mean specular reflectance) and one that reaches a
-  /// window (a transmitting polygon whose ior is 1) passes straight through either face (times
-  /// its mean transmittance), each such event counted, until the depth is used up: Wallace,
-  /// Cohen & Greenberg's mirror and window form factors, traced instead of built from virtual
-  /// mirror worlds (for planar mirrors the reflected ray is the ray to the virtual image).
+  /// `source`) and calls hit(leaf, patch, weight, path) for each diffuse arrival: a ray that
+  /// hits the front of another polygon's element arrives with weight 1 by Path::direct.
+  /// With FormFactorOptions::specular_depth > 0 (extended form factors) a ray also goes on
+  /// after a surface's diffuse part has counted it: reflected by an ideal mirror (times the
+  /// mirror's mean specular reflectance, at most specular_depth reflections), straight through
+  /// a window (ior 1, times its mean transmittance) or straight through refracting glass (times
+  /// its transmittance and the interface's Fresnel transmission; Path::glass). These are
+  /// Wallace, Cohen & Greenberg's mirror and window form factors, traced instead of built from
+  /// virtual mirror worlds (for a planar mirror the reflected ray is the ray to the virtual image).
   template <typename Hit>
   void shoot(const LeafRays& rays, std::uint32_t from, const Patch& source, std::uint32_t count, Rng& rng,
              Scratch& scratch, const Hit& hit) const {
@@ -482,33 +490,43 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       // hierarchy's structs would be cache misses.)
       if (specular_depth_ == 0) {
         if (glm::dot(w, h->geometric_normal) >= 0.0f || rays.polygon[h->triangle] == source.polygon) continue;
-        hit(h->id, rays.patch[h->triangle], 1.0f, 0u);
+        hit(h->id, rays.patch[h->triangle], 1.0f, Path::direct);
         continue;
       }
       float weight = 1.0f;
-      std::uint32_t events = 0, last = source.polygon;
+      std::uint32_t mirrors = 0, last = source.polygon;
+      Path path = Path::direct;
       for (;;) {
         const std::uint32_t polygon = rays.polygon[h->triangle];
-        const bool front = glm::dot(w, h->geometric_normal) < 0.0f;
+        const glm::vec3 ng = glm::normalize(h->geometric_normal);
+        const float cos_in = glm::dot(w, ng);
+        const bool front = cos_in < 0.0f;
         const SpecularSurface& surface = specular_[polygon];
-        // A ray cannot meet the plane it left (the source's, or the mirror's or window's it just
+        // A ray cannot meet the plane it left (the source's, or the mirror's or pane's it just
         // passed): such a hit is rounding.
         if (polygon == last) break;
-        if (front) hit(h->id, rays.patch[h->triangle], weight, events);
-        if (events >= specular_depth_) break;
+        if (front) hit(h->id, rays.patch[h->triangle], weight, path);
         const glm::vec3 p = x + h->t * w;
-        const glm::vec3 ng = glm::normalize(h->geometric_normal);
-        if (front && surface.mirror > 0.0f) {
-          w = w - 2.0f * glm::dot(w, ng) * ng;
+        if (front && surface.mirror > 0.0f && mirrors < specular_depth_) {
+          w = w - 2.0f * cos_in * ng;
           weight *= surface.mirror;
           x = p + epsilon_ * ng;
+          ++mirrors;
+          if (path == Path::direct) path = Path::specular;
         } else if (surface.window > 0.0f) {
           weight *= surface.window;
           x = p + epsilon_ * w;  // straight on, through either face
+          if (path == Path::direct) path = Path::specular;
+        } else if (surface.glass > 0.0f) {
+          // Straight on with the interface's Fresnel transmission (total internal reflection
+          // ends the ray): the block's displacement of the ray is ignored.
+          weight *= surface.glass * (1.0f - fresnel_dielectric(-cos_in, surface.ior));
+          if (!(weight > 0.0f)) break;
+          x = p + epsilon_ * w;
+          path = Path::glass;
         } else {
           break;  // absorbed (the diffuse part was counted above)
         }
-        ++events;
         last = polygon;
         h = rays.scene.intersect(x, w, 0.0f, kInfinity);
         if (!h) break;
@@ -565,7 +583,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   /// Per polygon, for extended form factors: mean reflectance of an ideal mirror, mean
   /// transmittance of a window (0 = neither).
   struct SpecularSurface {
-    float mirror = 0.0f, window = 0.0f;
+    float mirror = 0.0f, window = 0.0f, glass = 0.0f;
+    float ior = 1.0f;
   };
   std::vector<SpecularSurface> specular_;
   std::uint32_t specular_depth_ = 0;

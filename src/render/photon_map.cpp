@@ -56,8 +56,9 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
   glm::vec3 origin = y.position + scene.epsilon() * y.normal;
   const RayScene& rays = scene.rays();
   // Whether every specular event so far is one that pass 1 carries (mirror reflection, window
-  // passage); with at most `pass1_depth` of them, pass 1 already has this landing.
+  // passage); with at most `pass1_depth` mirror reflections, pass 1 already has this landing.
   bool pass1_kind = true;
+  int mirrors = 0;
   for (int specular = 0;;) {
     const auto hit = rays.intersect(origin, dir, 0.0f, std::numeric_limits<float>::infinity());
     if (!hit) return;
@@ -68,7 +69,7 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
     const bool front = glm::dot(s.normal, dir) < 0.0f;
 
     // An L S+ D landing: the caustic map's business, unless the extended pass 1 carries it.
-    const bool counted_by_pass1 = pass1_kind && specular <= pass1_depth;
+    const bool counted_by_pass1 = pass1_depth > 0 && pass1_kind && mirrors <= pass1_depth;
     if (specular >= 1 && front && s.uses_pass1 && max_channel(s.diffuse) > 0.0f && !counted_by_pass1)
       out.push_back(Photon{x, s.normal, power, polygon, static_cast<std::uint16_t>(specular)});
 
@@ -84,6 +85,7 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
     power *= sample->weight / q;
     const bool reflected = sample->wi.z > 0.0f;
     pass1_kind = pass1_kind && sample->delta && (reflected ? s.pass1_mirror : s.pass1_window);
+    mirrors += reflected ? 1 : 0;
     dir = glm::normalize(frame.to_world(sample->wi));
     origin = x + scene.epsilon() * (glm::dot(dir, s.normal) > 0.0f ? s.normal : -s.normal);
     ++specular;

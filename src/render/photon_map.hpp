@@ -36,8 +36,9 @@ struct PhotonShoot {
 /// specular event: every such landing is stored, and the photon goes on along the surface's
 /// specular part (Russian roulette by the event's weight) until `options.max_bounces` specular
 /// events. Landings that the extended pass 1 already carries are not stored: those reached
-/// through at most `pass1_depth` (SolveReport::specular_depth) specular events, all of them
-/// mirror reflections or window passages (scene/specular_transport.hpp). Photon k uses the
+/// only through mirror reflections (at most `pass1_depth`, SolveReport::specular_depth) and
+/// window passages (scene/specular_transport.hpp); with pass1_depth 0 (classic radiosity) every
+/// landing is stored. Photon k uses the
 /// stream (seed, k), so the result does not depend on `threads`.
 PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth,
                                   unsigned threads, std::uint64_t seed);

@@ -36,6 +36,7 @@ struct SplitSurface {
   /// What the extended first pass (FormFactorOptions::specular_depth > 0) carries through this
   /// surface: ideal-mirror reflection and straight window passage (scene/specular_transport.hpp).
   bool pass1_mirror = false, pass1_window = false;
+  float ior = 1.0f;  ///< index of the back side (Material::ior), for the radiance scale across a refraction
 };
 
 /// A uniform point on an emitter and the density with which it was chosen.

@@ -211,7 +211,16 @@ class TwoPassRenderer {
       if (u.x >= 1.0f) u.x -= 1.0f;
       const auto sample = s.specular->sample(wo, u);
       if (!sample) continue;
-      const Rgb throughput = beta * sample->weight / static_cast<float>(samples);
+      Rgb throughput = beta * sample->weight / static_cast<float>(samples);
+      // A refraction carries radiance from the index of wi's side n_i into wo's side n_o, scaled
+      // by (n_o / n_i)^2 (Veach 1997, ch. 5), which the models leave out (brdf.hpp). It cancels on
+      // a path that enters and leaves glass, but not on one that ends on a diffuse surface inside
+      // it (the floor under a glass block), whose light mostly stays trapped by total internal
+      // reflection. The same rule as the reference path tracer.
+      if (sample->delta && sample->wi.z * wo.z < 0.0f) {
+        const float n_o = wo.z > 0.0f ? 1.0f : s.ior, n_i = sample->wi.z > 0.0f ? 1.0f : s.ior;
+        throughput *= (n_o * n_o) / (n_i * n_i);
+      }
       if (!(max_channel(throughput) > 0.0f)) continue;
       const glm::vec3 wi = glm::normalize(frame.to_world(sample->wi));
       const glm::vec3 origin = h.x + scene_.epsilon() * (glm::dot(wi, s.normal) > 0.0f ? s.normal : -s.normal);

@@ -15,8 +15,12 @@ inline float channel_mean(const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; }
 inline float pass1_mirror(const Material& m) { return m.specular_exponent <= 0.0f ? channel_mean(m.specular) : 0.0f; }
 
 /// The mean transmittance with which pass 1 passes straight through `m` as a window, or 0:
-/// transmitting materials with ior 1 (thin panes, no refraction). Refracting glass is left to
-/// the second pass.
+/// transmitting materials with ior 1 (thin panes, no refraction).
 inline float pass1_window(const Material& m) { return m.ior == 1.0f ? channel_mean(m.transmittance) : 0.0f; }
+
+/// The mean transmittance of refracting glass (ior != 1), or 0. Pass 1 passes straight through
+/// it too (Fresnel-weighted, the bending ignored), but only for light that left a non-emitting
+/// surface: light from emitters through glass is the photon map's (sharp caustics).
+inline float pass1_glass(const Material& m) { return m.ior != 1.0f ? channel_mean(m.transmittance) : 0.0f; }
 
 }  // namespace radiosity::detail

@@ -5,8 +5,6 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include <radiosity/radiosity.hpp>
 
@@ -50,9 +48,6 @@ rad::Image two_pass_64(rad::CornellSpecular variant, rad::Solution& pass1_out) {
   rad::TwoPassOptions to;
   to.width = to.height = 64;
   to.spp = 256;
-  if (const char* e = std::getenv("TP_PHOTONS")) to.caustics.photons = std::strtoul(e, nullptr, 10);
-  if (const char* e = std::getenv("TP_NEAREST")) to.caustics.nearest = std::atoi(e);
-  if (const char* e = std::getenv("TP_LOOKUPS")) to.caustics.lookups_per_pixel = std::atoi(e);
   return rad::render_two_pass(scene, pass1_out, to);
 }
 
@@ -65,6 +60,7 @@ TEST_SUITE("two_pass") {
     const rad::Image R = two_pass_64(rad::CornellSpecular::mirror, pass1);
     const double rmse = relative_rmse(R, P), ratio = mean_ratio(R, P);
     MESSAGE("mirror Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
+    // Measured 4.0 % and 0.993 (pass 1 carries the mirror's light at element resolution).
     CHECK(rmse < 0.08);
     CHECK(std::fabs(ratio - 1.0) < 0.03);
   }
@@ -75,6 +71,8 @@ TEST_SUITE("two_pass") {
     const rad::Image R = two_pass_64(rad::CornellSpecular::glass, pass1);
     const double rmse = relative_rmse(R, P), ratio = mean_ratio(R, P);
     MESSAGE("glass Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
+    // Measured 7.8 % and 0.966: pass 1 passes light through the glass straight (no bending,
+    // no trapping by total internal reflection), the photon map blurs and speckles the caustics.
     CHECK(rmse < 0.12);
     CHECK(std::fabs(ratio - 1.0) < 0.05);
   }
