@@ -43,6 +43,14 @@ int main(int argc, char** argv) {
   int max_depth = 0;
   render->add_option("--max-depth", max_depth, "Path tracer: reflections at most (0 = unlimited, Russian roulette)")
       ->check(CLI::NonNegativeNumber);
+  bool two_pass = false, pass1_only = false, direct_only = false;
+  std::size_t photons = 200000;
+  render->add_flag("--two-pass", two_pass,
+                   "Two-pass compositor: radiosity, then ray-traced mirrors, glass and glossy lobes, and "
+                   "photon-mapped caustics; the EXR gets layers direct, indirect, specular, caustic");
+  render->add_flag("--pass1-only", pass1_only, "Two-pass: diffuse interreflection only, no specular pass");
+  render->add_flag("--direct-only", direct_only, "Two-pass: direct illumination only");
+  render->add_option("--photons", photons, "Two-pass: caustic photons (0 = no caustics)")->capture_default_str();
   add_solve_options(*render, render_args, true);
 
   // solve
@@ -93,6 +101,30 @@ int main(int argc, char** argv) {
         image = rad::render_path_traced(scene, po);
         bar.finish();
         std::printf("path traced: %d samples per pixel\n", po.spp);
+      } else if (two_pass || pass1_only || direct_only) {
+        // Pass 1: radiosity; with the Monte Carlo estimator and --specular-depth it carries mirror
+        // and window form factors (the extended first pass).
+        rad::Solution sol = rad::solve(scene, to_options(render_args, bar));
+        bar.finish();
+        print_summary(sol);
+        rad::TwoPassOptions to;
+        to.width = width;
+        to.height = height;
+        to.spp = spp > 0 ? spp : 16;
+        to.threads = render_args.threads;
+        to.seed = render_args.seed;
+        to.ambient = ambient;
+        to.camera = camera;
+        to.caustics.photons = photons;
+        to.content = direct_only  ? rad::TwoPassContent::direct_only
+                     : pass1_only ? rad::TwoPassContent::pass1_only
+                                  : rad::TwoPassContent::full;
+        to.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+        rad::TwoPassReport report;
+        image = rad::render_two_pass(scene, sol, to, report);
+        bar.finish();
+        std::printf("two-pass: %d samples per pixel, %zu of %zu caustic photons stored\n", to.spp,
+                    report.photons_stored, report.photons_emitted);
       } else {
         rad::Solution sol = rad::solve(scene, to_options(render_args, bar));
         bar.finish();
