@@ -2,7 +2,9 @@
 // form factors plus solve to tolerance 1e-3 with each method on 2 threads. Each configuration
 // runs in its own child process, so its peak memory (getrusage max RSS) is its own.
 //
-// Usage: bench_solvers [patches...]   (default: 4000; the second size is 16000)
+// Usage: bench_solvers [--ray-cast] [--rays N] [--only METHOD] [patches...]
+//          (default: 4000 with the monte_carlo estimator at 1024 rays; the second size is 16000)
+//        bench_solvers --compare PATCHES   (accuracy of monte_carlo against ray_cast on one mesh)
 // Prints one line per configuration: patches, elements, method, seconds (form factors, solve),
 // iterations, residual reached, peak RSS.
 #include <sys/resource.h>
@@ -58,8 +60,9 @@ double cpu_seconds() {
 }
 
 /// Accuracy of the Monte Carlo estimator: Gauss-Seidel solutions on one mesh with the accurate
-/// ray-cast factors and with monte_carlo at several ray counts; prints the area-weighted relative
-/// RMS difference of element radiosity (summed over channels) and the largest difference of a
+/// ray-cast factors (seed 1) and then with ray_cast at seed 2 (the reference's own noise) and
+/// monte_carlo at several ray counts; prints the area-weighted RMS difference of reflector
+/// element radiosity (summed over channels) over their RMS, and the largest difference of a
 /// group's mean. Emitters are left out (their emission dominates).
 void compare(std::size_t target_patches) {
   const radiosity::Scene scene = radiosity::cornell_box();
@@ -108,9 +111,14 @@ void compare(std::size_t target_patches) {
     double worst = 0.0;
     for (const std::string& g : scene.groups())
       worst = std::max(worst, std::fabs(sum3(mc.group_radiosity(g)) / sum3(ref.group_radiosity(g)) - 1.0));
-    std::printf("  monte_carlo %5u rays: reflectors' RMS difference / RMS radiosity %5.2f %%, worst group mean %5.2f %%, %.2f s CPU "
-                "(form factors %.2f s wall)\n",
-                rays, 100.0 * std::sqrt(num / den), 100.0 * worst, cpu, mc.report().seconds_form_factors);
+    char label[64];
+    if (rays == 0)
+      std::snprintf(label, sizeof label, "ray_cast, seed 2");
+    else
+      std::snprintf(label, sizeof label, "monte_carlo %u rays", rays);
+    std::printf("  %-22s reflectors' RMS difference / RMS radiosity %5.2f %%, worst group mean %5.2f %%, "
+                "%.2f s CPU (form factors %.2f s wall)\n",
+                label, 100.0 * std::sqrt(num / den), 100.0 * worst, cpu, mc.report().seconds_form_factors);
     std::fflush(stdout);
   }
 }
