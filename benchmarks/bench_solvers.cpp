@@ -34,7 +34,7 @@ int run(std::size_t target_patches, radiosity::SolverMethod method, const char* 
   opt.tolerance = 1e-3;
   opt.threads = 2;
   opt.form_factors.method = g_estimator;
-  opt.form_factors.hemisphere_rays = g_rays;
+  if (g_rays > 0) opt.form_factors.hemisphere_rays = g_rays;
   // Patches are at most this large, so there are somewhat more than target_patches of them.
   opt.mesh.max_patch_area = static_cast<float>(scene.total_area() / static_cast<double>(target_patches));
   opt.mesh.max_element_area = opt.mesh.max_patch_area;

@@ -82,7 +82,7 @@ struct SolveArgs {
   std::string scene;
   std::string method = "gauss-seidel";
   std::string form_factors = "ray-cast";
-  unsigned hemisphere_rays = 0;
+  unsigned hemisphere_rays = rad::FormFactorOptions{}.hemisphere_rays;
   unsigned specular_depth = 0;
   float max_patch_area = 0.0f;
   float max_element_area = 0.0f;
@@ -119,8 +119,9 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
       ->check(CLI::IsMember(form_factor_names()))
       ->capture_default_str();
-  cmd.add_option("--hemisphere-rays", a.hemisphere_rays,
-                 "Monte Carlo estimator: rays per element, 16..1048576 (0 = default: 1024)");
+  cmd.add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo estimator: rays per element, 16..1048576")
+      ->check(CLI::Range(16u, 1u << 20))
+      ->capture_default_str();
   cmd.add_option("--specular-depth", a.specular_depth,
                  "Monte Carlo estimator: mirror reflections and window passages carried between diffuse surfaces "
                  "(extended form factors), 0..16")

@@ -19,7 +19,10 @@ struct FactorsArgs {
   bool sparse = false;
   std::string output;
   std::string groups;
-  unsigned samples = 0, rays = 0, resolution = 0, hemisphere_rays = 0;
+  // The library's defaults; an explicit 0 is passed on and rejected with the field named.
+  unsigned samples = rad::FormFactorOptions{}.source_samples, rays = rad::FormFactorOptions{}.visibility_rays,
+           resolution = rad::FormFactorOptions{}.hemicube_resolution,
+           hemisphere_rays = rad::FormFactorOptions{}.hemisphere_rays;
   std::uint64_t seed = 1;
   unsigned threads = 0;
   float max_patch_area = 0.0f, max_element_area = 0.0f;
@@ -87,14 +90,18 @@ Command add_factors_command(CLI::App& app) {
   cmd->add_option("-o,--output", a.output, "Write here instead of stdout");
   cmd->add_option("--groups", a.groups, "Comma-separated groups to report, in this order (default: all)");
   cmd->add_option("--samples", a.samples,
-                  "Points per source element, 1..64 (0 = default: 4; hemicube: a square count is a Gauss rule)")
-      ->check(CLI::Range(0u, 64u));
-  cmd->add_option("--rays", a.rays, "Ray cast: occlusion rays per source point, 1..64 (0 = default: 4)")
-      ->check(CLI::Range(0u, 64u));
-  cmd->add_option("--hemisphere-rays", a.hemisphere_rays,
-                  "Monte Carlo: rays per element, 16..1048576 (0 = default: 1024)");
-  cmd->add_option("--resolution", a.resolution, "Hemicube: top-face resolution in pixels, 2..8192 (0 = 256)")
-      ->check(CLI::Range(0u, 8192u));
+                  "Points per source element, 1..64 (hemicube: a square count is a Gauss rule)")
+      ->check(CLI::Range(1u, 64u))
+      ->capture_default_str();
+  cmd->add_option("--rays", a.rays, "Ray cast: occlusion rays per source point, 1..64")
+      ->check(CLI::Range(1u, 64u))
+      ->capture_default_str();
+  cmd->add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo: rays per element, 16..1048576")
+      ->check(CLI::Range(16u, 1u << 20))
+      ->capture_default_str();
+  cmd->add_option("--resolution", a.resolution, "Hemicube: top-face resolution in pixels, 2..8192")
+      ->check(CLI::Range(2u, 8192u))
+      ->capture_default_str();
   cmd->add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->capture_default_str();
   cmd->add_option("--threads", a.threads, "Worker threads (0 = all cores)");

@@ -39,27 +39,28 @@ enum class FormFactorMethod {
   monte_carlo,
 };
 
-/// Options of the estimators. 0 means "use the default" where stated; every field has one.
+/// Options of the estimators; every field has a default. A count or resolution of 0 (or any
+/// value outside its range) is an Error naming the field.
 struct FormFactorOptions {
   FormFactorMethod method = FormFactorMethod::ray_cast;
-  /// Points per source element, in [1, 64]; 0 = 4. Ray cast: the smallest number of
+  /// Points per source element, in [1, 64]. Ray cast: the smallest number of
   /// stratified points from which occlusion rays leave (pairs with large factors or a penumbra
   /// get more, see visibility_rays). Hemicube: the hemicubes per element, at the nodes of a
   /// g x g Gauss-Legendre rule when the count is a square g^2 (else at the centres of strata
   /// along the element). Analytic: unused.
-  std::uint32_t source_samples = 0;
+  std::uint32_t source_samples = 4;
   /// Ray cast: occlusion rays from each source point to stratified points on the receiving
-  /// patch, in [1, 64]; 0 = 4. With n = source_samples x visibility_rays and F the pair's
+  /// patch, in [1, 64]. With n = source_samples x visibility_rays and F the pair's
   /// unoccluded factor, a pair that some polygon may shadow casts max(n, min(256 n F, 1024))
   /// rays, then, if some are blocked and some clear, max(4 n, min(1024 n F, 4096)) more.
-  std::uint32_t visibility_rays = 0;
-  /// Hemicube: top-face resolution in pixels, in [2, 8192]; 0 = 256. The four side faces are
+  std::uint32_t visibility_rays = 4;
+  /// Hemicube: top-face resolution in pixels, in [2, 8192]. The four side faces are
   /// resolution x resolution/2. Memory: about 8 x resolution^2 bytes per thread plus
   /// 6 x resolution^2 bytes shared.
-  std::uint32_t hemicube_resolution = 0;
+  std::uint32_t hemicube_resolution = 256;
   /// Monte Carlo: rays per element (per patch when shooting a column, times the patch's
-  /// elements), in [16, 1 << 20]; 0 = 1024.
-  std::uint32_t hemisphere_rays = 0;
+  /// elements), in [16, 1 << 20].
+  std::uint32_t hemisphere_rays = 1024;
   /// Monte Carlo only: extended form factors (Wallace, Cohen & Greenberg 1987) carry light
   /// between diffuse surfaces through ideal mirrors (Material::specular with specular_exponent
   /// 0; at most this many reflections on a path, weighted by the mean specular reflectance) and

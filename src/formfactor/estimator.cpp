@@ -10,22 +10,16 @@ namespace radiosity::detail {
 
 FormFactorOptions resolve(const FormFactorOptions& options) {
   FormFactorOptions o = options;
-  if (o.source_samples == 0) o.source_samples = o.method == FormFactorMethod::analytic ? 16 : 4;
-  if (o.visibility_rays == 0) o.visibility_rays = 4;
-  if (o.hemisphere_rays == 0) o.hemisphere_rays = 1024;
-  if (o.hemisphere_rays < 16 || o.hemisphere_rays > (1u << 20))
-    throw Error(ErrorCode::invalid_argument, "form_factors.hemisphere_rays must be in [16, 1048576] (0 = 1024), got " +
-                                                 std::to_string(o.hemisphere_rays));
-  if (o.hemicube_resolution == 0) o.hemicube_resolution = 256;
-  if (o.hemicube_resolution < 2 || o.hemicube_resolution > 8192)
-    throw Error(ErrorCode::invalid_argument, "form_factors.hemicube_resolution must be in [2, 8192] (0 = 256), got " +
-                                                 std::to_string(o.hemicube_resolution));
-  if (o.source_samples > 64)
-    throw Error(ErrorCode::invalid_argument, "form_factors.source_samples must be in [1, 64] (0 = default), got " +
-                                                 std::to_string(o.source_samples));
-  if (o.visibility_rays > 64)
-    throw Error(ErrorCode::invalid_argument,
-                "form_factors.visibility_rays must be in [1, 64] (0 = 4), got " + std::to_string(o.visibility_rays));
+  auto in_range = [](const char* field, std::uint32_t value, std::uint32_t lo, std::uint32_t hi) {
+    if (value < lo || value > hi)
+      throw Error(ErrorCode::invalid_argument, std::string("form_factors.") + field + " must be in [" +
+                                                   std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                                                   std::to_string(value));
+  };
+  in_range("source_samples", o.source_samples, 1, 64);
+  in_range("visibility_rays", o.visibility_rays, 1, 64);
+  in_range("hemicube_resolution", o.hemicube_resolution, 2, 8192);
+  in_range("hemisphere_rays", o.hemisphere_rays, 16, 1u << 20);
   if (o.specular_depth > 16)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth must be in [0, 16], got " + std::to_string(o.specular_depth));

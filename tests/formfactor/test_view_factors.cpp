@@ -123,7 +123,7 @@ TEST_SUITE("formfactor") {
     CHECK_THROWS_AS(rad::view_factors(s, o), rad::Error);
   }
 
-  TEST_CASE("absurd estimator options are errors that name the field; 0 means the default") {
+  TEST_CASE("absurd estimator options, zero counts included, are errors that name the field") {
     const rad::Scene s = test::closed_box(rad::Material{});
     const rad::PatchHierarchy h(s, coarse());
     auto fails_naming = [&](rad::FormFactorOptions o, const char* field) {
@@ -153,13 +153,28 @@ TEST_SUITE("formfactor") {
     o = {};
     o.method = static_cast<rad::FormFactorMethod>(42);
     fails_naming(o, "method");
-    // All zeros: defaults, and a usable estimator.
+    // Zero samples, rays or resolution: an error for every estimator, never a NaN.
     for (const rad::FormFactorMethod m : kMethods) {
+      CAPTURE(static_cast<int>(m));
+      o = {};
+      o.method = m;
+      o.source_samples = 0;
+      fails_naming(o, "source_samples");
+      o = {};
+      o.method = m;
+      o.visibility_rays = 0;
+      fails_naming(o, "visibility_rays");
+      o = {};
+      o.method = m;
+      o.hemicube_resolution = 0;
+      fails_naming(o, "hemicube_resolution");
+      o = {};
+      o.method = m;
+      o.hemisphere_rays = 0;
+      fails_naming(o, "hemisphere_rays");
+      // The defaults make a usable estimator.
       rad::FormFactorOptions d;
       d.method = m;
-      d.source_samples = 0;
-      d.visibility_rays = 0;
-      d.hemicube_resolution = 0;
       CHECK_NOTHROW(rad::make_form_factor_estimator(s, h, d));
     }
     rad::ViewFactorOptions bad_mesh;
