@@ -79,7 +79,7 @@ Command add_factors_command(CLI::App& app) {
   FactorsArgs& a = *args;
   CLI::App* cmd = app.add_subcommand(
       "factors", "Group-to-group view factors F(gi -> gk), area-weighted over each source group, as CSV or JSON");
-  cmd->add_option("scene", a.scene, "OBJ file (default: the built-in Cornell box)");
+  cmd->add_option("scene", a.scene, "OBJ or JSON scene file (default: the built-in Cornell box)");
   cmd->add_option("--method", a.method, "Form-factor estimator")
       ->check(CLI::IsMember({"ray-cast", "hemicube", "analytic"}))
       ->capture_default_str();

@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   float fov = 0.0f;
   float exposure = 1.0f;
   CLI::App* render = app.add_subcommand("render", "Solve and render a scene to EXR (linear) and PNG (preview)");
-  render->add_option("scene", render_args.scene, "OBJ file (default: the built-in Cornell box)");
+  render->add_option("scene", render_args.scene, "OBJ or JSON scene file (default: the built-in Cornell box)");
   render->add_option("-o,--output", out, "EXR output")->capture_default_str();
   render->add_option("--png", png, "PNG preview (default: the EXR path with .png)");
   render->add_flag("--no-png", no_png, "Do not write a PNG preview");
@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   SolveArgs solve_args;
   std::string stats, ply;
   CLI::App* solve = app.add_subcommand("solve", "Solve a scene; write statistics (JSON) and a coloured mesh (PLY)");
-  solve->add_option("scene", solve_args.scene, "OBJ file (default: the built-in Cornell box)");
+  solve->add_option("scene", solve_args.scene, "OBJ or JSON scene file (default: the built-in Cornell box)");
   solve->add_option("--stats", stats, "Write statistics JSON here");
   solve->add_option("--ply", ply, "Write the solution as a PLY mesh with per-vertex colours");
   add_solve_options(*solve, solve_args);
