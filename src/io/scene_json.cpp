@@ -13,6 +13,7 @@
 #include <initializer_list>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -57,6 +58,57 @@ std::string line_column(std::string_view text, std::size_t pos) {
     if (text[i] == '\n') ++line, line_start = i + 1;
   return std::to_string(line) + ":" + std::to_string(pos - line_start + 1);
 }
+
+/// A key that occurs twice in one object: nlohmann-json would keep the last silently, which
+/// hides a pasted-over value as surely as a typo.
+struct DuplicateKey {
+  std::string path;
+};
+
+/// Parser callback state that tracks the document path and throws DuplicateKey.
+class DuplicateKeyCheck {
+ public:
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        next_element();
+        frames_.push_back({event == json::parse_event_t::object_start, {}, {}, static_cast<std::size_t>(-1)});
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        break;
+      case json::parse_event_t::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second) throw DuplicateKey{path()};
+        break;
+      }
+      case json::parse_event_t::value:
+        next_element();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;    ///< objects: the key being read
+    std::size_t index;  ///< arrays: the element being read
+  };
+  void next_element() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) p = f.object ? key_path(p, f.key.c_str()) : index_path(p, f.index);
+    return p;
+  }
+  std::vector<Frame> frames_;
+};
 
 /// Walks one parsed document. Every accessor takes the value's document path for messages.
 class SceneReader {
@@ -528,7 +580,9 @@ Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_
   const std::string source(source_name);
   nlohmann::json root;
   try {
-    root = nlohmann::json::parse(text.begin(), text.end());
+    root = nlohmann::json::parse(text.begin(), text.end(), detail::DuplicateKeyCheck());
+  } catch (const detail::DuplicateKey& d) {
+    throw Error(ErrorCode::parse_error, source + ": " + d.path + ": duplicate key");
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte is 1-based: the position of the byte the parser stopped at. Its message repeats a
     // line and column of its own and a "[json.exception...]" tag; keep only the description.

@@ -299,6 +299,10 @@ TEST_CASE("JSON unknown keys, wrong types, missing fields and unknown names are 
   check_error(R"({"surfaces": []})", ErrorCode::parse_error, "scene.json: version: missing");
   check_error(R"({"version": 2, "surfaces": []})", ErrorCode::parse_error, "version: unsupported format version 2");
   check_error(with_materials(R"({"reflectance": 0.3})"), ErrorCode::parse_error, "materials[0].name: missing");
+  check_error(with_materials(R"({"name": "m0"}, {"name": "m1", "reflectance": 0.2, "reflectance": 0.3})"),
+              ErrorCode::parse_error, "scene.json: materials[1].reflectance: duplicate key");
+  check_error(R"({"version": 1, "surfaces": [{"type": "quad"}, {"type": "box", "lower": [0,0,0], "lower": [1,1,1]}]})",
+              ErrorCode::parse_error, "scene.json: surfaces[1].lower: duplicate key");
   check_error(with_materials(R"({"name": "m0"}, {"name": "m0"})"), ErrorCode::parse_error,
               "materials[1].name: duplicate material name 'm0'");
   check_error(R"({"version": 1, "materials": [{"name": "white"}, {"name": "red"}], "surfaces": [
