@@ -9,6 +9,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -347,6 +348,27 @@ TEST_CASE("load_scene reads .json files and names the file in errors") {
   CHECK_THROWS_WITH_AS(rad::load_scene(kTmp / "missing.json"), doctest::Contains("missing.json"), Error);
   const rad::Scene scene = rad::load_scene(kScenes / "cornell_box.json");
   CHECK(scene.groups().size() == 8);
+}
+
+TEST_CASE("the complete example of docs/SCENE_JSON.md loads") {
+  std::ifstream in(kData / ".." / ".." / "docs" / "SCENE_JSON.md");
+  REQUIRE(in.good());
+  std::stringstream md;
+  md << in.rdbuf();
+  const std::string text = md.str();
+  const std::size_t start = text.find("```json\n");
+  REQUIRE(start != std::string::npos);
+  const std::size_t end = text.find("```\n", start + 8);
+  REQUIRE(end != std::string::npos);
+  // Its OBJ include, chair.obj, stands for any OBJ next to the file: use a fixture.
+  const fs::path dir = kTmp / "scene_json_doc";
+  fs::create_directories(dir);
+  fs::copy_file(kData / "two_quads.obj", dir / "chair.obj", fs::copy_options::overwrite_existing);
+  fs::copy_file(kData / "two_quads.mtl", dir / "two_quads.mtl", fs::copy_options::overwrite_existing);
+  const rad::Scene scene = rad::parse_scene_json(text.substr(start + 8, end - start - 8), dir, "SCENE_JSON.md");
+  CHECK(scene.materials().size() == 5 + 2);
+  for (const char* g : {"floor", "ceiling", "back", "light", "box", "ball", "plate"}) CHECK(scene.find_group(g).has_value());
+  CHECK(scene.warnings().empty());
 }
 
 TEST_CASE("the JSON Cornell box solves to the built-in Cornell box's group radiosities within 0.5%") {
