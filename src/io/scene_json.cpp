@@ -374,9 +374,14 @@ void SceneReader::materials(const json& j, Scene& scene) {
     const json* emission = find(m, "emission");
     const json* radiance = find(m, "radiance");
     if (emission && radiance) fail(ErrorCode::parse_error, loc, "give either emission or radiance, not both");
-    if (emission) mat.emission = bounded_colour(*emission, key_path(loc, "emission"), FLT_MAX, false);
-    if (radiance)
-      mat.emission = glm::pi<float>() * bounded_colour(*radiance, key_path(loc, "radiance"), FLT_MAX / 4.0f, false);
+    auto non_negative_colour = [&](const json& c, const std::string& where) {
+      const Rgb v = colour(c, where);
+      if (v.x < 0.0f || v.y < 0.0f || v.z < 0.0f)
+        fail(ErrorCode::invalid_scene, where, "each channel must be >= 0 (got " + rgb_text(v) + ")");
+      return v;
+    };
+    if (emission) mat.emission = non_negative_colour(*emission, key_path(loc, "emission"));
+    if (radiance) mat.emission = glm::pi<float>() * non_negative_colour(*radiance, key_path(loc, "radiance"));
 
     Rgb brdf_diffuse(0.0f);
     if (const json* b = find(m, "brdf")) mat.brdf = brdf(*b, key_path(loc, "brdf"), brdf_diffuse);

@@ -84,7 +84,7 @@ void check_same_model(const rad::Brdf& a, const rad::Brdf& b) {
   }
 }
 
-void put_le(std::ofstream& out, std::uint64_t bits, int bytes) {
+void put_le(std::ofstream& out, std::uint32_t bits, int bytes) {
   for (int i = 0; i < bytes; ++i) out.put(static_cast<char>((bits >> (8 * i)) & 0xff));
 }
 
@@ -101,7 +101,13 @@ fs::path write_merl(const fs::path& path) {
       std::uint64_t bits = 0;
       const double stored = f / scale[c];
       std::memcpy(&bits, &stored, sizeof bits);
-      for (int k = 0; k < 90 * 180; ++k) put_le(out, bits, 8);
+      // One theta_half slab (90 x 180 equal entries), written at once.
+      char entry[8];
+      for (int b = 0; b < 8; ++b) entry[b] = static_cast<char>((bits >> (8 * b)) & 0xff);
+      std::string slab;
+      slab.reserve(90 * 180 * 8);
+      for (int k = 0; k < 90 * 180; ++k) slab.append(entry, 8);
+      out.write(slab.data(), static_cast<std::streamsize>(slab.size()));
     }
   REQUIRE(out.good());
   return path;
@@ -260,7 +266,7 @@ TEST_CASE("JSON bad values name the document path of the value") {
   check_error(with_materials(R"({"name": "m0", "reflectance": 0.6, "specular": 0.5})"), ErrorCode::invalid_scene,
               "materials[0]: reflectance + specular + diffuse_transmittance must be < 1");
   check_error(with_materials(R"({"name": "m0", "emission": [1, -1, 0]})"), ErrorCode::invalid_scene,
-              "materials[0].emission: each channel must be in [0,");
+              "materials[0].emission: each channel must be >= 0 (got [1, -1, 0])");
   check_error(with_materials(R"({"name": "m0", "reflectance": 1e300})"), ErrorCode::invalid_scene,
               "materials[0].reflectance: must be a finite number within float range");
   check_error(R"({"version": 1, "materials": [{"name": "m0"}], "surfaces": [

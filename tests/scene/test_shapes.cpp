@@ -57,7 +57,7 @@ double uv_sphere_area(double r, int n) {
 
 TEST_SUITE("scene") {
 
-TEST_CASE("add_quad faces edge_u x edge_v with area |edge_u x edge_v|") {
+TEST_CASE("add_quad faces edge_u x edge_v with the area of that cross product") {
   rad::Scene scene;
   const rad::MaterialId m = scene.add_material(rad::Material{});
   const rad::PolygonRange r = rad::add_quad(scene, {1, 2, 3}, {2, 0, 0}, {0.5f, 0, -3}, m, "q");
