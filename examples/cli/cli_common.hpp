@@ -171,10 +171,10 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
 
 /// Help text for the SCENE argument of every command.
 constexpr const char* kSceneHelp =
-    "OBJ file, or a built-in scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
+    "OBJ or JSON scene file, or a built-in scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
     "block, glass short block), cornell-mirror, cornell-glass";
 
-/// A built-in scene by name, else the OBJ file at `path`.
+/// A built-in scene by name, else the OBJ or JSON file at `path`.
 inline rad::Scene load(const std::string& path) {
   if (path.empty() || path == "cornell" || path == "cornell-box") return rad::cornell_box();
   if (path == "cornell-specular") return rad::cornell_box_specular();

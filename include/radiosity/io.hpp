@@ -21,9 +21,23 @@ inline namespace v1 {
 /// MTL details: `Ks` -> specular with `Ns` as Phong exponent; `illum` 3/5 with `Ks` -> ideal
 /// mirror; `illum` 4/6/7/9 with `Tf` -> transmittance, `Ni` -> ior; when Kd + Ks would reach 1,
 /// Ks is scaled down with a warning. Warnings in Scene::warnings() start with "file:line: ".
+/// JSON (.json): the scene format of docs/SCENE_JSON.md (materials with any model of brdf.hpp,
+/// polygons, quads, boxes, spheres, OBJ includes, a camera); see parse_scene_json().
 /// Throws Error{invalid_argument} for an unsupported extension.
 /// Thread safety: may be called concurrently.
 RADIOSITY_API Scene load_scene(const std::filesystem::path& path);
+
+/// Reads a scene in the JSON format of docs/SCENE_JSON.md from `text`. Relative file names in
+/// it (OBJ includes, measured BRDFs) are resolved against `base_dir`; `source_name` starts every
+/// message (load_scene() passes the file's path). Every error names the value's place in the
+/// document, e.g. "scene.json: materials[2].brdf.alpha_x: must be > 0 (got -0.1)":
+/// Error{parse_error} for broken JSON ("scene.json:3:14: JSON syntax error: ..."), an unknown
+/// key, a wrong type, a missing field, an unknown material name or format version;
+/// Error{invalid_scene} for a value out of range or unusable geometry; the reader's own error
+/// (with the place in front) for a missing or broken OBJ or measured-BRDF file.
+/// Thread safety: may be called concurrently.
+RADIOSITY_API Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_dir = {},
+                                     std::string_view source_name = "<string>");
 
 /// Writes linear float RGB (channels R, G, B) and each layer as LAYER.R/.G/.B. Throws
 /// Error{io_error} naming the path when the file cannot be written, Error{invalid_argument}

@@ -14,11 +14,12 @@ Scene load_scene(const std::filesystem::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".obj") return detail::load_obj(path);
+  if (ext == ".json") return detail::load_scene_json(path);
   if (ext.empty())
     throw Error(ErrorCode::invalid_argument,
-                "load_scene: '" + path.string() + "' has no file extension (supported: .obj)");
+                "load_scene: '" + path.string() + "' has no file extension (supported: .obj, .json)");
   throw Error(ErrorCode::invalid_argument, "load_scene: '" + path.string() + "': unsupported extension '" +
-                                               path.extension().string() + "' (supported: .obj)");
+                                               path.extension().string() + "' (supported: .obj, .json)");
 }
 
 }  // namespace v1
