@@ -151,6 +151,23 @@ bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tne
 
 namespace {
 
+/// Lane k of a packet of rays (RTCRay4/8/16): the ray origin + t dir, t in (tnear, tfar).
+template <typename RayK>
+void set_lane(RayK& ray, std::size_t k, const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) {
+  ray.org_x[k] = origin.x;
+  ray.org_y[k] = origin.y;
+  ray.org_z[k] = origin.z;
+  ray.dir_x[k] = dir.x;
+  ray.dir_y[k] = dir.y;
+  ray.dir_z[k] = dir.z;
+  ray.tnear[k] = tnear;
+  ray.tfar[k] = tfar;
+  ray.time[k] = 0.0f;
+  ray.mask[k] = 0xffffffffu;
+  ray.id[k] = 0;
+  ray.flags[k] = 0;
+}
+
 // Segments [i, i + K) of the batch as one packet of K rays; lanes past `count` are switched off.
 template <int K, typename RayK, typename Occluded>
 void occluded_packets(RTCScene scene, std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear,
@@ -164,20 +181,8 @@ void occluded_packets(RTCScene scene, std::size_t count, const glm::vec3* origin
   for (std::size_t i = 0; i < count; i += K) {
     const std::size_t n = std::min<std::size_t>(K, count - i);
     for (std::size_t k = 0; k < static_cast<std::size_t>(K); ++k) {
-      const std::size_t q = k < n ? i + k : i;
       valid[k] = k < n ? -1 : 0;
-      ray.org_x[k] = origin[q].x;
-      ray.org_y[k] = origin[q].y;
-      ray.org_z[k] = origin[q].z;
-      ray.dir_x[k] = dir[q].x;
-      ray.dir_y[k] = dir[q].y;
-      ray.dir_z[k] = dir[q].z;
-      ray.tnear[k] = tnear;
-      ray.tfar[k] = tfar;
-      ray.time[k] = 0.0f;
-      ray.mask[k] = 0xffffffffu;
-      ray.id[k] = 0;
-      ray.flags[k] = 0;
+      set_lane(ray, k, origin[k < n ? i + k : i], dir[k < n ? i + k : i], tnear, tfar);
     }
     occluded(valid, scene, &context, &ray);
     for (std::size_t k = 0; k < n; ++k) blocked[i + k] = ray.tfar[k] < 0.0f ? 1 : 0;
@@ -211,20 +216,8 @@ void intersect_packets(RTCScene scene, const std::vector<std::uint32_t>& ids, st
   for (std::size_t i = 0; i < count; i += K) {
     const std::size_t n = std::min<std::size_t>(K, count - i);
     for (std::size_t k = 0; k < static_cast<std::size_t>(K); ++k) {
-      const std::size_t q = k < n ? i + k : i;
       valid[k] = k < n ? -1 : 0;
-      rh.ray.org_x[k] = origin[q].x;
-      rh.ray.org_y[k] = origin[q].y;
-      rh.ray.org_z[k] = origin[q].z;
-      rh.ray.dir_x[k] = dir[q].x;
-      rh.ray.dir_y[k] = dir[q].y;
-      rh.ray.dir_z[k] = dir[q].z;
-      rh.ray.tnear[k] = tnear;
-      rh.ray.tfar[k] = tfar;
-      rh.ray.time[k] = 0.0f;
-      rh.ray.mask[k] = 0xffffffffu;
-      rh.ray.id[k] = 0;
-      rh.ray.flags[k] = 0;
+      set_lane(rh.ray, k, origin[k < n ? i + k : i], dir[k < n ? i + k : i], tnear, tfar);
       rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;

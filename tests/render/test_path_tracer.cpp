@@ -14,6 +14,7 @@
 
 #include "geometry/ray_scene.hpp"
 #include "render/camera.hpp"
+#include "support/images.hpp"
 #include "support/scenes.hpp"
 
 namespace rad = radiosity;
@@ -40,20 +41,6 @@ Stats channel_stats(const rad::Image& image, int c) {
 }
 
 double channel_mean(const rad::Image& image, int c) { return channel_stats(image, c).mean; }
-
-/// Relative RMSE as issue #4 uses it: sqrt(mean over pixels and channels of (R - P)^2), divided
-/// by the mean of P over pixels and channels.
-double relative_rmse(const rad::Image& r, const rad::Image& p) {
-  double se = 0.0, sum = 0.0;
-  for (std::size_t i = 0; i < p.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double d = static_cast<double>(r.pixels[i][c]) - p.pixels[i][c];
-      se += d * d;
-      sum += p.pixels[i][c];
-    }
-  const double n = 3.0 * static_cast<double>(p.pixels.size());
-  return std::sqrt(se / n) / (sum / n);
-}
 
 /// Distance from p to a planar convex polygon.
 float distance_to_polygon(const glm::vec3& p, const rad::Polygon& q) {
@@ -394,7 +381,7 @@ TEST_SUITE("path") {
         fresh_blocks.at(x / 4, y / 4) += fresh.at(x, y) / 16.0f;
         reference_blocks.at(x / 4, y / 4) += reference.at(x, y) / 16.0f;
       }
-    const double block_rmse = relative_rmse(fresh_blocks, reference_blocks);
+    const double block_rmse = test::relative_rmse(fresh_blocks, reference_blocks);
     MESSAGE("fresh 256 spp vs reference: 4x4-block relative RMSE " << block_rmse);
     CHECK(block_rmse < 0.03);
   }
@@ -419,7 +406,7 @@ TEST_SUITE("path") {
     ro.spp = 1024;  // enough that pixel coverage noise at silhouettes stays small
     const rad::Image R = rad::render(scene, solution, ro);
 
-    const double rmse = relative_rmse(R, P);
+    const double rmse = test::relative_rmse(R, P);
     MESSAGE("radiosity vs path-traced Cornell box: relative RMSE " << rmse);
     CHECK(rmse < 0.05);
     for (int c = 0; c < 3; ++c) {

@@ -14,6 +14,7 @@
 #include <radiosity/radiosity.hpp>
 
 #include "render/camera.hpp"
+#include "support/images.hpp"
 
 namespace rad = radiosity;
 
@@ -26,19 +27,6 @@ constexpr double kPi = 3.14159265358979323846;
 const char* const kMirrorReference = RADIOSITY_TEST_DATA "/cornell_mirror_path_64.exr";
 const char* const kGlassReference = RADIOSITY_TEST_DATA "/cornell_glass_path_64.exr";
 constexpr int kSpecularReferenceSpp = 32400;  // a 180 x 180 grid
-
-/// sqrt(mean over pixels and channels of (a - b)^2) / mean of b, as issues #4 and #6 define it.
-double relative_rmse(const rad::Image& a, const rad::Image& b) {
-  double se = 0.0, sum = 0.0;
-  for (std::size_t i = 0; i < b.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double d = static_cast<double>(a.pixels[i][c]) - b.pixels[i][c];
-      se += d * d;
-      sum += b.pixels[i][c];
-    }
-  const double n = 3.0 * static_cast<double>(b.pixels.size());
-  return std::sqrt(se / n) / (sum / n);
-}
 
 /// Means over k x k pixel blocks.
 rad::Image block_means(const rad::Image& image, int k) {
@@ -102,7 +90,7 @@ void check_specular_reference(const char* path, rad::CornellSpecular blocks, dou
     MESSAGE("channel " << c << ": fresh / reference mean " << ratio);
     CHECK(std::fabs(ratio - 1.0) < 0.015);
   }
-  const double block_rmse = relative_rmse(block_means(fresh, 8), block_means(reference, 8));
+  const double block_rmse = test::relative_rmse(block_means(fresh, 8), block_means(reference, 8));
   MESSAGE("fresh 256 spp vs reference: 8x8-block relative RMSE " << block_rmse);
   CHECK(block_rmse < block_limit);
 }

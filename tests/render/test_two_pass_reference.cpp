@@ -8,33 +8,11 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "support/images.hpp"
+
 namespace rad = radiosity;
 
 namespace {
-
-/// Relative RMSE as issue #4 uses it: sqrt(mean over pixels and channels of (R - P)^2) divided
-/// by the mean of P.
-double relative_rmse(const rad::Image& r, const rad::Image& p) {
-  double se = 0.0, sum = 0.0;
-  for (std::size_t i = 0; i < p.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double d = static_cast<double>(r.pixels[i][c]) - p.pixels[i][c];
-      se += d * d;
-      sum += p.pixels[i][c];
-    }
-  const double n = 3.0 * static_cast<double>(p.pixels.size());
-  return std::sqrt(se / n) / (sum / n);
-}
-
-double mean_ratio(const rad::Image& r, const rad::Image& p) {
-  double a = 0.0, b = 0.0;
-  for (std::size_t i = 0; i < p.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      a += r.pixels[i][c];
-      b += p.pixels[i][c];
-    }
-  return a / b;
-}
 
 rad::Image two_pass_64(rad::CornellSpecular variant, rad::Solution& pass1_out) {
   const rad::Scene scene = rad::cornell_box_specular(variant);
@@ -58,7 +36,7 @@ TEST_SUITE("two_pass") {
     const rad::Image P = rad::read_exr(RADIOSITY_TEST_DATA "/cornell_mirror_path_64.exr");
     rad::Solution pass1;
     const rad::Image R = two_pass_64(rad::CornellSpecular::mirror, pass1);
-    const double rmse = relative_rmse(R, P), ratio = mean_ratio(R, P);
+    const double rmse = test::relative_rmse(R, P), ratio = test::mean_ratio(R, P);
     MESSAGE("mirror Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
     // Measured 4.0 % and 0.993 (pass 1 carries the mirror's light at element resolution).
     CHECK(rmse < 0.08);
@@ -69,7 +47,7 @@ TEST_SUITE("two_pass") {
     const rad::Image P = rad::read_exr(RADIOSITY_TEST_DATA "/cornell_glass_path_64.exr");
     rad::Solution pass1;
     const rad::Image R = two_pass_64(rad::CornellSpecular::glass, pass1);
-    const double rmse = relative_rmse(R, P), ratio = mean_ratio(R, P);
+    const double rmse = test::relative_rmse(R, P), ratio = test::mean_ratio(R, P);
     MESSAGE("glass Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
     // Measured 7.8 % and 0.966: pass 1 passes light through the glass straight (no bending,
     // no trapping by total internal reflection), the photon map blurs and speckles the caustics.
