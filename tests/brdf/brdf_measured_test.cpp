@@ -191,7 +191,7 @@ TEST_SUITE("brdf") {
     CHECK(b->eval(wo, wi).x == doctest::Approx(89.0f).epsilon(1e-4));
   }
 
-  TEST_CASE("measured glossy data is reciprocal, isotropic, and its albedo and sampler agree") {
+  TEST_CASE("measured glossy data is reciprocal - isotropic - and its albedo and sampler agree") {
     // f = kd / pi + ks exp(-(theta_h / 0.3)^2) sampled on the MERL grid.
     const Rgb kd(0.3f, 0.2f, 0.1f);
     const float ks = 0.4f;
@@ -233,7 +233,7 @@ TEST_SUITE("brdf") {
     }
   }
 
-  TEST_CASE("load_measured rejects missing, short, wrong-dimension and truncated files naming the file") {
+  TEST_CASE("load_measured rejects missing - short - wrong-dimension and truncated files naming the file") {
     const std::filesystem::path dir(RADIOSITY_TEST_TMP);
     std::filesystem::create_directories(dir);
 

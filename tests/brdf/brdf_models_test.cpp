@@ -259,7 +259,7 @@ TEST_SUITE("brdf") {
     CHECK_NOTHROW(radiosity::make_lambertian(Rgb(1.0f)));
   }
 
-  TEST_CASE("shading frame is orthonormal, right-handed and round-trips directions") {
+  TEST_CASE("shading frame is orthonormal - right-handed and round-trips directions") {
     Rng rng(19);
     for (int n = 0; n < 500; ++n) {
       // Normals all over the sphere, including near -z where the construction switches branch.

@@ -165,7 +165,7 @@ std::vector<Poly> box(double sx, double sy, double sz) {
 
 TEST_SUITE("formfactor") {
   TEST_CASE(
-      "parallel rectangles (Howell C-11) at several sizes and distances, rotated: ray_cast and analytic within 0.5%, "
+      "parallel rectangles (Howell C-11) at several sizes and distances - rotated: ray_cast and analytic within 0.5% - "
       "hemicube within 2%") {
     const double cases[][3] = {{1, 1, 1}, {1, 1, 0.1}, {2, 0.5, 0.3}, {1, 1, 5}, {10, 1, 0.5}, {0.1, 0.1, 1}};
     std::uint64_t seed = 11;
@@ -184,8 +184,8 @@ TEST_SUITE("formfactor") {
   }
 
   TEST_CASE(
-      "perpendicular rectangles sharing an edge (Howell C-14) at several aspect ratios, rotated: ray_cast and analytic "
-      "within 0.5%, hemicube within 2%") {
+      "perpendicular rectangles sharing an edge (Howell C-14) at several aspect ratios - rotated: ray_cast and analytic "
+      "within 0.5% - hemicube within 2%") {
     // {shared edge l, source width w, receiver height h}
     const double cases[][3] = {{1, 1, 1}, {1, 0.1, 1}, {1, 1, 0.1}, {2, 1, 3}, {0.2, 1, 1}, {5, 1, 1}};
     std::uint64_t seed = 21;
@@ -232,7 +232,7 @@ TEST_SUITE("formfactor") {
   }
 
   TEST_CASE(
-      "point to disk: the contour integral matches the disk closed form and a polygon's exact polar integral, "
+      "point to disk: the contour integral matches the disk closed form and a polygon's exact polar integral - "
       "rotated") {
     const double h_values[] = {0.1, 1.0, 3.0};
     Random rng(5);
@@ -263,7 +263,7 @@ TEST_SUITE("formfactor") {
 
   TEST_CASE(
       "coaxial disks as 32-gons match the polygons' exact factor (and Howell C-41 within the polygon error): ray_cast "
-      "and analytic within 0.5%, hemicube within 2%, both directions") {
+      "and analytic within 0.5% - hemicube within 2% - both directions") {
     const double cases[][3] = {{0.5, 1.0, 0.5}, {0.5, 1.0, 2.0}, {0.9, 1.0, 0.25}};  // r1, r2, h
     std::uint64_t seed = 31;
     for (const auto& c : cases) {
@@ -296,7 +296,7 @@ TEST_SUITE("formfactor") {
     }
   }
 
-  TEST_CASE("unit cube: opposite faces 0.1998249, adjacent 0.2000438, rows sum to 1, for every estimator") {
+  TEST_CASE("unit cube: opposite faces 0.1998249 - adjacent 0.2000438 - rows sum to 1 - for every estimator") {
     const std::vector<Poly> faces = box(1, 1, 1);
     const rad::Scene s = scene_of(faces);
     for (const rad::FormFactorMethod m : kMethods) {
@@ -324,7 +324,7 @@ TEST_SUITE("formfactor") {
   }
 
   TEST_CASE(
-      "closed 1 x 2 x 3 box, rotated: faces match C-11 and C-14, reciprocity A_i F_ij = A_j F_ji and row sums of 1") {
+      "closed 1 x 2 x 3 box - rotated: faces match C-11 and C-14 - reciprocity A_i F_ij = A_j F_ji and row sums of 1") {
     const std::vector<Poly> faces = box(1, 2, 3);
     // Pairs with closed forms: x0 -> x1 is C-11 (2 x 3 at distance 1); x0 -> y0 is C-14 (shared
     // edge 3, source width 2, receiver height 1); z0 -> y1 is C-14 (edge 1, width 2, height 3).

@@ -72,7 +72,7 @@ std::vector<Config> configs() {
 
 TEST_SUITE("formfactor") {
   TEST_CASE(
-      "occluded pairs match an independent Monte Carlo reference: ray_cast within 1%, hemicube within 2%, also "
+      "occluded pairs match an independent Monte Carlo reference: ray_cast within 1% - hemicube within 2% - also "
       "rotated") {
     Random rng(77);
     std::uint64_t seed = 100;
@@ -105,7 +105,7 @@ TEST_SUITE("formfactor") {
   }
 
   TEST_CASE(
-      "closed box around a floating cube: rows still sum to 1 and A_i F_ij = A_j F_ji (ray_cast 1%, hemicube 2%)") {
+      "closed box around a floating cube: rows still sum to 1 and A_i F_ij = A_j F_ji (ray_cast 1% - hemicube 2%)") {
     // The room's walls see each other only in part; what the cube hides, it receives.
     std::vector<Poly> polys;
     const glm::dvec3 lo(0.35, 0.3, 0.4), hi(0.65, 0.6, 0.7);

@@ -13,7 +13,7 @@
 namespace rad = radiosity;
 
 TEST_SUITE("formfactor") {
-  TEST_CASE("batched occlusion rays answer exactly as single rays, including a partial last packet") {
+  TEST_CASE("batched occlusion rays answer exactly as single rays - including a partial last packet") {
     const rad::Scene scene = rad::cornell_box();
     const rad::detail::RayScene rays = rad::detail::RayScene::from_polygons(scene);
     const rad::Bounds b = scene.bounds();

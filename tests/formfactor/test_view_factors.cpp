@@ -47,7 +47,7 @@ rad::MeshOptions coarse() {
 
 TEST_SUITE("formfactor") {
   TEST_CASE(
-      "view_factors names the groups, sums element areas, and is bit-identical at 1 and 2 threads for every "
+      "view_factors names the groups - sums element areas - and is bit-identical at 1 and 2 threads for every "
       "estimator") {
     const rad::Scene s = room_with_block();
     for (const rad::FormFactorMethod m : kMethods) {
@@ -73,7 +73,7 @@ TEST_SUITE("formfactor") {
     }
   }
 
-  TEST_CASE("patch_column agrees with element_rows for every estimator, in an occluded scene") {
+  TEST_CASE("patch_column agrees with element_rows for every estimator - in an occluded scene") {
     const rad::Scene s = room_with_block();
     const rad::PatchHierarchy h(s, coarse());
     const std::size_t n = h.patches().size();
@@ -100,7 +100,7 @@ TEST_SUITE("formfactor") {
     }
   }
 
-  TEST_CASE("view_factors: a group filter selects and orders rows and columns; unknown or repeated names are errors") {
+  TEST_CASE("view_factors: a group filter selects and orders rows and columns - unknown or repeated names are errors") {
     const rad::Scene s = room_with_block();
     rad::ViewFactorOptions o;
     o.mesh = coarse();
@@ -123,7 +123,7 @@ TEST_SUITE("formfactor") {
     CHECK_THROWS_AS(rad::view_factors(s, o), rad::Error);
   }
 
-  TEST_CASE("absurd estimator options, zero counts included, are errors that name the field") {
+  TEST_CASE("absurd estimator options including zero counts are errors that name the field") {
     const rad::Scene s = test::closed_box(rad::Material{});
     const rad::PatchHierarchy h(s, coarse());
     auto fails_naming = [&](rad::FormFactorOptions o, const char* field) {
@@ -202,7 +202,7 @@ TEST_SUITE("formfactor") {
     CHECK(same_thread);
   }
 
-  TEST_CASE("touching and grazing polygons give finite factors in [0, 1], coincident or crossing ones an error") {
+  TEST_CASE("touching and grazing polygons give finite factors in 0..1 - coincident or crossing ones an error") {
     // A square, a fin standing on it (touching along its bottom edge), and one sharing an edge
     // at a grazing angle: legal, and every factor must be finite.
     auto base = [] {
@@ -259,7 +259,7 @@ TEST_SUITE("formfactor") {
     }
   }
 
-  TEST_CASE("radiosity factors formats: CSV header and rows, sparse triplets, JSON with areas parses back") {
+  TEST_CASE("radiosity factors formats: CSV header and rows - sparse triplets - JSON with areas parses back") {
     rad::GroupViewFactors v;
     v.groups = {"floor", "wall, north", "sky"};
     v.area = {2.0, 1.5, 0.0};

@@ -99,7 +99,7 @@ float triangle_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) 
 
 TEST_SUITE("io") {
 
-TEST_CASE("write_ply writes the leaves as triangles over the vertices they use, with radiosity and sRGB colour") {
+TEST_CASE("write_ply writes the leaves as triangles over the vertices they use - with radiosity and sRGB colour") {
   const radiosity::Solution sol = small_solution();
   const radiosity::PatchHierarchy& h = sol.hierarchy();
   std::set<std::uint32_t> used;
@@ -193,7 +193,7 @@ TEST_CASE("write_ply errors name the path") {
   }
 }
 
-TEST_CASE("write_stats_json records status, sizes, power, per-group radiosity, timings and warnings") {
+TEST_CASE("write_stats_json records status - sizes - power - per-group radiosity - timings and warnings") {
   const radiosity::Solution sol = small_solution();
   fs::create_directories(kTmp);
   const fs::path path = kTmp / "stats.json";

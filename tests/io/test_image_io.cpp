@@ -92,7 +92,7 @@ TEST_CASE("write_exr then read_exr gives the pixels and layers back bit-exact") 
   CHECK(same_bits(back.layers[1].second, img.layers[1].second));
 }
 
-TEST_CASE("read_exr reads HALF channels and an offset data window, and missing channels are 0") {
+TEST_CASE("read_exr reads HALF channels and an offset data window - and missing channels are 0") {
   const Image img = radiosity::read_exr(kData / "half_partial.exr");
   REQUIRE(img.width == 3);
   REQUIRE(img.height == 2);
@@ -110,7 +110,7 @@ TEST_CASE("read_exr reads HALF channels and an offset data window, and missing c
   }
 }
 
-TEST_CASE("read_exr errors name the path: missing file, not an EXR, no RGB channels") {
+TEST_CASE("read_exr errors name the path: missing file - not an EXR - no RGB channels") {
   Error missing = error_of([] { radiosity::read_exr(kTmp / "no_such.exr"); });
   CHECK(missing.code() == ErrorCode::file_not_found);
   CHECK(contains(missing.what(), "no_such.exr"));
@@ -136,7 +136,7 @@ TEST_CASE("read_exr errors name the path: missing file, not an EXR, no RGB chann
   CHECK(contains(no_rgb.what(), "Y"));
 }
 
-TEST_CASE("write_exr errors name the path: unwritable location, inconsistent image") {
+TEST_CASE("write_exr errors name the path: unwritable location - inconsistent image") {
   const fs::path bad = kTmp / "no_such_dir" / "out.exr";
   Error unwritable = error_of([&] { radiosity::write_exr(test_image(), bad); });
   CHECK(unwritable.code() == ErrorCode::io_error);
@@ -150,7 +150,7 @@ TEST_CASE("write_exr errors name the path: unwritable location, inconsistent ima
   CHECK(contains(size.what(), "wrong.exr"));
 }
 
-TEST_CASE("the sRGB curve is continuous, clamps and maps NaN to 0") {
+TEST_CASE("the sRGB curve is continuous - clamps and maps NaN to 0") {
   using radiosity::detail::srgb8;
   using radiosity::detail::srgb_encode;
   CHECK(srgb_encode(0.0f) == 0.0f);

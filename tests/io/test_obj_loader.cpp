@@ -57,7 +57,7 @@ bool near(const Rgb& a, const Rgb& b, float eps = 1e-5f) {
 
 TEST_SUITE("io") {
 
-TEST_CASE("two quads keep o/g names as groups, Kd as reflectance and pi*Ke as emission") {
+TEST_CASE("two quads keep o/g names as groups - Kd as reflectance and pi*Ke as emission") {
   radiosity::Scene s = radiosity::load_scene(kData / "two_quads.obj");
   REQUIRE(s.polygons().size() == 2);
   REQUIRE(s.groups().size() == 2);
@@ -83,7 +83,7 @@ TEST_CASE("two quads keep o/g names as groups, Kd as reflectance and pi*Ke as em
   CHECK(near(lamp.emission, kPi * Rgb(17, 12, 4), 1e-4f));
 }
 
-TEST_CASE("MTL Ks, Ns, illum, Tf and Ni map to specular, mirror and glass, and unknown materials get the default grey") {
+TEST_CASE("MTL Ks - Ns - illum - Tf and Ni map to specular - mirror and glass - and unknown materials get the default grey") {
   radiosity::Scene s = radiosity::load_scene(kData / "materials.obj");
   REQUIRE(s.polygons().size() == 6);
   REQUIRE(s.groups().size() == 1);
@@ -178,7 +178,7 @@ TEST_CASE("a missing OBJ file or an unsupported extension is an error naming the
   CHECK(contains(ext.what(), "'.gltf'"));
 }
 
-TEST_CASE("a missing MTL file is an error naming the OBJ, the mtllib line and the MTL") {
+TEST_CASE("a missing MTL file is an error naming the OBJ - the mtllib line and the MTL") {
   check_error(kData / "missing_mtl.obj", ErrorCode::file_not_found, "missing_mtl.obj", 3, "does_not_exist.mtl");
 }
 
@@ -210,7 +210,7 @@ TEST_CASE("a face with fewer than 3 vertices is an error naming file and line") 
   check_error(write_tmp("empty_face.obj", "v 0 0 0\nf\n"), ErrorCode::parse_error, "empty_face.obj", 2, "0 vertices");
 }
 
-TEST_CASE("a reflectance of 1 or more in an MTL is an error naming the MTL, its line and the material") {
+TEST_CASE("a reflectance of 1 or more in an MTL is an error naming the MTL - its line and the material") {
   check_error(kData / "kd_too_high.obj", ErrorCode::invalid_scene, "kd_too_high.mtl", 4, "'hot'");
   Error e = load_error(kData / "kd_too_high.obj");
   CHECK(contains(e.what(), "Kd"));
@@ -225,7 +225,7 @@ TEST_CASE("a reflectance of 1 or more in an MTL is an error naming the MTL, its 
               "ke_negative.mtl", 3, "Ke");
 }
 
-TEST_CASE("line numbers count comments, blank lines and CRLF or CR line ends") {
+TEST_CASE("line numbers count comments - blank lines and CRLF or CR line ends") {
   check_error(kData / "line_numbers.obj", ErrorCode::parse_error, "line_numbers.obj", 23, "'99'");
   std::ifstream in(kData / "line_numbers.obj", std::ios::binary);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

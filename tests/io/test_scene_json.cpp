@@ -209,7 +209,7 @@ TEST_CASE("JSON materials read every Material field and derive reflectance from 
   CHECK(scene.materials()[4].ior == defaults.ior);
 }
 
-TEST_CASE("JSON primitives, camera and an OBJ include build the expected polygons") {
+TEST_CASE("JSON primitives - camera and an OBJ include build the expected polygons") {
   const std::string doc = R"({
     "version": 1,
     "camera": {"eye": [0, 1, -5], "look_at": [0, 1, 0], "fov_deg": 50},
@@ -283,7 +283,7 @@ TEST_CASE("JSON bad values name the document path of the value") {
               ErrorCode::invalid_scene, "scene.json: camera: ");
 }
 
-TEST_CASE("JSON unknown keys, wrong types, missing fields and unknown names are errors") {
+TEST_CASE("JSON unknown keys - wrong types - missing fields and unknown names are errors") {
   // A misspelt key must not fall back to a default silently.
   check_error(with_materials(R"({"name": "m0", "reflectence": 0.3})"), ErrorCode::parse_error,
               "scene.json: materials[0].reflectence: unknown key (expected one of: name, emission");

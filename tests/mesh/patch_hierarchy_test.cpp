@@ -121,7 +121,7 @@ TEST_CASE("every leaf fits max_element_area and every patch fits max_patch_area 
   }
 }
 
-TEST_CASE("triangles, quads and a pentagon mesh into counter-clockwise cells of the polygon") {
+TEST_CASE("triangles - quads and a pentagon mesh into counter-clockwise cells of the polygon") {
   SUBCASE("a unit square with max_patch_area 0.25 is a 2x2 grid sharing 9 vertices") {
     const PatchHierarchy h(one_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}), MeshOptions{0.25f, 0.25f});
     CHECK(h.patches().size() == 4);
@@ -261,7 +261,7 @@ TEST_CASE("a constant field is reproduced exactly at every vertex") {
   for (const Rgb& v : h.vertex_values(values)) CHECK(v == c);
 }
 
-TEST_CASE("vertex values are continuous across T-vertices, nested ones included (abs 1e-5)") {
+TEST_CASE("vertex values are continuous across T-vertices - nested ones included (abs 1e-5)") {
   // Patch 1 of a 2x1 strip is refined twice along the shared edge x = 1, patch 0 not at all.
   PatchHierarchy h(one_polygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}}), MeshOptions{1.0f, 1.0f});
   const std::uint32_t first = h.subdivide(h.patches()[1].root);

@@ -149,7 +149,7 @@ void check_error_names(const rad::PathTraceOptions& o, const std::string& field)
 }  // namespace
 
 TEST_SUITE("path") {
-  TEST_CASE("inside a furnace every pixel converges to E/((1-rho) pi), per channel") {
+  TEST_CASE("inside a furnace every pixel converges to E/((1-rho) pi) - per channel") {
     // A closed box whose faces all emit E and reflect rho: L = E/pi sum_k rho^k = E/((1-rho) pi).
     // Every face is an emitter, so this exercises next-event estimation, the MIS-weighted emitter
     // hits and Russian roulette (rho = 0.75 keeps paths alive long after it starts).
@@ -293,7 +293,7 @@ TEST_SUITE("path") {
     CHECK(a.pixels != c.pixels);
   }
 
-  TEST_CASE("progress reaches 1 on the calling thread, and returning false cancels") {
+  TEST_CASE("progress reaches 1 on the calling thread - and returning false cancels") {
     rad::Scene scene = rad::cornell_box();
     rad::PathTraceOptions o;
     o.width = 8;

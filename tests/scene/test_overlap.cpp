@@ -93,7 +93,7 @@ TEST_SUITE("scene") {
     }
   }
 
-  TEST_CASE("coplanar quads overlapping by half, facing either way, are coincident") {
+  TEST_CASE("coplanar quads overlapping by half - facing either way - are coincident") {
     for (const Motion& m : kMotions) {
       for (const bool flip : {false, true}) {
         Builder b(m);
@@ -111,7 +111,7 @@ TEST_SUITE("scene") {
     }
   }
 
-  TEST_CASE("near-coplanar quads within the tolerance are coincident, a gap beyond it is allowed") {
+  TEST_CASE("near-coplanar quads within the tolerance are coincident - a gap beyond it is allowed") {
     // Scene diagonal ~6.1 (floor 4 x 4 in y = 0, squares up to y = 2.2): the tolerance is 2e-5 of
     // it, ~1.2e-4; the lifted copy reaches at most 8e-5, gaps of 3e-4 and more are real.
     for (const Motion& m : kMotions) {
@@ -153,7 +153,7 @@ TEST_SUITE("scene") {
     }
   }
 
-  TEST_CASE("a corner poking through a quad interpenetrates it, one stopping short does not") {
+  TEST_CASE("a corner poking through a quad interpenetrates it - one stopping short does not") {
     for (const Motion& m : kMotions) {
       for (const float tip : {0.05f, -0.01f}) {
         Builder b(m);
@@ -171,7 +171,7 @@ TEST_SUITE("scene") {
     }
   }
 
-  TEST_CASE("a box sunk into the floor interpenetrates it with each side, one standing on it passes") {
+  TEST_CASE("a box sunk into the floor interpenetrates it with each side - one standing on it passes") {
     for (const Motion& m : kMotions) {
       Builder sunk(m);
       sunk.floor();
@@ -210,7 +210,7 @@ TEST_SUITE("scene") {
     }
   }
 
-  TEST_CASE("shared edges, shared corners, T-junctions and a corner of three walls pass") {
+  TEST_CASE("shared edges - shared corners - T-junctions and a corner of three walls pass") {
     for (const Motion& m : kMotions) {
       Builder b(m);
       b.add(square(0, 0, 1), "a");                                  // neighbours sharing edges
@@ -227,7 +227,7 @@ TEST_SUITE("scene") {
     }
   }
 
-  TEST_CASE("a triangulated non-convex polygon, closed boxes and the Cornell box pass") {
+  TEST_CASE("a triangulated non-convex polygon - closed boxes and the Cornell box pass") {
     rad::Scene s;
     const rad::MaterialId id = s.add_material({});
     const rad::PolygonRange r = s.add_polygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}}, id, "L");

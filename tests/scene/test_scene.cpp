@@ -29,7 +29,7 @@ rad::Error capture(F&& f) {
 }  // namespace
 
 TEST_SUITE("scene") {
-  TEST_CASE("a quad keeps its vertices, right-hand normal and area") {
+  TEST_CASE("a quad keeps its vertices - right-hand normal and area") {
     rad::Scene s;
     auto m = s.add_material({});
     auto r = s.add_polygon({{0, 0, 0}, {2, 0, 0}, {2, 3, 0}, {0, 3, 0}}, m, "wall");
@@ -75,7 +75,7 @@ TEST_SUITE("scene") {
     CHECK(s.warnings()[0].find("non-planar") != std::string::npos);
   }
 
-  TEST_CASE("NaN, infinite and degenerate polygons are rejected with a message naming the problem") {
+  TEST_CASE("NaN - infinite and degenerate polygons are rejected with a message naming the problem") {
     rad::Scene s;
     auto m = s.add_material({});
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
@@ -94,7 +94,7 @@ TEST_SUITE("scene") {
     CHECK(s.polygons().empty());
   }
 
-  TEST_CASE("reflectance of 1 or more, negative emission and NaN are rejected naming the material") {
+  TEST_CASE("reflectance of 1 or more - negative emission and NaN are rejected naming the material") {
     rad::Scene s;
     rad::Material m;
     m.name = "bright";
@@ -117,7 +117,7 @@ TEST_SUITE("scene") {
     CHECK(s.materials().empty());
   }
 
-  TEST_CASE("the built-in Cornell box has the published camera, groups and materials") {
+  TEST_CASE("the built-in Cornell box has the published camera - groups and materials") {
     rad::Scene s = rad::cornell_box();
     rad::Camera c = s.camera();
     CHECK(c.eye.x == doctest::Approx(278));

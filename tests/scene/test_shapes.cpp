@@ -69,7 +69,7 @@ TEST_CASE("add_quad faces edge_u x edge_v with the area of that cross product") 
   CHECK_THROWS_AS(rad::add_quad(scene, {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, m), rad::Error);
 }
 
-TEST_CASE("add_box makes six outward quads enclosing the box volume, also under a mirroring transform") {
+TEST_CASE("add_box makes six outward quads enclosing the box volume - also under a mirroring transform") {
   rad::Scene scene;
   const rad::MaterialId m = scene.add_material(rad::Material{});
   const glm::vec3 lo(-1, 0, 2), hi(1, 3, 2.5f);
@@ -96,7 +96,7 @@ TEST_CASE("add_box makes six outward quads enclosing the box volume, also under 
   CHECK(glm::length(t.weighted_normal) < 1e-5 * t.area);
 }
 
-TEST_CASE("add_box rejects empty bounds and singular, non-affine or non-finite transforms") {
+TEST_CASE("add_box rejects empty bounds and singular - non-affine or non-finite transforms") {
   rad::Scene scene;
   const rad::MaterialId m = scene.add_material(rad::Material{});
   CHECK_THROWS_WITH_AS(rad::add_box(scene, {0, 0, 0}, {1, 0, 1}, m), doctest::Contains("lower must be below upper"),
@@ -157,7 +157,7 @@ TEST_CASE("add_sphere area converges to 4 pi r^2 from below as 1 over segments s
   }
 }
 
-TEST_CASE("add_sphere validates segments, radius and centre naming the argument") {
+TEST_CASE("add_sphere validates segments - radius and centre naming the argument") {
   rad::Scene scene;
   const rad::MaterialId m = scene.add_material(rad::Material{});
   CHECK_THROWS_WITH_AS(rad::add_sphere(scene, {0, 0, 0}, 1.0f, m, "s", 3), doctest::Contains("segments"), rad::Error);

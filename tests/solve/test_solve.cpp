@@ -50,7 +50,7 @@ TEST_SUITE("solve") {
     }
   }
 
-  TEST_CASE("Jacobi, Gauss-Seidel and progressive agree on the Cornell box within 0.5%") {
+  TEST_CASE("Jacobi - Gauss-Seidel and progressive agree on the Cornell box within 0.5%") {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;
     o.mesh.max_patch_area = 12000.0f;
@@ -77,7 +77,7 @@ TEST_SUITE("solve") {
     }
   }
 
-  TEST_CASE("open Cornell box: emitted power = absorbed + escaped, with escape through the open front") {
+  TEST_CASE("open Cornell box: emitted power = absorbed + escaped - with escape through the open front") {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;
     o.mesh.max_patch_area = 20000.0f;
@@ -143,7 +143,7 @@ TEST_SUITE("solve") {
     CHECK_THROWS_AS(rad::solve(rad::Scene{}, rad::SolveOptions{}), rad::Error);
   }
 
-  TEST_CASE("a matrix larger than the memory budget is refused with advice, not allocated") {
+  TEST_CASE("a matrix larger than the memory budget is refused with advice - not allocated") {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;
     o.memory_budget_bytes = 1024;
