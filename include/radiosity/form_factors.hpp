@@ -31,8 +31,9 @@ enum class FormFactorMethod {
   analytic,
   /// Monte Carlo ray shooting: from each element, hemisphere_rays cosine-distributed rays leave
   /// stratified points, and F(e -> j) is the fraction that first hits patch j's front. Factors
-  /// to emitting patches, whose noise would show as blotchy direct light, are ray_cast's
-  /// accurate ones instead. Rows are sparse (at most hemisphere_rays entries plus the emitting
+  /// to emitting patches, whose noise would show as blotchy direct light, are computed apart:
+  /// the exact unoccluded factor times the element's visible fraction of the emitting polygon
+  /// (shadow rays). Rows are sparse (at most hemisphere_rays entries plus the emitting
   /// patches), so time and memory grow as elements x rays instead of elements x patches: the
   /// method for meshes of thousands of patches and more. Unbiased; a row's sum is exact in a
   /// closed enclosure, an entry's relative noise is about sqrt((1 - F) / (F hemisphere_rays)).
