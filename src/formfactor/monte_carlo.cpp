@@ -45,6 +45,7 @@
 #include "radiosity/brdf.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
+#include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "scene/specular_transport.hpp"
 
@@ -289,32 +290,14 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     std::vector<std::uint32_t> patch, polygon;  ///< per triangle
   };
 
-  /// An emitting polygon, as a target of shadow rays: area-uniform points from a fan of triangles.
+  /// An emitting polygon, as a target of shadow rays.
   struct Light {
     Light(PolygonId polygon_id, const Polygon& source)
-        : polygon(polygon_id), vertices(source.vertices), normal(source.normal) {
-      double total = 0.0;
-      for (std::size_t k = 1; k + 1 < vertices.size(); ++k) {
-        total += 0.5 * glm::length(glm::cross(vertices[k] - vertices[0], vertices[k + 1] - vertices[0]));
-        cdf.push_back(static_cast<float>(total));
-      }
-      for (float& c : cdf) c = static_cast<float>(c / total);
-      cdf.back() = 1.0f;
-    }
-    /// Area-uniform for u uniform; the first coordinate picks the triangle and is then rescaled,
-    /// so strata of u stay compact.
-    glm::vec3 sample(glm::vec2 u) const {
-      const std::size_t t = std::min<std::size_t>(
-          static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin()), cdf.size() - 1);
-      const float lo = t == 0 ? 0.0f : cdf[t - 1];
-      const float a = std::clamp((u.x - lo) / std::max(cdf[t] - lo, 1e-12f), 0.0f, 1.0f);
-      const float su = std::sqrt(a);
-      return (1.0f - su) * vertices[0] + (su * (1.0f - u.y)) * vertices[t + 1] + (su * u.y) * vertices[t + 2];
-    }
+        : polygon(polygon_id), vertices(source.vertices), normal(source.normal), fan(source.vertices) {}
     PolygonId polygon;
     std::vector<glm::vec3> vertices;
     glm::vec3 normal;
-    std::vector<float> cdf;  ///< cumulative area fraction of the fan's triangles
+    PolygonFan fan;  ///< area-uniform points, strata kept
   };
 
   /// F(e -> emitting patch) for each element: unoccluded factor times the element's visible
@@ -373,7 +356,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       for (std::uint32_t i = count; i > 1; --i) std::swap(to[i - 1], to[rng.next() % i]);
       for (std::uint32_t r = 0; r < count; ++r) {
         const glm::vec3 x = sampler(from[r]) + epsilon_ * patch.normal;
-        const glm::vec3 d = (L.sample(to[r]) + epsilon_ * L.normal) - x;
+        const glm::vec3 d = (L.fan.sample(to[r]) + epsilon_ * L.normal) - x;
         const float r2 = glm::dot(d, d);
         if (!(r2 > 0.0f)) continue;
         const float w = std::max(0.0f, glm::dot(d, patch.normal)) * std::max(0.0f, -glm::dot(d, L.normal)) / (r2 * r2);

@@ -29,6 +29,7 @@
 
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
+#include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/brdf.hpp"
 #include "render/camera.hpp"
@@ -59,12 +60,6 @@ float max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 float power_heuristic(float pdf_this, float pdf_other) {
   const float a = pdf_this * pdf_this, b = pdf_other * pdf_other;
   return a / (a + b);
-}
-
-/// Index i with cdf[i-1] <= u < cdf[i] in a normalised cumulative table (last entry 1).
-std::size_t sample_cdf(const std::vector<float>& cdf, float u) {
-  auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
-  return std::min(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
 }
 
 /// The surfaces as the tracer needs them, indexed by polygon id (= RayScene hit id).
@@ -105,8 +100,7 @@ struct Shading {
 /// An emitting polygon, fan-triangulated for uniform area sampling.
 struct Emitter {
   std::uint32_t polygon = 0;
-  std::vector<glm::vec3> a, b, c;  ///< the fan's triangles
-  std::vector<float> cdf;          ///< over the triangles, by area
+  detail::PolygonFan fan;
 };
 
 /// A polygon whose material is a plain one-sided ideal mirror (specular only, exponent 0), for
@@ -152,20 +146,7 @@ class PathTracer {
       }
       const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;
       if (!(power > 0.0)) continue;
-      Emitter e;
-      e.polygon = static_cast<std::uint32_t>(p);
-      float area = 0.0f;
-      for (std::size_t k = 1; k + 1 < poly.vertices.size(); ++k) {
-        e.a.push_back(poly.vertices[0]);
-        e.b.push_back(poly.vertices[k]);
-        e.c.push_back(poly.vertices[k + 1]);
-        const glm::vec3 edge_b = poly.vertices[k] - poly.vertices[0], edge_c = poly.vertices[k + 1] - poly.vertices[0];
-        area += 0.5f * glm::length(glm::cross(edge_b, edge_c));
-        e.cdf.push_back(area);
-      }
-      for (float& v : e.cdf) v /= area;
-      e.cdf.back() = 1.0f;
-      emitters_.push_back(std::move(e));
+      emitters_.push_back(Emitter{static_cast<std::uint32_t>(p), detail::PolygonFan(poly.vertices)});
       emitter_power_.push_back(power);
       total_power += power;
     }
@@ -449,12 +430,9 @@ class PathTracer {
 
   /// A uniform point on an emitter chosen by power, and that emitter.
   const Surface& sample_light(detail::Rng& rng, glm::vec3& y) const {
-    const Emitter& e = emitters_[sample_cdf(emitter_cdf_, rng.uniform())];
-    const std::size_t tri = sample_cdf(e.cdf, rng.uniform());
-    // Uniform point in a triangle: barycentrics (1 - sqrt(u1), u2 sqrt(u1)).
-    const glm::vec2 u = rng.uniform2();
-    const float su = std::sqrt(u.x);
-    y = (1.0f - su) * e.a[tri] + (u.y * su) * e.b[tri] + (su * (1.0f - u.y)) * e.c[tri];
+    const Emitter& e = emitters_[detail::sample_cdf(emitter_cdf_, rng.uniform())];
+    const std::size_t tri = e.fan.triangle(rng.uniform());
+    y = e.fan.point(tri, rng.uniform2());
     return surfaces_[e.polygon];
   }
 

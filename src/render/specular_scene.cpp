@@ -24,11 +24,6 @@ namespace {
 
 float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
-std::size_t sample_cdf(const std::vector<float>& cdf, float u) {
-  auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
-  return std::min(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
-}
-
 }  // namespace
 
 SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy)
@@ -81,16 +76,7 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
     emitted_power_ += m.emission * poly.area;
     Emitter e;
     e.polygon = static_cast<std::uint32_t>(p);
-    float area = 0.0f;
-    for (std::size_t k = 1; k + 1 < poly.vertices.size(); ++k) {
-      e.a.push_back(poly.vertices[0]);
-      e.b.push_back(poly.vertices[k]);
-      e.c.push_back(poly.vertices[k + 1]);
-      area += 0.5f * glm::length(glm::cross(poly.vertices[k] - poly.vertices[0], poly.vertices[k + 1] - poly.vertices[0]));
-      e.cdf.push_back(area);
-    }
-    for (float& v : e.cdf) v /= area;
-    e.cdf.back() = 1.0f;
+    e.fan = PolygonFan(poly.vertices);
     emitters_.push_back(std::move(e));
     powers.push_back(power);
     total_power += power;
@@ -112,16 +98,9 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
 
 EmitterSample SpecularScene::sample_emitter(float u_emitter, const glm::vec2& u_point) const {
   const Emitter& e = emitters_[sample_cdf(emitter_cdf_, u_emitter)];
-  const std::size_t tri = sample_cdf(e.cdf, u_point.x);
-  // Reuse u_point.x inside the chosen triangle's slice of the cdf, so one number picks the
-  // triangle and drives the point (keeps stratification).
-  const float lo = tri == 0 ? 0.0f : e.cdf[tri - 1], hi = e.cdf[tri];
-  const float ux = hi > lo ? std::min((u_point.x - lo) / (hi - lo), 0x1.fffffep-1f) : 0.5f;
-  // Uniform point in a triangle: barycentrics (1 - sqrt(u1), u2 sqrt(u1)).
-  const float su = std::sqrt(std::max(ux, 0.0f));
   const SplitSurface& s = surfaces_[e.polygon];
   EmitterSample out;
-  out.position = (1.0f - su) * e.a[tri] + (u_point.y * su) * e.b[tri] + (su * (1.0f - u_point.y)) * e.c[tri];
+  out.position = e.fan.sample(u_point);  // u_point.x picks the triangle and drives the point
   out.normal = s.normal;
   out.emission = s.emission;
   out.pdf_area = e.pdf_area;

@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/brdf.hpp"
 #include "radiosity/common.hpp"
@@ -83,8 +84,7 @@ class SpecularScene {
 
   struct Emitter {
     std::uint32_t polygon = 0;
-    std::vector<glm::vec3> a, b, c;  ///< the fan's triangles
-    std::vector<float> cdf;          ///< over the triangles, by area
+    PolygonFan fan;
     float pdf_area = 0.0f;
   };
 
