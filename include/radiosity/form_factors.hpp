@@ -72,6 +72,15 @@ struct FormFactorOptions {
   /// specular parts are ignored and every polygon is opaque. Glossy lobes are not carried. In
   /// [0, 16].
   std::uint32_t specular_depth = 0;
+  /// Monte Carlo only: diffuse transmission (Rushmeier & Torrance 1990). A patch whose
+  /// material has diffuse_transmittance > 0 is translucent: a thin sheet with two sides. Its
+  /// back becomes a second target, numbered patch count + k for the k-th translucent patch
+  /// (FormFactorEstimator::translucent_patches()), which sparse rows and columns then report,
+  /// and its elements get a second row over the back hemisphere (sparse_back_rows(): Rushmeier's
+  /// backward form factors). The dense calls (element_rows(), patch_column()) keep to the
+  /// fronts of patches. solve() sets this when the scene has a translucent material. false =
+  /// every polygon is opaque and sees nothing behind it.
+  bool diffuse_transmission = false;
   /// Seeds every random stream (ray-cast samples, hemicube orientations).
   std::uint64_t seed = 1;
   unsigned threads = 0;  ///< 0 = all hardware threads; 1 = the calling thread only
@@ -106,12 +115,16 @@ class RADIOSITY_API FormFactorEstimator {
                             float* out) const = 0;
 
   /// element_rows() with only the non-zero entries: out[k] (resized to elements.size()) is the
-  /// row of elements[k], indexed by patch id. The default compresses dense rows computed a few
-  /// hundred at a time.
+  /// row of elements[k], indexed by patch id (and, with diffuse transmission, by target: the
+  /// backs of translucent patches follow the patches). The default compresses dense rows
+  /// computed a few hundred at a time.
   virtual void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const;
 
   /// patch_column() with only the non-zero entries, indexed by position in `elements`. The
-  /// default compresses the dense column.
+  /// default compresses the dense column. With diffuse transmission `patch` may be any target
+  /// (>= the patch count: the back of a translucent patch), and arrivals at the backs of
+  /// translucent elements are reported too: index k < elements.size() is the front of
+  /// elements[k], elements.size() + k its back.
   virtual void sparse_patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                                    SparseFactors& out) const;
 
@@ -127,13 +140,28 @@ class RADIOSITY_API FormFactorEstimator {
   /// An upper bound of the non-zero entries of any row; the patch count for dense estimators.
   virtual std::size_t max_row_entries() const;
 
+  /// With FormFactorOptions::diffuse_transmission: the translucent patches, increasing; the
+  /// back of translucent_patches()[k] is target patch count + k. Empty otherwise.
+  const std::vector<std::uint32_t>& translucent_patches() const { return translucent_; }
+  /// Patches plus the backs of translucent patches: the index range of a sparse row.
+  std::size_t target_count() const { return patch_count_ + translucent_.size(); }
+
+  /// F(back of element -> target) for elements of translucent patches: the fraction of the
+  /// energy leaving the element's back side (a Lambertian emitter facing -normal) that
+  /// arrives at each target, indexed like sparse_element_rows(). Throws Error{invalid_argument}
+  /// for an estimator without diffuse transmission or an element of an opaque patch.
+  virtual void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const;
+
  protected:
   /// `patch_count`: the patches of the hierarchy, the length of a dense row.
   explicit FormFactorEstimator(std::size_t patch_count) : patch_count_(patch_count) {}
   std::size_t patch_count() const { return patch_count_; }
+  /// Declares the translucent patches (increasing), for estimators with diffuse transmission.
+  void set_translucent_patches(std::vector<std::uint32_t> patches) { translucent_ = std::move(patches); }
 
  private:
   std::size_t patch_count_;
+  std::vector<std::uint32_t> translucent_;
 };
 
 /// Makes the estimator named by options.method. The scene and hierarchy must outlive it.

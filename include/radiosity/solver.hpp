@@ -84,11 +84,13 @@ struct SolveReport {
 class RADIOSITY_API Solution {
  public:
   Solution() = default;
-  /// `radiosity` and `ambient_radiosity` are indexed by element id (inner nodes included);
-  /// `ambient_radiosity` is reflectance x ambient per element, or empty for none.
+  /// `radiosity`, `ambient_radiosity` and `back_radiosity` are indexed by element id (inner
+  /// nodes included); `ambient_radiosity` is reflectance x ambient per element, or empty for
+  /// none; `back_radiosity` is the radiosity leaving the backs of translucent elements (0
+  /// elsewhere), or empty when the scene has no translucent material.
   Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
            SolveStatus status, SolveReport report, Rgb ambient = Rgb(0.0f),
-           std::vector<Rgb> ambient_radiosity = {});
+           std::vector<Rgb> ambient_radiosity = {}, std::vector<Rgb> back_radiosity = {});
   Solution(Solution&&) noexcept = default;
   Solution& operator=(Solution&&) noexcept = default;
   Solution(const Solution&) = delete;
@@ -97,8 +99,16 @@ class RADIOSITY_API Solution {
   SolveStatus status() const { return status_; }
   const SolveReport& report() const { return report_; }
   const PatchHierarchy& hierarchy() const { return hierarchy_; }
-  /// Radiosity B (W/m^2) per element id; inner nodes hold the area-weighted mean of their children.
+  /// Radiosity B (W/m^2) per element id; inner nodes hold the area-weighted mean of their
+  /// children. This is the front side's; a translucent element (Material::diffuse_transmittance)
+  /// includes what its back receives and transmits.
   const std::vector<Rgb>& radiosity() const { return radiosity_; }
+  /// Diffuse transmission: the radiosity leaving the back side of each element id, tau times
+  /// what the front receives (plus what the back reflects for a two-sided material); 0 for
+  /// opaque elements. Empty when the scene has no translucent material: every back is black.
+  const std::vector<Rgb>& back_radiosity() const { return back_radiosity_; }
+  /// back_radiosity() per vertex for display (empty when it is empty); no ambient term.
+  std::vector<Rgb> vertex_back_radiosity() const;
   Rgb patch_radiosity(std::uint32_t patch) const;
   /// The ambient radiosity of progressive refinement (Cohen et al. 1988): the unshot radiosity
   /// that remained, times the mean interreflection factor 1 / (1 - mean reflectance). Zero
@@ -126,6 +136,7 @@ class RADIOSITY_API Solution {
   SolveReport report_;
   Rgb ambient_{0.0f};
   std::vector<Rgb> ambient_radiosity_;
+  std::vector<Rgb> back_radiosity_;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field.

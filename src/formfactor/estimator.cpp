@@ -26,6 +26,9 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   if (o.specular_depth > 0 && o.method != FormFactorMethod::monte_carlo)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth > 0 (mirror and window form factors) needs FormFactorMethod::monte_carlo");
+  if (o.diffuse_transmission && o.method != FormFactorMethod::monte_carlo)
+    throw Error(ErrorCode::invalid_argument,
+                "form_factors.diffuse_transmission (translucent materials) needs FormFactorMethod::monte_carlo");
   return o;
 }
 
@@ -76,6 +79,12 @@ void FormFactorEstimator::sparse_patch_columns(const std::vector<std::uint32_t>&
                                                std::vector<SparseFactors>& out) const {
   out.assign(patches.size(), SparseFactors{});
   for (std::size_t k = 0; k < patches.size(); ++k) sparse_patch_column(patches[k], elements, out[k]);
+}
+
+void FormFactorEstimator::sparse_back_rows(const std::vector<std::uint32_t>&, std::vector<SparseFactors>&) const {
+  throw Error(ErrorCode::invalid_argument,
+              "sparse_back_rows: this estimator has no diffuse transmission (FormFactorOptions::diffuse_transmission "
+              "with FormFactorMethod::monte_carlo)");
 }
 
 bool FormFactorEstimator::sparse() const { return false; }

@@ -141,7 +141,17 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       specular_[p].glass = pass1_glass(m);
       specular_[p].ior = m.ior;
     }
-    exact_.assign(patches.size(), 0);
+    back_target_.assign(patches.size(), kNone);
+    if (options.diffuse_transmission) {
+      std::vector<std::uint32_t> translucent;
+      for (std::uint32_t j = 0; j < patches.size(); ++j)
+        if (pass1_translucent(scene.material(polygons[patches[j].polygon].material))) {
+          back_target_[j] = static_cast<std::uint32_t>(patches.size() + translucent.size());
+          translucent.push_back(j);
+        }
+      set_translucent_patches(std::move(translucent));
+    }
+    exact_.assign(target_count(), 0);  // backs never emit
     emitter_of_.assign(patches.size(), kNone);
     std::vector<std::uint32_t> polygon_slot(polygons.size(), kNone);
     for (std::uint32_t j = 0; j < patches.size(); ++j) {
@@ -184,7 +194,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     // One parallel loop does everything for a run of elements; the analytic estimator used
     // inside is single-threaded, so no nested parallel region is opened per emitting patch.
     parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
-      HitCounter counter(hierarchy_.patches().size());
+      HitCounter counter(target_count());
       Scratch scratch(N);
       std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
                                              elements.begin() + static_cast<std::ptrdiff_t>(end));
@@ -212,7 +222,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         const Element& el = hierarchy_.element(e);
         const Patch& source = hierarchy_.patches()[el.patch];
         Rng rng(options_.seed, e, 0x300000000ull);
-        shoot(*rays, e, source, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
+        shoot(*rays, e, source, false, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
           // Emitting patches reached directly are in the exact part, through glass in the photon map.
           if (!exact_[j] || path == Path::specular) counter.add(j, w);
         });
@@ -224,27 +234,63 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     });
   }
 
+  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
+    for (std::uint32_t e : elements)
+      if (e >= hierarchy_.elements().size() || back_target_[hierarchy_.element(e).patch] == kNone)
+        throw Error(ErrorCode::invalid_argument, "sparse_back_rows: element " + std::to_string(e) +
+                                                     " is not an element of a translucent patch");
+    const std::size_t m = elements.size();
+    out.assign(m, SparseFactors{});
+    const std::shared_ptr<const LeafRays> rays = leaf_scene();
+    const std::uint32_t N = options_.hemisphere_rays;
+    const float per_ray = 1.0f / static_cast<float>(N);
+    // All by rays, emitters too (no exact part: the analytic factors are for fronts). Light of
+    // an emitter through glass stays the photon map's, as in the front rows.
+    parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
+      HitCounter counter(target_count());
+      Scratch scratch(N);
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::uint32_t e = elements[k];
+        const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
+        Rng rng(options_.seed, e, 0x600000000ull);
+        shoot(*rays, e, source, true, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
+          if (!exact_[j] || path != Path::glass) counter.add(j, w);
+        });
+        counter.drain(out[k].index, out[k].value, [&](std::uint32_t, float c) { return c * per_ray; });
+      }
+    });
+  }
+
+  /// Dense rows keep to the fronts of patches (FormFactorOptions::diffuse_transmission).
   void element_rows(const std::vector<std::uint32_t>& elements, float* out) const override {
     const std::size_t n = hierarchy_.patches().size();
     std::fill(out, out + elements.size() * n, 0.0f);
     std::vector<SparseFactors> rows;
     sparse_element_rows(elements, rows);
     for (std::size_t k = 0; k < rows.size(); ++k)
-      for (std::size_t i = 0; i < rows[k].index.size(); ++i) out[k * n + rows[k].index[i]] = rows[k].value[i];
+      for (std::size_t i = 0; i < rows[k].index.size() && rows[k].index[i] < n; ++i)
+        out[k * n + rows[k].index[i]] = rows[k].value[i];
   }
 
   void sparse_patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                            SparseFactors& out) const override {
     out.index.clear();
     out.value.clear();
+    if (patch >= target_count())
+      throw Error(ErrorCode::invalid_argument, "sparse_patch_column: target " + std::to_string(patch) +
+                                                   " out of range (" + std::to_string(target_count()) + " targets)");
     if (exact_[patch]) {
       std::vector<float> column(elements.size());
-      emitter_column(patch, elements, column.data());
+      SparseFactors backs;
+      emitter_column(patch, elements, column.data(), &backs);
       for (std::size_t k = 0; k < column.size(); ++k)
         if (column[k] > 0.0f) {
           out.index.push_back(static_cast<std::uint32_t>(k));
           out.value.push_back(column[k]);
         }
+      // Arrivals at backs: indices past the fronts, already increasing.
+      out.index.insert(out.index.end(), backs.index.begin(), backs.index.end());
+      out.value.insert(out.value.end(), backs.value.begin(), backs.value.end());
       return;
     }
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
@@ -271,15 +317,17 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     });
   }
 
+  /// Dense columns keep to patches and to the fronts of elements.
   void patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
     if (exact_[patch]) {
-      emitter_column(patch, elements, out);
+      emitter_column(patch, elements, out, nullptr);
       return;
     }
     SparseFactors column;
     sparse_patch_column(patch, elements, column);
     std::fill(out, out + elements.size(), 0.0f);
-    for (std::size_t i = 0; i < column.index.size(); ++i) out[column.index[i]] = column.value[i];
+    for (std::size_t i = 0; i < column.index.size() && column.index[i] < elements.size(); ++i)
+      out[column.index[i]] = column.value[i];
   }
 
  private:
@@ -288,6 +336,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   struct LeafRays {
     RayScene scene;
     std::vector<std::uint32_t> patch, polygon;  ///< per triangle
+    std::vector<std::uint32_t> back;            ///< per triangle: its patch's back target, or kNone
   };
 
   /// An emitting polygon, as a target of shadow rays.
@@ -301,8 +350,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   };
 
   /// F(e -> emitting patch) for each element: unoccluded factor times the element's visible
-  /// fraction of the patch's polygon, the latter kept per element for later columns.
-  void emitter_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
+  /// fraction of the patch's polygon, the latter kept per element for later columns. With
+  /// `backs`, the arrivals at the backs of translucent elements (found by the shot) are
+  /// appended to it as sparse entries (indices elements.size() + k).
+  void emitter_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out,
+                      SparseFactors* backs) const {
     analytic_->patch_column(patch, elements, out);
     const std::uint32_t light = emitter_of_[patch];
     {
@@ -318,12 +370,20 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         }
       });
     }
-    if (specular_depth_ > 0) {
-      // What the patch sends through mirrors and windows is shot like any other patch's.
+    if (specular_depth_ > 0 || !translucent_patches().empty()) {
+      // What the patch sends through mirrors and windows, and onto the backs of translucent
+      // elements, is shot like any other patch's.
       SparseFactors extra;
       const std::shared_ptr<const LeafRays> rays = leaf_scene();
       shot_column(patch, elements, positions(elements), *rays, options_.threads, true, extra);
-      for (std::size_t i = 0; i < extra.index.size(); ++i) out[extra.index[i]] += extra.value[i];
+      for (std::size_t i = 0; i < extra.index.size(); ++i) {
+        if (extra.index[i] < elements.size()) {
+          out[extra.index[i]] += extra.value[i];
+        } else if (backs) {
+          backs->index.push_back(extra.index[i]);
+          backs->value.push_back(extra.value[i]);
+        }
+      }
     }
   }
 
@@ -380,16 +440,20 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     return position;
   }
 
-  /// The column of a non-emitting patch, shot from it: as many rays as its elements would shoot
-  /// for their rows, in chunks with their own random streams (on up to `threads` threads); the
-  /// counts are integers, so the result does not depend on the thread count.
-  /// `emitter`: only arrivals through mirrors and windows count (an emitting patch's direct
-  /// factors are computed exactly, its light through glass is the photon map's).
-  void shot_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
+  /// The column of a non-emitting target, shot from it (from the back of a translucent patch
+  /// for a back target): as many rays as its elements would shoot for their rows, in chunks with
+  /// their own random streams (on up to `threads` threads); the sums do not depend on the thread
+  /// count. Arrivals at the back of elements[k] are entry elements.size() + k.
+  /// `emitter`: arrivals at fronts count only through mirrors and windows (an emitting patch's
+  /// direct factors are computed exactly), and none through glass (the photon map's).
+  void shot_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
                    const std::vector<std::uint32_t>& position, const LeafRays& rays, unsigned threads,
                    bool emitter, SparseFactors& out) const {
     out.index.clear();
     out.value.clear();
+    const std::size_t n = hierarchy_.patches().size();
+    const bool back = target >= n;
+    const std::uint32_t patch = back ? translucent_patches()[target - n] : target;
     const Patch& source = hierarchy_.patches()[patch];
     const std::uint32_t root = source.root;
     const std::uint64_t total = std::uint64_t{options_.hemisphere_rays} * leaves_under(root);
@@ -400,18 +464,23 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       Scratch scratch(kChunk);
       for (std::size_t c = begin; c < end; ++c) {
         const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
-        Rng rng(options_.seed, patch, 0x400000000ull + c);
-        shoot(rays, root, source, count, rng, scratch, [&](std::uint32_t leaf, std::uint32_t, float w, Path path) {
-          if (position[leaf] != kNone && (!emitter || path == Path::specular)) hits[c].emplace_back(position[leaf], w);
-        });
+        Rng rng(options_.seed, target, 0x400000000ull + c);
+        shoot(rays, root, source, back, count, rng, scratch,
+              [&](std::uint32_t leaf, std::uint32_t j, float w, Path path) {
+                if (position[leaf] == kNone) return;
+                const bool at_back = j >= n;
+                if (emitter && (path == Path::glass || (!at_back && path != Path::specular))) return;
+                hits[c].emplace_back(static_cast<std::uint32_t>(position[leaf] + (at_back ? elements.size() : 0)), w);
+              });
       }
     });
-    HitCounter counter(elements.size());
+    const std::size_t m = elements.size();
+    HitCounter counter(translucent_patches().empty() ? m : 2 * m);
     for (const auto& h : hits)
       for (const auto& [k, w] : h) counter.add(k, w);
     const double scale = static_cast<double>(source.area) / static_cast<double>(total);
     counter.drain(out.index, out.value, [&](std::uint32_t k, float c) {
-      return static_cast<float>(scale * c / static_cast<double>(hierarchy_.element(elements[k]).area));
+      return static_cast<float>(scale * c / static_cast<double>(hierarchy_.element(elements[k % m]).area));
     });
   }
 
@@ -429,8 +498,10 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   };
 
   /// Casts `count` cosine-distributed rays from stratified points of element `from` (of patch
-  /// `source`) and calls hit(leaf, patch, weight, path) for each diffuse arrival: a ray that
-  /// hits the front of another polygon's element arrives with weight 1 by Path::direct.
+  /// `source`; from its back side when `back`) and calls hit(leaf, target, weight, path) for
+  /// each diffuse arrival: a ray that hits the front of another polygon's element arrives at its
+  /// patch with weight 1 by Path::direct; one that hits the back of a translucent polygon's
+  /// element arrives at that patch's back target (>= the patch count).
   /// With FormFactorOptions::specular_depth > 0 (extended form factors) a ray also goes on
   /// after a surface's diffuse part has counted it: reflected by an ideal mirror (times the
   /// mirror's mean specular reflectance, at most specular_depth reflections), straight through
@@ -439,7 +510,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   /// Wallace, Cohen & Greenberg's mirror and window form factors, traced instead of built from
   /// virtual mirror worlds (for a planar mirror the reflected ray is the ray to the virtual image).
   template <typename Hit>
-  void shoot(const LeafRays& rays, std::uint32_t from, const Patch& source, std::uint32_t count, Rng& rng,
+  void shoot(const LeafRays& rays, std::uint32_t from, const Patch& source, bool back, std::uint32_t count, Rng& rng,
              Scratch& scratch, const Hit& hit) const {
     if (scratch.points.size() < count) scratch = Scratch(count);
     stratified(count, rng, true, scratch.points.data());
@@ -447,7 +518,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     // Pair point strata with direction strata at random, so the 4D samples are stratified in
     // each 2D projection (a Latin-hypercube-like padding).
     for (std::uint32_t i = count; i > 1; --i) std::swap(scratch.directions[i - 1], scratch.directions[rng.next() % i]);
-    const glm::vec3 n = source.normal;
+    const glm::vec3 n = back ? -source.normal : source.normal;
     glm::vec3 t, b;
     tangents(n, t, b);
     const Element& el = hierarchy_.element(from);
@@ -472,8 +543,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       // source's own plane is rounding. (Per-triangle arrays and Embree's normal, because the
       // hierarchy's structs would be cache misses.)
       if (specular_depth_ == 0) {
-        if (glm::dot(w, h->geometric_normal) >= 0.0f || rays.polygon[h->triangle] == source.polygon) continue;
-        hit(h->id, rays.patch[h->triangle], 1.0f, Path::direct);
+        if (rays.polygon[h->triangle] == source.polygon) continue;
+        if (glm::dot(w, h->geometric_normal) < 0.0f)
+          hit(h->id, rays.patch[h->triangle], 1.0f, Path::direct);
+        else if (rays.back[h->triangle] != kNone)
+          hit(h->id, rays.back[h->triangle], 1.0f, Path::direct);
         continue;
       }
       float weight = 1.0f;
@@ -488,7 +562,10 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         // A ray cannot meet the plane it left (the source's, or the mirror's or pane's it just
         // passed): such a hit is rounding.
         if (polygon == last) break;
-        if (front) hit(h->id, rays.patch[h->triangle], weight, path);
+        if (front)
+          hit(h->id, rays.patch[h->triangle], weight, path);
+        else if (rays.back[h->triangle] != kNone)
+          hit(h->id, rays.back[h->triangle], weight, path);
         const glm::vec3 p = x + h->t * w;
         if (front && surface.mirror > 0.0f && mirrors < specular_depth_) {
           w = w - 2.0f * cos_in * ng;
@@ -548,12 +625,14 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     std::lock_guard<std::mutex> lock(leaf_mutex_);
     if (!leaf_rays_ || leaf_count_ != hierarchy_.leaves().size()) {
       RayScene scene = RayScene::from_leaves(hierarchy_);
-      std::vector<std::uint32_t> patch, polygon;
+      std::vector<std::uint32_t> patch, polygon, back;
       for (std::uint32_t e : scene.triangle_ids()) {
         patch.push_back(hierarchy_.element(e).patch);
         polygon.push_back(hierarchy_.patches()[patch.back()].polygon);
+        back.push_back(back_target_[patch.back()]);
       }
-      leaf_rays_ = std::make_shared<const LeafRays>(LeafRays{std::move(scene), std::move(patch), std::move(polygon)});
+      leaf_rays_ = std::make_shared<const LeafRays>(
+          LeafRays{std::move(scene), std::move(patch), std::move(polygon), std::move(back)});
       leaf_count_ = hierarchy_.leaves().size();
     }
     return leaf_rays_;
@@ -571,7 +650,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   };
   std::vector<SpecularSurface> specular_;
   std::uint32_t specular_depth_ = 0;
-  std::vector<std::uint8_t> exact_;                ///< per patch: 1 when it emits (no ray counts)
+  std::vector<std::uint8_t> exact_;                ///< per target: 1 when it emits (no ray counts)
+  std::vector<std::uint32_t> back_target_;         ///< per patch: target of its back, or kNone (opaque)
   std::vector<std::uint32_t> emitters_;            ///< the patches with exact_ set, increasing
   std::vector<std::uint32_t> emitter_of_;          ///< per patch: index into lights_, or kNone
   std::vector<Light> lights_;                      ///< the emitting polygons

@@ -35,6 +35,7 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
   const detail::PinholeCamera camera(camera_settings, options.width, options.height);
   const detail::RayScene rays = detail::RayScene::from_leaves(hierarchy);
   const std::vector<Rgb> vertex_B = solution.vertex_radiosity(options.ambient);
+  const std::vector<Rgb> vertex_back = solution.vertex_back_radiosity();  // empty: every back is black
 
   // spp rounded up to a square for a jittered g x g grid per pixel.
   const int g = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9));
@@ -61,11 +62,13 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
   auto shade = [&](const glm::vec3& dir) -> Rgb {
     auto hit = rays.intersect(camera.eye, dir, 0.0f, std::numeric_limits<float>::infinity());
     if (!hit) return Rgb(0.0f);
-    // One-sided surfaces: the back of a polygon reflects nothing.
-    if (glm::dot(hierarchy.normal(hit->id), dir) >= 0.0f) return Rgb(0.0f);
+    // One-sided surfaces: the back of a polygon sends nothing, unless it is translucent.
+    const bool front = glm::dot(hierarchy.normal(hit->id), dir) < 0.0f;
+    if (!front && vertex_back.empty()) return Rgb(0.0f);
+    const std::vector<Rgb>& values = front ? vertex_B : vertex_back;
     const std::uint32_t* tri = rays.triangle(hit->triangle);
     const float w = 1.0f - hit->u - hit->v;
-    Rgb b = w * vertex_B[tri[0]] + hit->u * vertex_B[tri[1]] + hit->v * vertex_B[tri[2]];
+    Rgb b = w * values[tri[0]] + hit->u * values[tri[1]] + hit->v * values[tri[2]];
     if (options.wireframe && near_element_edge(hit->id, tri, w, hit->u, hit->v, hit->t)) return Rgb(0.0f);
     return b * inv_pi;
   };

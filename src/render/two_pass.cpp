@@ -68,6 +68,7 @@ class TwoPassRenderer {
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
     auto start = std::chrono::steady_clock::now();
     vertex_B_ = pass1.vertex_radiosity(options.ambient);
+    vertex_back_ = pass1.vertex_back_radiosity();
     vertex_direct_ = direct_part_of_pass1();
     caustics_ = options.content == TwoPassContent::full && options.caustics.photons > 0;
     specular_ = options.content == TwoPassContent::full && options.max_specular_depth > 0 && scene_.has_specular();
@@ -242,6 +243,8 @@ class TwoPassRenderer {
       } else {
         out.layer[kSpecular] += beta * s.emission * kInvPi;
       }
+    } else if (s.uses_pass1 && !vertex_back_.empty()) {
+      out.layer[kSpecular] += beta * interpolate(vertex_back_, h) * kInvPi;  // a translucent back
     }
     if (!s.specular || depth >= options_.max_specular_depth) return;
     scatter(h, dir, beta, depth, 1, Strata{0, 1, 0.0f, caustic_weight}, rng, out);
@@ -271,6 +274,9 @@ class TwoPassRenderer {
       } else {
         out.layer[kDirect] = s.emission * kInvPi;
       }
+    } else if (s.uses_pass1 && !vertex_back_.empty() && options_.content != TwoPassContent::direct_only) {
+      // The back of a translucent sheet shows what pass 1 transmitted through it: all indirect.
+      out.layer[kIndirect] = interpolate(vertex_back_, h) * kInvPi;
     }
     if (specular_ && s.specular) {
       const int samples = s.specular_is_delta ? 1 : options_.glossy_samples;
@@ -311,6 +317,7 @@ class TwoPassRenderer {
   detail::SpecularScene scene_;
   int g_;
   std::vector<Rgb> vertex_B_;
+  std::vector<Rgb> vertex_back_;  ///< pass 1's radiosity of translucent backs, or empty (black backs)
   std::vector<Rgb> vertex_direct_;
   detail::PhotonMap photon_map_;
   float max_radius_ = 0.0f;

@@ -1,4 +1,5 @@
-// Which specular events the extended first pass carries (FormFactorOptions::specular_depth):
+// Which specular events the extended first pass carries (FormFactorOptions::specular_depth),
+// and which surfaces it treats as translucent (FormFactorOptions::diffuse_transmission):
 // one rule shared by the Monte Carlo form factors, which carry them, and the photon map of the
 // second pass, which must then leave them out so that nothing is counted twice.
 #pragma once
@@ -22,5 +23,12 @@ inline float pass1_window(const Material& m) { return m.ior == 1.0f ? channel_me
 /// it too (Fresnel-weighted, the bending ignored), but only for light that left a non-emitting
 /// surface: light from emitters through glass is the photon map's (sharp caustics).
 inline float pass1_glass(const Material& m) { return m.ior != 1.0f ? channel_mean(m.transmittance) : 0.0f; }
+
+/// Whether pass 1 treats `m` as a translucent thin sheet (FormFactorOptions::
+/// diffuse_transmission): some channel of diffuse_transmittance is > 0. Such a patch has a
+/// radiosity on each side; each side sends on tau times what the other receives.
+inline bool pass1_translucent(const Material& m) {
+  return m.diffuse_transmittance.x > 0.0f || m.diffuse_transmittance.y > 0.0f || m.diffuse_transmittance.z > 0.0f;
+}
 
 }  // namespace radiosity::detail

@@ -28,14 +28,21 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   result.B = B0.empty() ? sys.emission : B0;
   result.H.assign(m, Rgb(0.0f));
 
-  // Which leaves still need a row, and where it goes.
-  if (store.slot.size() < ctx.hierarchy.elements().size()) store.slot.resize(ctx.hierarchy.elements().size(), kNone);
+  // Which sides still need a row (unknowns, fronts first), and where it goes.
+  const std::size_t elements = ctx.hierarchy.elements().size();
+  if (store.slot.size() < elements) store.slot.resize(elements, kNone);
+  if (store.back_slot.size() < elements) store.back_slot.resize(elements, kNone);
+  auto slot_of = [&](std::size_t u) -> std::uint32_t& {
+    return (u < sys.fronts() ? store.slot : store.back_slot)[sys.element(u)];
+  };
   std::vector<std::uint32_t> missing;
-  for (std::uint32_t e : sys.leaves)
-    if (store.slot[e] == kNone) missing.push_back(e);
+  for (std::size_t u = 0; u < m; ++u)
+    if (slot_of(u) == kNone) missing.push_back(static_cast<std::uint32_t>(u));
   // Memory, stated before anything is computed: dense rows hold a float per patch, sparse rows
   // an index and a float per entry, at most max_row_entries() of them.
   const bool sparse = ctx.estimator.sparse();
+  if (sys.has_backs() && !sparse)
+    throw Error(ErrorCode::internal, "solve: diffuse transmission needs an estimator with sparse rows");
   const std::size_t row_bytes =
       sparse ? std::min(n, ctx.estimator.max_row_entries()) * 2 * sizeof(float) : n * sizeof(float);
   std::size_t rows_held = 0;
@@ -64,21 +71,27 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   // Form factors, in chunks so that progress is reported and cancel is honoured.
   auto t0 = std::chrono::steady_clock::now();
   const std::size_t chunk = std::max<std::size_t>(64, missing.size() / 200);
-  std::vector<std::uint32_t> rows;
-  std::vector<SparseFactors> sparse_rows;
+  std::vector<std::uint32_t> rows, backs;
+  std::vector<SparseFactors> sparse_rows, back_rows;
   std::vector<float> buffer;
   for (std::size_t begin = 0; begin < missing.size(); begin += chunk) {
     std::size_t end = std::min(missing.size(), begin + chunk);
-    rows.assign(missing.begin() + static_cast<std::ptrdiff_t>(begin), missing.begin() + static_cast<std::ptrdiff_t>(end));
+    rows.clear();
+    backs.clear();
+    for (std::size_t k = begin; k < end; ++k)
+      (missing[k] < sys.fronts() ? rows : backs).push_back(sys.element(missing[k]));
     if (sparse) {
       ctx.estimator.sparse_element_rows(rows, sparse_rows);
+      if (!backs.empty()) ctx.estimator.sparse_back_rows(backs, back_rows);
+      std::size_t front = 0, back = 0;  // fronts come before backs in `missing`
       for (std::size_t k = begin; k < end; ++k) {
+        SparseFactors& from = missing[k] < sys.fronts() ? sparse_rows[front++] : back_rows[back++];
         FactorVector& r = store.rows[slots[k]];
-        r.index = std::move(sparse_rows[k - begin].index);
-        r.value = std::move(sparse_rows[k - begin].value);
+        r.index = std::move(from.index);
+        r.value = std::move(from.value);
         r.index.shrink_to_fit();
         r.value.shrink_to_fit();
-        store.slot[missing[k]] = slots[k];
+        slot_of(missing[k]) = slots[k];
       }
     } else {
       buffer.resize(rows.size() * n);
@@ -87,7 +100,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         FactorVector& r = store.rows[slots[k]];
         r.index.clear();
         r.value.assign(buffer.data() + (k - begin) * n, buffer.data() + (k - begin + 1) * n);
-        store.slot[missing[k]] = slots[k];
+        slot_of(missing[k]) = slots[k];
       }
     }
     Progress p;
@@ -97,7 +110,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       // Leaves without a row would be read below: forget the partial work and stop here with
       // the starting estimate, which is consistent.
       for (std::size_t k = 0; k < missing.size(); ++k)
-        if (store.slot[missing[k]] == kNone) store.free_slots.push_back(slots[k]);
+        if (slot_of(missing[k]) == kNone) store.free_slots.push_back(slots[k]);
       result.status = SolveStatus::cancelled;
       result.seconds_form_factors = seconds_since(t0);
       result.form_factor_bytes = store.bytes();
@@ -106,7 +119,15 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   }
   result.seconds_form_factors = seconds_since(t0);
   result.form_factor_bytes = store.bytes();
-  auto row = [&](std::size_t i) -> const FactorVector& { return store.row(sys.leaves[i]); };
+  std::vector<const FactorVector*> row_of(m);
+  for (std::size_t u = 0; u < m; ++u) row_of[u] = &store.rows[slot_of(u)];
+  auto row = [&](std::size_t i) -> const FactorVector& { return *row_of[i]; };
+  // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp); opaque sides have no twin.
+  auto radiosity = [&](std::size_t i, const Rgb& h) {
+    Rgb b = sys.emission[i] + sys.reflectance[i] * h;
+    if (sys.twin[i] != kNone) b += sys.transmittance[i] * result.H[sys.twin[i]];
+    return b;
+  };
 
   // Sweeps. Residual: power that the last sweep changed, over the emitted power.
   std::vector<Rgb> patch_B, next(m);
@@ -116,22 +137,29 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
     sys.patch_means(result.B, patch_B);
     double change = 0.0;
     if (!gauss_seidel) {
-      // Jacobi: every element from the previous sweep's patch radiosity; rows are independent.
+      // Jacobi: every side from the previous sweep's patch radiosity; rows are independent.
+      // Translucent sides need the other side's irradiance, so all of H comes first.
       parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-          next[i] = sys.emission[i] + sys.reflectance[i] * row(i).dot(patch_B);
-        }
+        for (std::size_t i = begin; i < end; ++i) result.H[i] = row(i).dot(patch_B);
       });
+      for (std::size_t i = 0; i < m; ++i) next[i] = radiosity(i, result.H[i]);
       for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * l1(next[i] - result.B[i]);
       result.B.swap(next);
     } else {
-      // Gauss-Seidel: each element sees the patch means already updated by earlier elements.
-      for (std::size_t i = 0; i < m; ++i) {
-        Rgb b = sys.emission[i] + sys.reflectance[i] * row(i).dot(patch_B);
-        Rgb d = b - result.B[i];
+      // Gauss-Seidel: each side sees the patch means already updated by earlier sides. A new
+      // irradiance changes the twin's radiosity too (it transmits it), so that is updated at
+      // once: otherwise a sweep could change only irradiances and look converged.
+      auto set = [&](std::size_t i) {
+        const Rgb b = radiosity(i, result.H[i]);
+        const Rgb d = b - result.B[i];
         change += sys.area[i] * l1(d);
         patch_B[sys.patch[i]] += (sys.area[i] / sys.patch_area[sys.patch[i]]) * d;
         result.B[i] = b;
+      };
+      for (std::size_t i = 0; i < m; ++i) {
+        result.H[i] = row(i).dot(patch_B);
+        set(i);
+        if (sys.twin[i] != kNone) set(sys.twin[i]);
       }
     }
     result.iterations = it;

@@ -8,6 +8,10 @@
 // so one column F(. -> i) of the element-to-patch matrix serves a shot: O(m) per step. The
 // received radiosity is added to e's patch's unshot radiosity, area-weighted, and the shooter's
 // unshot radiosity is set to zero before distributing, so nothing is counted twice.
+//
+// Diffuse transmission (system.hpp): the backs of translucent patches are shooters too, and a
+// column reports arrivals at the backs of translucent elements. A side receiving irradiance
+// dH reflects rho dH from itself and transmits tau dH from its other side.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -143,7 +147,7 @@ SolverResult solve_progressive(const SolverContext& ctx) {
         }
         F = cached[shooter] ? &cache[shooter] : &scratch;
       } else {
-        scratch.value.resize(m);
+        scratch.value.resize(sys.fronts());
         ctx.estimator.patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, scratch.value.data());
         if (cached_bytes + scratch.bytes() <= ctx.options.memory_budget_bytes) {
           cached_bytes += scratch.bytes();
@@ -162,15 +166,20 @@ SolverResult solve_progressive(const SolverContext& ctx) {
     const Rgb shot = unshot[shooter];
     unshot[shooter] = Rgb(0.0f);
     power[shooter] = 0.0;
-    F->for_each([&](std::size_t e, float f) {
-      if (f <= 0.0f) return;
-      const Rgb incident = shot * f;  // irradiance arriving at e from this shot
-      const Rgb dB = sys.reflectance[e] * incident;
-      result.H[e] += incident;
-      result.B[e] += dB;
-      const std::uint32_t p = sys.patch[e];
-      unshot[p] += (sys.area[e] / sys.patch_area[p]) * dB;
+    auto receive = [&](std::uint32_t u, const Rgb& dB) {
+      result.B[u] += dB;
+      const std::uint32_t p = sys.patch[u];
+      unshot[p] += (sys.area[u] / sys.patch_area[p]) * dB;
       power[p] = sum3(unshot[p]) * sys.patch_area[p];
+    };
+    F->for_each([&](std::size_t k, float f) {
+      if (f <= 0.0f) return;
+      const std::uint32_t u = sys.column_unknown(k);
+      if (u == kNone) return;
+      const Rgb incident = shot * f;  // irradiance arriving at side u from this shot
+      result.H[u] += incident;
+      receive(u, sys.reflectance[u] * incident);
+      if (sys.twin[u] != kNone) receive(sys.twin[u], sys.transmittance[u] * incident);
     });
 
     result.iterations = step;

@@ -4,14 +4,18 @@ namespace radiosity {
 inline namespace v1 {
 
 Solution::Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
-                   SolveStatus status, SolveReport report, Rgb ambient, std::vector<Rgb> ambient_radiosity)
+                   SolveStatus status, SolveReport report, Rgb ambient, std::vector<Rgb> ambient_radiosity,
+                   std::vector<Rgb> back_radiosity)
     : hierarchy_(std::move(hierarchy)),
       radiosity_(std::move(radiosity)),
       groups_(std::move(groups)),
       status_(status),
       report_(std::move(report)),
       ambient_(ambient),
-      ambient_radiosity_(std::move(ambient_radiosity)) {
+      ambient_radiosity_(std::move(ambient_radiosity)),
+      back_radiosity_(std::move(back_radiosity)) {
+  if (!back_radiosity_.empty() && back_radiosity_.size() != hierarchy_.elements().size())
+    throw Error(ErrorCode::invalid_argument, "Solution: back_radiosity must be empty or have one value per element");
   if (!ambient_radiosity_.empty() && ambient_radiosity_.size() != hierarchy_.elements().size())
     throw Error(ErrorCode::invalid_argument, "Solution: ambient_radiosity must be empty or have one value per element");
   if (radiosity_.size() != hierarchy_.elements().size())
@@ -32,6 +36,11 @@ std::vector<Rgb> Solution::radiosity_with_ambient() const {
 
 std::vector<Rgb> Solution::vertex_radiosity(bool with_ambient) const {
   return hierarchy_.vertex_values(with_ambient ? radiosity_with_ambient() : radiosity_);
+}
+
+std::vector<Rgb> Solution::vertex_back_radiosity() const {
+  if (back_radiosity_.empty()) return {};
+  return hierarchy_.vertex_values(back_radiosity_);
 }
 
 GroupId Solution::group_id(std::string_view group) const {

@@ -7,6 +7,7 @@
 
 #include "formfactor/estimators.hpp"
 #include "radiosity/solver.hpp"
+#include "scene/specular_transport.hpp"
 #include "solve/system.hpp"
 
 namespace radiosity {
@@ -53,6 +54,17 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
 
   SolveOptions o = options;
   if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
+  // Translucent materials in use switch diffuse transmission on; only monte_carlo carries it.
+  for (const Polygon& polygon : scene.polygons()) {
+    const Material& mat = scene.material(polygon.material);
+    if (!detail::pass1_translucent(mat)) continue;
+    if (o.form_factors.method != FormFactorMethod::monte_carlo)
+      throw Error(ErrorCode::invalid_argument,
+                  "solve: material '" + mat.name +
+                      "' has diffuse_transmittance > 0; diffuse transmission needs form_factors.method = monte_carlo");
+    o.form_factors.diffuse_transmission = true;
+    break;
+  }
   o.form_factors.seed = o.seed;
   o.form_factors.threads = o.threads;
 
@@ -69,8 +81,10 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   if (o.max_iterations == 0)
     o.max_iterations = o.method == SolverMethod::progressive ? static_cast<int>(100 * report.patch_count) : 1000;
 
-  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy);
+  const bool translucency = o.form_factors.diffuse_transmission;
+  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy, translucency);
   std::vector<Rgb> B_elements(hierarchy.elements().size(), Rgb(0.0f));
+  std::vector<Rgb> B_back;  // per element id, with diffuse transmission: the backs' radiosity
   std::vector<std::string> groups = scene.groups();
 
   if (!gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true))
@@ -85,18 +99,31 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   }
 
   auto estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
+  if (estimator->target_count() != system->patches())
+    throw Error(ErrorCode::internal, "solve: the estimator and the system number the translucent patches differently");
   detail::MatrixStore store;
   const bool progressive = o.method == SolverMethod::progressive;
   auto t1 = std::chrono::steady_clock::now();
 
   // Per element id, so values survive the re-indexing of unknowns when leaves are split.
-  std::vector<Rgb> H_elements(hierarchy.elements().size(), Rgb(0.0f));
+  std::vector<Rgb> H_elements(hierarchy.elements().size(), Rgb(0.0f)), H_back;
+  auto resize = [&] {
+    const std::size_t count = hierarchy.elements().size();
+    B_elements.resize(count, Rgb(0.0f));
+    H_elements.resize(count, Rgb(0.0f));
+    if (translucency) {
+      B_back.resize(count, Rgb(0.0f));
+      H_back.resize(count, Rgb(0.0f));
+    }
+  };
+  // Side u's values, per element id.
+  auto B_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? B_elements : B_back)[system->element(u)]; };
+  auto H_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? H_elements : H_back)[system->element(u)]; };
   auto keep = [&](const detail::SolverResult& res) {
-    B_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
-    H_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
+    resize();
     for (std::size_t i = 0; i < system->unknowns(); ++i) {
-      B_elements[system->leaves[i]] = res.B[i];
-      H_elements[system->leaves[i]] = res.H[i];
+      B_of(i) = res.B[i];
+      H_of(i) = res.H[i];
     }
     report.iterations += res.iterations;
     report.residual = res.residual;
@@ -129,23 +156,24 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
       if (split.empty()) break;
       std::vector<std::uint32_t> created;
       for (std::uint32_t e : split) {
-        if (e < store.slot.size() && store.slot[e] != kNone) {
-          store.free_slots.push_back(store.slot[e]);
-          store.slot[e] = kNone;
-        }
+        store.release(e);
         const std::uint32_t first = hierarchy.subdivide(e);
         for (std::uint32_t c = first; c < first + 4; ++c) created.push_back(c);
       }
       // Children start from their parent's value (a warm start for the next sweeps).
-      B_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
-      H_elements.resize(hierarchy.elements().size(), Rgb(0.0f));
+      resize();
       for (std::uint32_t c : created) {
-        B_elements[c] = B_elements[hierarchy.element(c).parent];
-        H_elements[c] = H_elements[hierarchy.element(c).parent];
+        const std::uint32_t parent = hierarchy.element(c).parent;
+        B_elements[c] = B_elements[parent];
+        H_elements[c] = H_elements[parent];
+        if (translucency) {
+          B_back[c] = B_back[parent];
+          H_back[c] = H_back[parent];
+        }
       }
       report.refined_elements += split.size();
       report.refinement_passes = pass;
-      system.emplace(scene, hierarchy);
+      system.emplace(scene, hierarchy, translucency);
       Progress p{Phase::refining, static_cast<double>(pass) / o.adaptive.max_passes, pass, report.residual};
       if (!gate.report(p, true)) {
         status = SolveStatus::cancelled;
@@ -155,7 +183,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
       if (!progressive) {
         // Matrix methods: rows for the new elements only, then sweeps from the warm start.
         std::vector<Rgb> B0(system->unknowns());
-        for (std::size_t i = 0; i < system->unknowns(); ++i) B0[i] = B_elements[system->leaves[i]];
+        for (std::size_t i = 0; i < system->unknowns(); ++i) B0[i] = B_of(i);
         detail::SolverContext context{scene, hierarchy, *system, *estimator, o, gate};
         r = detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, B0);
         keep(r);
@@ -163,22 +191,38 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
         if (status == SolveStatus::cancelled) break;
       } else {
         // Progressive: substructuring's gather. Each new element takes its radiosity from the
-        // patch radiosities it sees, B_c = E_c + rho_c sum_j F_cj B_j; no matrix is kept.
+        // target radiosities it sees, B_c = E_c + rho_c H_c (+ tau_c H_c' with a back), with
+        // H_c = sum_t F_ct B_t over its front row (and H_c' over its back row); no matrix is kept.
         std::vector<Rgb> patch_B;
         std::vector<Rgb> B_now(system->unknowns());
-        for (std::size_t i = 0; i < system->unknowns(); ++i) B_now[i] = B_elements[system->leaves[i]];
+        for (std::size_t i = 0; i < system->unknowns(); ++i) B_now[i] = B_of(i);
         system->patch_means(B_now, patch_B);
-        const std::size_t n = system->patches();
-        std::vector<float> rows(created.size() * n);
+        std::vector<SparseFactors> rows, back_rows;
+        std::vector<std::uint32_t> backs;
+        if (translucency)
+          for (std::uint32_t c : created)
+            if (detail::pass1_translucent(scene.material(hierarchy.patches()[hierarchy.element(c).patch].material)))
+              backs.push_back(c);
         auto tf = std::chrono::steady_clock::now();
-        estimator->element_rows(created, rows.data());
+        estimator->sparse_element_rows(created, rows);
+        if (!backs.empty()) estimator->sparse_back_rows(backs, back_rows);
         report.seconds_form_factors += seconds_since(tf);
-        for (std::size_t k = 0; k < created.size(); ++k) {
+        auto gather = [&](const SparseFactors& row) {
           Rgb h(0.0f);
-          for (std::size_t j = 0; j < n; ++j) h += rows[k * n + j] * patch_B[j];
-          const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(created[k]).patch].material);
-          H_elements[created[k]] = h;
-          B_elements[created[k]] = mat.emission + mat.reflectance * h;
+          for (std::size_t k = 0; k < row.index.size(); ++k) h += row.value[k] * patch_B[row.index[k]];
+          return h;
+        };
+        for (std::size_t k = 0; k < created.size(); ++k) H_elements[created[k]] = gather(rows[k]);
+        for (std::size_t k = 0; k < backs.size(); ++k) H_back[backs[k]] = gather(back_rows[k]);
+        for (std::uint32_t c : created) {
+          const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
+          B_elements[c] = mat.emission + mat.reflectance * H_elements[c];
+        }
+        for (std::uint32_t c : backs) {
+          const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
+          const Rgb tau = mat.diffuse_transmittance;
+          B_elements[c] += tau * H_back[c];
+          B_back[c] = (mat.two_sided ? mat.reflectance : Rgb(0.0f)) * H_back[c] + tau * H_elements[c];
         }
       }
     }
@@ -187,26 +231,30 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   report.seconds_solving = total - report.seconds_form_factors;
   report.element_count = hierarchy.leaves().size();
 
+  // Power balance: a side absorbs what it neither reflects nor transmits, (1 - rho - tau) H.
   glm::dvec3 emitted(0.0), absorbed(0.0);
   for (std::size_t i = 0; i < system->unknowns(); ++i) {
     const double a = system->area[i];
-    const std::uint32_t e = system->leaves[i];
     emitted += a * glm::dvec3(system->emission[i]);
-    absorbed += a * (glm::dvec3(1.0) - glm::dvec3(system->reflectance[i])) * glm::dvec3(H_elements[e]);
+    absorbed += a * (glm::dvec3(1.0) - glm::dvec3(system->reflectance[i]) - glm::dvec3(system->transmittance[i])) *
+                glm::dvec3(H_of(i));
   }
   report.emitted_power = Rgb(emitted);
   report.absorbed_power = Rgb(absorbed);
   // Inner nodes (split elements) hold the mean of their children from here on.
   hierarchy.aggregate(B_elements);
+  if (translucency) hierarchy.aggregate(B_back);
   std::vector<Rgb> ambient_elements;
   if (r.ambient != Rgb(0.0f)) {
+    // The ambient reaches both sides of a translucent element, and each side sends on
+    // (rho + tau) of it; the backs' share is not displayed.
     ambient_elements.assign(hierarchy.elements().size(), Rgb(0.0f));
-    for (std::size_t i = 0; i < system->unknowns(); ++i)
-      ambient_elements[system->leaves[i]] = system->reflectance[i] * r.ambient;
+    for (std::size_t i = 0; i < system->fronts(); ++i)
+      ambient_elements[system->leaves[i]] = (system->reflectance[i] + system->transmittance[i]) * r.ambient;
     hierarchy.aggregate(ambient_elements);
   }
   return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), status, std::move(report),
-                  r.ambient, std::move(ambient_elements));
+                  r.ambient, std::move(ambient_elements), std::move(B_back));
 }
 
 }  // namespace v1

@@ -1,30 +1,51 @@
 #include "solve/system.hpp"
 
+#include "scene/specular_transport.hpp"
+
 namespace radiosity::detail {
 
-RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy) : leaves(hierarchy.leaves()) {
-  const std::size_t m = leaves.size();
-  area.resize(m);
-  emission.resize(m);
-  reflectance.resize(m);
-  patch.resize(m);
-  // Patch areas as the sum of their leaves, so a patch mean of a constant field is exact.
-  patch_area.assign(hierarchy.patches().size(), 0.0f);
+RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission)
+    : leaves(hierarchy.leaves()) {
+  const std::size_t m = leaves.size(), n = hierarchy.patches().size();
+  // Back targets first, so each back unknown knows its target.
+  std::vector<std::uint32_t> back_target(n, kNone);
+  std::uint32_t targets = static_cast<std::uint32_t>(n);
+  if (diffuse_transmission)
+    for (std::uint32_t j = 0; j < n; ++j)
+      if (pass1_translucent(scene.material(hierarchy.patches()[j].material))) back_target[j] = targets++;
+  patch_area.assign(targets, 0.0f);
+  auto add = [&](std::uint32_t target, float a, const Rgb& E, const Rgb& rho, const Rgb& tau, std::uint32_t other) {
+    area.push_back(a);
+    emission.push_back(E);
+    reflectance.push_back(rho);
+    transmittance.push_back(tau);
+    patch.push_back(target);
+    twin.push_back(other);
+    // Patch areas as the sum of their leaves, so a patch mean of a constant field is exact.
+    patch_area[target] += a;
+    total_area += a;
+  };
+  std::vector<std::uint32_t> backs;  // positions in `leaves` of the leaves with a back
   for (std::size_t i = 0; i < m; ++i) {
     const Element& e = hierarchy.element(leaves[i]);
     const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
-    area[i] = e.area;
-    emission[i] = mat.emission;
-    reflectance[i] = mat.reflectance;
-    patch[i] = e.patch;
-    patch_area[e.patch] += e.area;
+    const bool translucent = back_target[e.patch] != kNone;
+    add(e.patch, e.area, mat.emission, mat.reflectance, translucent ? mat.diffuse_transmittance : Rgb(0.0f),
+        translucent ? static_cast<std::uint32_t>(m + backs.size()) : kNone);
+    if (translucent) backs.push_back(static_cast<std::uint32_t>(i));
     emitted += static_cast<double>(e.area) * (mat.emission.x + mat.emission.y + mat.emission.z);
-    total_area += e.area;
   }
-  glm::dvec3 mean_rho(0.0);
-  for (std::size_t i = 0; i < m; ++i) mean_rho += static_cast<double>(area[i]) * glm::dvec3(reflectance[i]);
-  if (total_area > 0.0) mean_rho /= total_area;
-  interreflection = Rgb(1.0 / (glm::dvec3(1.0) - mean_rho));
+  for (std::uint32_t i : backs) {
+    const Element& e = hierarchy.element(leaves[i]);
+    const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
+    add(back_target[e.patch], e.area, Rgb(0.0f), mat.two_sided ? mat.reflectance : Rgb(0.0f),
+        mat.diffuse_transmittance, i);
+  }
+  glm::dvec3 mean(0.0);
+  for (std::size_t u = 0; u < area.size(); ++u)
+    mean += static_cast<double>(area[u]) * glm::dvec3(reflectance[u] + transmittance[u]);
+  if (total_area > 0.0) mean /= total_area;
+  interreflection = Rgb(1.0 / (glm::dvec3(1.0) - mean));
 }
 
 void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const {

@@ -20,23 +20,44 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 /// B_e = E_e + rho_e sum_j F_ej B_j over the leaves e and patches j, B_j the area-weighted
 /// mean of patch j's leaves.
+///
+/// With diffuse transmission (Rushmeier & Torrance 1990) the unknowns are sides: first the
+/// fronts of all leaves (index = position in `leaves`), then the backs of the leaves of
+/// translucent patches. A side u gathers H_u = sum_t F_ut B_t over the targets t (the patches,
+/// then the backs of translucent patches, numbered as FormFactorEstimator::
+/// translucent_patches() numbers them) and leaves
+///   B_u = E_u + rho_u H_u + tau_u H_twin(u):
+/// what it reflects plus what its other side receives and transmits. The back of a one-sided
+/// material reflects nothing (rho 0), as in the path tracer; a two-sided one reflects like the
+/// front. Emission leaves the front only.
 struct RadiositySystem {
-  std::vector<std::uint32_t> leaves;  ///< element ids, index = unknown
+  std::vector<std::uint32_t> leaves;  ///< element ids of the fronts: the estimators' element list
   std::vector<float> area;            ///< per unknown
-  std::vector<Rgb> emission, reflectance;
-  std::vector<std::uint32_t> patch;   ///< per unknown
-  std::vector<float> patch_area;
+  std::vector<Rgb> emission, reflectance, transmittance;  ///< per unknown; tau = 0 when opaque
+  std::vector<std::uint32_t> patch;   ///< per unknown: its target (patch, or patches() + k for a back)
+  std::vector<std::uint32_t> twin;    ///< per unknown: the other side's unknown, or kNone (opaque)
+  std::vector<float> patch_area;      ///< per target
   double emitted = 0.0;               ///< sum_e A_e (E_r + E_g + E_b), the residual's denominator
-  /// 1 / (1 - area-weighted mean reflectance), per channel: the interreflection factor of the
-  /// ambient term (Cohen et al. 1988, eq. 6).
+  /// 1 / (1 - area-weighted mean of rho + tau over the sides), per channel: the
+  /// interreflection factor of the ambient term (Cohen et al. 1988, eq. 6).
   Rgb interreflection{1.0f};
-  double total_area = 0.0;
+  double total_area = 0.0;            ///< of all sides
 
-  RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy);
-  std::size_t unknowns() const { return leaves.size(); }
-  std::size_t patches() const { return patch_area.size(); }
-  /// Patch radiosity from leaf radiosity.
+  /// `diffuse_transmission`: give translucent patches (pass1_translucent()) their backs.
+  RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission);
+  std::size_t unknowns() const { return area.size(); }
+  std::size_t fronts() const { return leaves.size(); }
+  std::size_t patches() const { return patch_area.size(); }  ///< targets, backs included
+  bool has_backs() const { return unknowns() > fronts(); }
+  /// The element of unknown u (either side).
+  std::uint32_t element(std::size_t u) const { return leaves[u < fronts() ? u : twin[u]]; }
+  /// Target radiosity from side radiosity (area-weighted means).
   void patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const;
+  /// The unknown at position `index` of an estimator's column over `leaves`: the front for
+  /// index < fronts(), the back of leaves[index - fronts()] beyond (kNone if it has none).
+  std::uint32_t column_unknown(std::size_t index) const {
+    return index < fronts() ? static_cast<std::uint32_t>(index) : twin[index - fronts()];
+  }
 };
 
 /// What a solver hands back to solve().
@@ -104,12 +125,13 @@ struct FactorVector {
   }
 };
 
-/// Rows F(element -> every patch) kept across adaptive refinement passes, so a pass computes
-/// rows only for the elements it created. A subdivided element's row slot is reused by its
-/// first child.
+/// Rows F(element -> every target) kept across adaptive refinement passes, so a pass computes
+/// rows only for the elements it created. A subdivided element's row slots are reused by its
+/// children. The backs of translucent elements have rows of their own.
 struct MatrixStore {
   std::vector<FactorVector> rows;        ///< by slot
-  std::vector<std::uint32_t> slot;       ///< element id -> slot, kNone when it has no row
+  std::vector<std::uint32_t> slot;       ///< element id -> slot of its front row, kNone when it has none
+  std::vector<std::uint32_t> back_slot;  ///< element id -> slot of its back row, kNone when it has none
   std::vector<std::uint32_t> free_slots; ///< slots of elements that were subdivided
 
   std::size_t bytes() const {
@@ -117,7 +139,14 @@ struct MatrixStore {
     for (const FactorVector& r : rows) sum += r.bytes();
     return sum;
   }
-  const FactorVector& row(std::uint32_t element) const { return rows[slot[element]]; }
+  /// Frees the rows of an element that was subdivided.
+  void release(std::uint32_t element) {
+    for (std::vector<std::uint32_t>* s : {&slot, &back_slot})
+      if (element < s->size() && (*s)[element] != kNone) {
+        free_slots.push_back((*s)[element]);
+        (*s)[element] = kNone;
+      }
+  }
 };
 
 /// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
