@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -44,6 +45,11 @@ struct RayCastCounters {
 };
 /// Fills `out` and returns true when `estimator` is a ray-cast or analytic estimator.
 bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& out);
+
+/// patch_column() of a ray-cast or analytic estimator from the backs of the elements (each a
+/// Lambertian surface facing -normal): F(back of e -> patch) for diffuse transmission.
+void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch,
+                       const std::vector<std::uint32_t>& elements, float* out);
 
 /// The unoccluded estimator: the ray-cast estimator's exact point-to-polygon factor integrated
 /// over the element by adaptive Gauss quadrature, without visibility.

@@ -176,6 +176,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       }
       occluders_ = ShaftCuller(corners, normals);
       visible_.resize(lights_.size());
+      visible_back_.resize(lights_.size());
     }
   }
 
@@ -244,19 +245,40 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
     const std::uint32_t N = options_.hemisphere_rays;
     const float per_ray = 1.0f / static_cast<float>(N);
-    // All by rays, emitters too (no exact part: the analytic factors are for fronts). Light of
-    // an emitter through glass stays the photon map's, as in the front rows.
+    // As the front rows: emitting patches exactly (the unoccluded factor from the element's back
+    // times the back's visible fraction of the emitting polygon), everything else by rays.
     parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
       HitCounter counter(target_count());
       Scratch scratch(N);
+      std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
+                                             elements.begin() + static_cast<std::ptrdiff_t>(end));
+      std::vector<float> value, column(run.size()), fraction(lights_.size());
+      std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(run.size());
+      for (std::uint32_t j : emitters_) {
+        back_patch_column(*analytic_serial_, j, run, column.data());
+        for (std::size_t k = 0; k < run.size(); ++k)
+          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
+      }
       for (std::size_t k = begin; k < end; ++k) {
         const std::uint32_t e = elements[k];
+        auto& own = exact[k - begin];
+        std::fill(fraction.begin(), fraction.end(), -1.0f);
+        for (auto& [j, f] : own) {
+          float& v = fraction[emitter_of_[j]];
+          if (v < 0.0f) v = static_cast<float>(visibility(e, emitter_of_[j], true));
+          f *= v;
+        }
+        own.erase(std::remove_if(own.begin(), own.end(), [](const auto& x) { return !(x.second > 0.0f); }),
+                  own.end());
         const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
         Rng rng(options_.seed, e, 0x600000000ull);
         shoot(*rays, e, source, true, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
-          if (!exact_[j] || path != Path::glass) counter.add(j, w);
+          if (!exact_[j] || path == Path::specular) counter.add(j, w);
         });
-        counter.drain(out[k].index, out[k].value, [&](std::uint32_t, float c) { return c * per_ray; });
+        index.clear();
+        value.clear();
+        counter.drain(index, value, [&](std::uint32_t, float c) { return c * per_ray; });
+        merge(index, value, own, out[k]);
       }
     });
   }
@@ -351,8 +373,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   /// F(e -> emitting patch) for each element: unoccluded factor times the element's visible
   /// fraction of the patch's polygon, the latter kept per element for later columns. With
-  /// `backs`, the arrivals at the backs of translucent elements (found by the shot) are
-  /// appended to it as sparse entries (indices elements.size() + k).
+  /// `backs`, the arrivals at the backs of translucent elements (the same from their backs) are
+  /// appended to it as sparse entries (indices elements.size() + k, increasing).
   void emitter_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out,
                       SparseFactors* backs) const {
     analytic_->patch_column(patch, elements, out);
@@ -370,43 +392,70 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         }
       });
     }
-    if (specular_depth_ > 0 || !translucent_patches().empty()) {
-      // What the patch sends through mirrors and windows, and onto the backs of translucent
-      // elements, is shot like any other patch's.
+    // Arrivals at the backs of translucent elements: exact as well (backward factors).
+    std::vector<float> back;
+    if (backs && !translucent_patches().empty()) {
+      std::vector<std::uint32_t> translucent, where;
+      for (std::size_t k = 0; k < elements.size(); ++k)
+        if (back_target_[hierarchy_.element(elements[k]).patch] != kNone) {
+          translucent.push_back(elements[k]);
+          where.push_back(static_cast<std::uint32_t>(k));
+        }
+      std::vector<float> column(translucent.size());
+      back_patch_column(*analytic_, patch, translucent, column.data());
+      back.assign(elements.size(), 0.0f);
+      std::lock_guard<std::mutex> lock(visible_mutex_);
+      std::vector<float>& cache = visible_back_[light];
+      if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
+      parallel_for(options_.threads, translucent.size(), 64, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          if (!(column[k] > 0.0f)) continue;
+          float& v = cache[translucent[k]];
+          if (v < 0.0f) v = static_cast<float>(visibility(translucent[k], light, true));
+          back[where[k]] = column[k] * v;
+        }
+      });
+    }
+    if (specular_depth_ > 0) {
+      // What the patch sends through mirrors and windows is shot like any other patch's.
       SparseFactors extra;
       const std::shared_ptr<const LeafRays> rays = leaf_scene();
       shot_column(patch, elements, positions(elements), *rays, options_.threads, true, extra);
       for (std::size_t i = 0; i < extra.index.size(); ++i) {
-        if (extra.index[i] < elements.size()) {
+        if (extra.index[i] < elements.size())
           out[extra.index[i]] += extra.value[i];
-        } else if (backs) {
-          backs->index.push_back(extra.index[i]);
-          backs->value.push_back(extra.value[i]);
-        }
+        else if (!back.empty())
+          back[extra.index[i] - elements.size()] += extra.value[i];
       }
     }
+    for (std::size_t k = 0; k < back.size(); ++k)
+      if (back[k] > 0.0f) {
+        backs->index.push_back(static_cast<std::uint32_t>(elements.size() + k));
+        backs->value.push_back(back[k]);
+      }
   }
 
-  /// Kernel-weighted fraction of shadow rays from element e to light polygon `light` that are
-  /// clear: 1 without rays when a shaft test shows nothing can come between. 64 rays, and 256
-  /// more in a penumbra (some blocked, some clear). Its own random stream per pair, so the value
-  /// does not depend on the caller.
-  double visibility(std::uint32_t e, std::uint32_t light) const {
+  /// Kernel-weighted fraction of shadow rays from element e (from its back side when `back`) to
+  /// light polygon `light` that are clear: 1 without rays when a shaft test shows nothing can
+  /// come between. 64 rays, and 256 more in a penumbra (some blocked, some clear). Its own
+  /// random stream per pair, so the value does not depend on the caller.
+  double visibility(std::uint32_t e, std::uint32_t light, bool back = false) const {
     const Light& L = lights_[light];
     const Element& el = hierarchy_.element(e);
     const Patch& patch = hierarchy_.patches()[el.patch];
+    const glm::vec3 normal = back ? -patch.normal : patch.normal;
     std::array<glm::vec3, 4> corners{};
     for (int k = 0; k < el.corner_count(); ++k)
       corners[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
     if (L.vertices.size() <= 4) {
       Shaft shaft;
-      if (!shaft.build(corners.data(), el.corner_count(), patch.normal, L.vertices.data(),
+      if (!shaft.build(corners.data(), el.corner_count(), normal, L.vertices.data(),
                        static_cast<int>(L.vertices.size()), L.normal, epsilon_) ||
           !occluders_.any(shaft, patch.polygon, L.polygon))
         return 1.0;
     }
     const CellSampler sampler(corners.data(), el.corner_count());
-    Rng rng(options_.seed, e, 0x500000000ull + light);
+    Rng rng(options_.seed, e, (back ? 0x700000000ull : 0x500000000ull) + light);
     std::array<glm::vec2, 256> from, to;
     double weight = 0.0, clear_weight = 0.0;
     std::uint32_t clear = 0, blocked = 0;
@@ -415,11 +464,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       stratified(count, rng, true, to.data());
       for (std::uint32_t i = count; i > 1; --i) std::swap(to[i - 1], to[rng.next() % i]);
       for (std::uint32_t r = 0; r < count; ++r) {
-        const glm::vec3 x = sampler(from[r]) + epsilon_ * patch.normal;
+        const glm::vec3 x = sampler(from[r]) + epsilon_ * normal;
         const glm::vec3 d = (L.fan.sample(to[r]) + epsilon_ * L.normal) - x;
         const float r2 = glm::dot(d, d);
         if (!(r2 > 0.0f)) continue;
-        const float w = std::max(0.0f, glm::dot(d, patch.normal)) * std::max(0.0f, -glm::dot(d, L.normal)) / (r2 * r2);
+        const float w = std::max(0.0f, glm::dot(d, normal)) * std::max(0.0f, -glm::dot(d, L.normal)) / (r2 * r2);
         const bool visible = !shadow_rays_->occluded(x, d, 0.0f, 1.0f - 1e-4f);
         (visible ? clear : blocked) += 1;
         weight += w;
@@ -444,8 +493,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   /// for a back target): as many rays as its elements would shoot for their rows, in chunks with
   /// their own random streams (on up to `threads` threads); the sums do not depend on the thread
   /// count. Arrivals at the back of elements[k] are entry elements.size() + k.
-  /// `emitter`: arrivals at fronts count only through mirrors and windows (an emitting patch's
-  /// direct factors are computed exactly), and none through glass (the photon map's).
+  /// `emitter`: arrivals count only through mirrors and windows (an emitting patch's direct
+  /// factors, to fronts and backs, are computed exactly; its light through glass is the photon
+  /// map's).
   void shot_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
                    const std::vector<std::uint32_t>& position, const LeafRays& rays, unsigned threads,
                    bool emitter, SparseFactors& out) const {
@@ -469,7 +519,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
               [&](std::uint32_t leaf, std::uint32_t j, float w, Path path) {
                 if (position[leaf] == kNone) return;
                 const bool at_back = j >= n;
-                if (emitter && (path == Path::glass || (!at_back && path != Path::specular))) return;
+                if (emitter && path != Path::specular) return;
                 hits[c].emplace_back(static_cast<std::uint32_t>(position[leaf] + (at_back ? elements.size() : 0)), w);
               });
       }
@@ -659,6 +709,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   ShaftCuller occluders_;
   mutable std::mutex visible_mutex_;
   mutable std::vector<std::vector<float>> visible_;  ///< per light, per element id: V, or -1 = not yet
+  mutable std::vector<std::vector<float>> visible_back_;  ///< the same for the elements' backs
   float epsilon_ = 0.0f;
   mutable std::mutex leaf_mutex_;
   mutable std::shared_ptr<const LeafRays> leaf_rays_;

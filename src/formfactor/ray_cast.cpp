@@ -148,6 +148,21 @@ class SampledEstimator final : public FormFactorEstimator {
     });
   }
 
+  /// patch_column() for the backs of the elements: each treated as a Lambertian surface facing
+  /// -normal (diffuse transmission's backward form factors).
+  void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
+    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source);
+        source.normal = -source.normal;
+        out[k] = static_cast<float>(factor(source, patch, counts));
+      }
+      add(counts);
+    });
+  }
+
   RayCastCounters counters() const {
     RayCastCounters c;
     c.factors = factors_.load(std::memory_order_relaxed);
@@ -441,6 +456,13 @@ bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& ou
   if (e == nullptr) return false;
   out = e->counters();
   return true;
+}
+
+void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch, const std::vector<std::uint32_t>& elements,
+                       float* out) {
+  const auto* e = dynamic_cast<const SampledEstimator*>(&estimator);
+  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not a ray-cast or analytic estimator");
+  e->back_column(patch, elements, out);
 }
 
 std::unique_ptr<FormFactorEstimator> make_ray_cast_estimator(const Scene& scene, const PatchHierarchy& hierarchy,

@@ -3,6 +3,7 @@
 // on tau times what the other receives.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -215,6 +216,51 @@ TEST_SUITE("solve") {
     camera.look_at = {0.5f, 0.5f, 0.0f};
     ro.camera = camera;
     CHECK(rad::render(scene, sol, ro).at(4, 4).x == 0.0f);
+  }
+
+  TEST_CASE("backward form factors: exact to emitters and numbered after the patches") {
+    // Lamp (patch 0), panel (1, translucent: its back is target 3) and tile (2), one element
+    // each. The panel's back sees the lamp with the C-11 factor F: an emitting target, so the
+    // entry is exact (analytic factor, visibility 1). The lamp's front row reaches the panel's
+    // back by rays (2^16: 0.8 % noise), and the lamp's column reports the same arrival exactly.
+    rad::Material panel;
+    panel.name = "paper";
+    panel.reflectance = rad::Rgb(0.2f);
+    panel.diffuse_transmittance = rad::Rgb(0.5f);
+    const Stack s = lamp_panel_tile(panel);
+    const double F = test::parallel_rectangles(1.0, 1.0, 1.0);
+    rad::FormFactorOptions f;
+    f.method = rad::FormFactorMethod::monte_carlo;
+    f.diffuse_transmission = true;
+    f.hemisphere_rays = 1u << 16;
+    const rad::PatchHierarchy h(s.scene, rad::MeshOptions{10.0f, 10.0f});
+    const auto estimator = rad::make_form_factor_estimator(s.scene, h, f);
+    const std::vector<std::uint32_t> leaves = h.leaves();
+    REQUIRE(leaves.size() == 3);
+    const std::uint32_t lamp = h.patches()[0].root, paper = h.patches()[1].root, tile = h.patches()[2].root;
+
+    std::vector<rad::SparseFactors> rows;
+    estimator->sparse_back_rows({paper}, rows);
+    REQUIRE(rows[0].index == std::vector<std::uint32_t>{0});  // the lamp only (the tile is in front)
+    CHECK(relative(rows[0].value[0], F) < 1e-3);
+
+    estimator->sparse_element_rows({lamp, tile}, rows);
+    REQUIRE(rows[0].index == std::vector<std::uint32_t>{3});  // the lamp sees the panel's back
+    CHECK(relative(rows[0].value[0], F) < 0.03);
+    REQUIRE(rows[1].index == std::vector<std::uint32_t>{1});  // the tile sees the panel's front
+    CHECK(relative(rows[1].value[0], F) < 0.03);
+
+    // Columns: arrivals at the back of leaves[k] are index leaves.size() + k.
+    const auto position = [&](std::uint32_t e) {
+      return static_cast<std::uint32_t>(std::find(leaves.begin(), leaves.end(), e) - leaves.begin());
+    };
+    rad::SparseFactors column;
+    estimator->sparse_patch_column(0, leaves, column);
+    REQUIRE(column.index == std::vector<std::uint32_t>{static_cast<std::uint32_t>(leaves.size()) + position(paper)});
+    CHECK(relative(column.value[0], F) < 1e-3);
+    estimator->sparse_patch_column(3, leaves, column);  // shot from the panel's back
+    REQUIRE(column.index == std::vector<std::uint32_t>{position(lamp)});
+    CHECK(relative(column.value[0], F) < 0.03);
   }
 
   TEST_CASE("diffuse transmission needs the monte_carlo estimator and says so") {
