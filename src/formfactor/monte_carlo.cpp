@@ -324,7 +324,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     out.assign(patches.size(), SparseFactors{});
     std::vector<std::size_t> shot;
     for (std::size_t k = 0; k < patches.size(); ++k) {
-      if (exact_[patches[k]])
+      if (patches[k] >= target_count() || exact_[patches[k]])
         sparse_patch_column(patches[k], elements, out[k]);  // parallel inside
       else
         shot.push_back(k);

@@ -149,8 +149,10 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
   /// patch_column() for the backs of the elements: each treated as a Lambertian surface facing
-  /// -normal (diffuse transmission's backward form factors).
+  /// -normal (diffuse transmission's backward form factors). Unoccluded factors only: the
+  /// shaft verdicts cached per patch pair are the fronts'.
   void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
+    if (visibility_) throw Error(ErrorCode::internal, "back_patch_column: needs the analytic estimator");
     parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
       Source source;
       RayCastCounters counts;
@@ -461,7 +463,7 @@ bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& ou
 void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                        float* out) {
   const auto* e = dynamic_cast<const SampledEstimator*>(&estimator);
-  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not a ray-cast or analytic estimator");
+  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not an analytic estimator");
   e->back_column(patch, elements, out);
 }
 

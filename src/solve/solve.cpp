@@ -84,18 +84,19 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   const bool translucency = o.form_factors.diffuse_transmission;
   std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy, translucency);
   std::vector<Rgb> B_elements(hierarchy.elements().size(), Rgb(0.0f));
-  std::vector<Rgb> B_back;  // per element id, with diffuse transmission: the backs' radiosity
+  // Per element id, with diffuse transmission: the backs' radiosity (empty without).
+  std::vector<Rgb> B_back(translucency ? hierarchy.elements().size() : 0, Rgb(0.0f));
   std::vector<std::string> groups = scene.groups();
 
   if (!gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true))
     return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
-                    std::move(report));
+                    std::move(report), Rgb(0.0f), {}, std::move(B_back));
 
   if (system->emitted <= 0.0) {
     // Nothing emits: B = 0 is the exact answer.
     report.warnings.push_back("the scene emits no light; every radiosity is 0");
     return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), SolveStatus::converged,
-                    std::move(report));
+                    std::move(report), Rgb(0.0f), {}, std::move(B_back));
   }
 
   auto estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
