@@ -187,52 +187,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   }
 
   void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    const std::size_t m = elements.size();
-    out.assign(m, SparseFactors{});
-    const std::shared_ptr<const LeafRays> rays = leaf_scene();
-    const std::uint32_t N = options_.hemisphere_rays;
-    const float per_ray = 1.0f / static_cast<float>(N);
-    // One parallel loop does everything for a run of elements; the analytic estimator used
-    // inside is single-threaded, so no nested parallel region is opened per emitting patch.
-    parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
-      HitCounter counter(target_count());
-      Scratch scratch(N);
-      std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
-                                             elements.begin() + static_cast<std::ptrdiff_t>(end));
-      std::vector<float> value, column(run.size()), fraction(lights_.size());
-      // Emitting patches: unoccluded factors, column by column over the run...
-      std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(run.size());
-      for (std::uint32_t j : emitters_) {
-        analytic_serial_->patch_column(j, run, column.data());
-        for (std::size_t k = 0; k < run.size(); ++k)
-          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
-      }
-      for (std::size_t k = begin; k < end; ++k) {
-        // ... times the element's visible fraction of each emitting polygon it faces.
-        auto& own = exact[k - begin];
-        std::fill(fraction.begin(), fraction.end(), -1.0f);
-        for (auto& [j, f] : own) {
-          float& v = fraction[emitter_of_[j]];
-          if (v < 0.0f) v = static_cast<float>(visibility(elements[k], emitter_of_[j]));
-          f *= v;
-        }
-        own.erase(std::remove_if(own.begin(), own.end(), [](const auto& x) { return !(x.second > 0.0f); }),
-                  own.end());
-        // Everything else: the hit fractions of the rays.
-        const std::uint32_t e = elements[k];
-        const Element& el = hierarchy_.element(e);
-        const Patch& source = hierarchy_.patches()[el.patch];
-        Rng rng(options_.seed, e, 0x300000000ull);
-        shoot(*rays, e, source, false, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
-          // Emitting patches reached directly are in the exact part, through glass in the photon map.
-          if (!exact_[j] || path == Path::specular) counter.add(j, w);
-        });
-        index.clear();
-        value.clear();
-        counter.drain(index, value, [&](std::uint32_t, float c) { return c * per_ray; });
-        merge(index, value, own, out[k]);
-      }
-    });
+    rows(elements, false, out);
   }
 
   void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
@@ -240,47 +195,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       if (e >= hierarchy_.elements().size() || back_target_[hierarchy_.element(e).patch] == kNone)
         throw Error(ErrorCode::invalid_argument, "sparse_back_rows: element " + std::to_string(e) +
                                                      " is not an element of a translucent patch");
-    const std::size_t m = elements.size();
-    out.assign(m, SparseFactors{});
-    const std::shared_ptr<const LeafRays> rays = leaf_scene();
-    const std::uint32_t N = options_.hemisphere_rays;
-    const float per_ray = 1.0f / static_cast<float>(N);
-    // As the front rows: emitting patches exactly (the unoccluded factor from the element's back
-    // times the back's visible fraction of the emitting polygon), everything else by rays.
-    parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
-      HitCounter counter(target_count());
-      Scratch scratch(N);
-      std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
-                                             elements.begin() + static_cast<std::ptrdiff_t>(end));
-      std::vector<float> value, column(run.size()), fraction(lights_.size());
-      std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(run.size());
-      for (std::uint32_t j : emitters_) {
-        back_patch_column(*analytic_serial_, j, run, column.data());
-        for (std::size_t k = 0; k < run.size(); ++k)
-          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
-      }
-      for (std::size_t k = begin; k < end; ++k) {
-        const std::uint32_t e = elements[k];
-        auto& own = exact[k - begin];
-        std::fill(fraction.begin(), fraction.end(), -1.0f);
-        for (auto& [j, f] : own) {
-          float& v = fraction[emitter_of_[j]];
-          if (v < 0.0f) v = static_cast<float>(visibility(e, emitter_of_[j], true));
-          f *= v;
-        }
-        own.erase(std::remove_if(own.begin(), own.end(), [](const auto& x) { return !(x.second > 0.0f); }),
-                  own.end());
-        const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
-        Rng rng(options_.seed, e, 0x600000000ull);
-        shoot(*rays, e, source, true, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
-          if (!exact_[j] || path == Path::specular) counter.add(j, w);
-        });
-        index.clear();
-        value.clear();
-        counter.drain(index, value, [&](std::uint32_t, float c) { return c * per_ray; });
-        merge(index, value, own, out[k]);
-      }
-    });
+    rows(elements, true, out);
   }
 
   /// Dense rows keep to the fronts of patches (FormFactorOptions::diffuse_transmission).
@@ -370,6 +285,58 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     glm::vec3 normal;
     PolygonFan fan;  ///< area-uniform points, strata kept
   };
+
+  /// The rows of the elements' fronts, or of their backs when `back` (backward form factors).
+  void rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
+    const std::size_t m = elements.size();
+    out.assign(m, SparseFactors{});
+    const std::shared_ptr<const LeafRays> rays = leaf_scene();
+    const std::uint32_t N = options_.hemisphere_rays;
+    const float per_ray = 1.0f / static_cast<float>(N);
+    // One parallel loop does everything for a run of elements; the analytic estimator used
+    // inside is single-threaded, so no nested parallel region is opened per emitting patch.
+    parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
+      HitCounter counter(target_count());
+      Scratch scratch(N);
+      std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
+                                             elements.begin() + static_cast<std::ptrdiff_t>(end));
+      std::vector<float> value, column(run.size()), fraction(lights_.size());
+      // Emitting patches: unoccluded factors, column by column over the run...
+      std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(run.size());
+      for (std::uint32_t j : emitters_) {
+        if (back)
+          back_patch_column(*analytic_serial_, j, run, column.data());
+        else
+          analytic_serial_->patch_column(j, run, column.data());
+        for (std::size_t k = 0; k < run.size(); ++k)
+          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
+      }
+      for (std::size_t k = begin; k < end; ++k) {
+        // ... times the element's visible fraction of each emitting polygon it faces.
+        auto& own = exact[k - begin];
+        std::fill(fraction.begin(), fraction.end(), -1.0f);
+        for (auto& [j, f] : own) {
+          float& v = fraction[emitter_of_[j]];
+          if (v < 0.0f) v = static_cast<float>(visibility(elements[k], emitter_of_[j], back));
+          f *= v;
+        }
+        own.erase(std::remove_if(own.begin(), own.end(), [](const auto& x) { return !(x.second > 0.0f); }),
+                  own.end());
+        // Everything else: the hit fractions of the rays.
+        const std::uint32_t e = elements[k];
+        const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
+        Rng rng(options_.seed, e, back ? 0x600000000ull : 0x300000000ull);
+        shoot(*rays, e, source, back, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
+          // Emitting patches reached directly are in the exact part, through glass in the photon map.
+          if (!exact_[j] || path == Path::specular) counter.add(j, w);
+        });
+        index.clear();
+        value.clear();
+        counter.drain(index, value, [&](std::uint32_t, float c) { return c * per_ray; });
+        merge(index, value, own, out[k]);
+      }
+    });
+  }
 
   /// F(e -> emitting patch) for each element: unoccluded factor times the element's visible
   /// fraction of the patch's polygon, the latter kept per element for later columns. With

@@ -31,4 +31,8 @@ inline bool pass1_translucent(const Material& m) {
   return m.diffuse_transmittance.x > 0.0f || m.diffuse_transmittance.y > 0.0f || m.diffuse_transmittance.z > 0.0f;
 }
 
+/// What the back of a translucent sheet of `m` reflects: like the front for a two-sided
+/// material, nothing for a one-sided one (its back transmits only, as in the path tracer).
+inline Rgb pass1_back_reflectance(const Material& m) { return m.two_sided ? m.reflectance : Rgb(0.0f); }
+
 }  // namespace radiosity::detail

@@ -223,7 +223,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
           const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
           const Rgb tau = mat.diffuse_transmittance;
           B_elements[c] += tau * H_back[c];
-          B_back[c] = (mat.two_sided ? mat.reflectance : Rgb(0.0f)) * H_back[c] + tau * H_elements[c];
+          B_back[c] = detail::pass1_back_reflectance(mat) * H_back[c] + tau * H_elements[c];
         }
       }
     }

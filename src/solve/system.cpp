@@ -38,8 +38,7 @@ RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hiera
   for (std::uint32_t i : backs) {
     const Element& e = hierarchy.element(leaves[i]);
     const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
-    add(back_target[e.patch], e.area, Rgb(0.0f), mat.two_sided ? mat.reflectance : Rgb(0.0f),
-        mat.diffuse_transmittance, i);
+    add(back_target[e.patch], e.area, Rgb(0.0f), pass1_back_reflectance(mat), mat.diffuse_transmittance, i);
   }
   glm::dvec3 mean(0.0);
   for (std::size_t u = 0; u < area.size(); ++u)
