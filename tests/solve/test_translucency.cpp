@@ -52,6 +52,15 @@ Stack lamp_panel_tile(rad::Material panel) {
   return s;
 }
 
+/// lamp_panel_tile() with a one-sided paper panel (rho 0.2, tau 0.5).
+Stack paper_stack() {
+  rad::Material panel;
+  panel.name = "paper";
+  panel.reflectance = rad::Rgb(0.2f);
+  panel.diffuse_transmittance = rad::Rgb(0.5f);
+  return lamp_panel_tile(panel);
+}
+
 double relative(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
 
 /// The unit box of test::closed_box(wall) with an emitting ceiling, split at x = 0.5 by a
@@ -270,11 +279,7 @@ TEST_SUITE("solve") {
     // each. The panel's back sees the lamp with the C-11 factor F: an emitting target, so the
     // entry is exact (analytic factor, visibility 1). The lamp's front row reaches the panel's
     // back by rays (2^16: 0.8 % noise), and the lamp's column reports the same arrival exactly.
-    rad::Material panel;
-    panel.name = "paper";
-    panel.reflectance = rad::Rgb(0.2f);
-    panel.diffuse_transmittance = rad::Rgb(0.5f);
-    const Stack s = lamp_panel_tile(panel);
+    const Stack s = paper_stack();
     const double F = test::parallel_rectangles(1.0, 1.0, 1.0);
     rad::FormFactorOptions f;
     f.method = rad::FormFactorMethod::monte_carlo;
@@ -311,11 +316,7 @@ TEST_SUITE("solve") {
   }
 
   TEST_CASE("diffuse transmission needs the monte_carlo estimator and says so") {
-    rad::Material panel;
-    panel.name = "paper";
-    panel.reflectance = rad::Rgb(0.2f);
-    panel.diffuse_transmittance = rad::Rgb(0.5f);
-    const Stack s = lamp_panel_tile(panel);
+    const Stack s = paper_stack();
     for (rad::FormFactorMethod method :
          {rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::hemicube, rad::FormFactorMethod::analytic}) {
       rad::SolveOptions o;
