@@ -78,6 +78,32 @@ rad::Scene partitioned_box(const rad::Material& wall, const rad::Material& ceili
   return out;
 }
 
+/// partitioned_box() with grey walls, a ceiling of exitance 2 and a coloured paper.
+rad::Scene paper_box() {
+  rad::Material wall, ceiling, paper;
+  wall.name = "wall";
+  wall.reflectance = rad::Rgb(0.6f, 0.5f, 0.4f);
+  ceiling.name = "ceiling";
+  ceiling.emission = rad::Rgb(2.0f);
+  ceiling.reflectance = rad::Rgb(0.2f);
+  paper.name = "paper";
+  paper.reflectance = rad::Rgb(0.3f);
+  paper.diffuse_transmittance = rad::Rgb(0.5f, 0.3f, 0.1f);
+  return partitioned_box(wall, ceiling, paper);
+}
+
+/// 4096 rays per element, elements of 0.05, tolerance 1e-6.
+rad::SolveOptions box_options(rad::SolverMethod method) {
+  rad::SolveOptions o;
+  o.method = method;
+  o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+  o.form_factors.hemisphere_rays = 4096;
+  o.mesh.max_patch_area = 0.1f;
+  o.mesh.max_element_area = 0.05f;
+  o.tolerance = 1e-6;
+  return o;
+}
+
 }  // namespace
 
 TEST_SUITE("solve") {
@@ -130,30 +156,14 @@ TEST_SUITE("solve") {
     // A closed grey box with an emitting ceiling, split by a one-sided translucent partition.
     // In a closed enclosure every ray lands on a side that keeps a radiosity, so all the power
     // is absorbed: by the walls (1 - rho) H and by the partition's sides (1 - rho - tau) H.
-    rad::Material wall, ceiling, paper;
-    wall.name = "wall";
-    wall.reflectance = rad::Rgb(0.6f, 0.5f, 0.4f);
-    ceiling.name = "ceiling";
-    ceiling.emission = rad::Rgb(2.0f);
-    ceiling.reflectance = rad::Rgb(0.2f);
-    paper.name = "paper";
-    paper.reflectance = rad::Rgb(0.3f);
-    paper.diffuse_transmittance = rad::Rgb(0.5f, 0.3f, 0.1f);
-    const rad::Scene scene = partitioned_box(wall, ceiling, paper);
+    const rad::Scene scene = paper_box();
 
     rad::Solution by[3];
     const rad::SolverMethod methods[3] = {rad::SolverMethod::jacobi, rad::SolverMethod::gauss_seidel,
                                           rad::SolverMethod::progressive};
     for (int k = 0; k < 3; ++k) {
       CAPTURE(k);
-      rad::SolveOptions o;
-      o.method = methods[k];
-      o.form_factors.method = rad::FormFactorMethod::monte_carlo;
-      o.form_factors.hemisphere_rays = 4096;
-      o.mesh.max_patch_area = 0.1f;
-      o.mesh.max_element_area = 0.05f;
-      o.tolerance = 1e-6;
-      by[k] = rad::solve(scene, o);
+      by[k] = rad::solve(scene, box_options(methods[k]));
       REQUIRE(by[k].status() == rad::SolveStatus::converged);
       const rad::SolveReport& r = by[k].report();
       for (int c = 0; c < 3; ++c) CHECK(relative(r.absorbed_power[c], r.emitted_power[c]) < 0.01);
@@ -176,24 +186,12 @@ TEST_SUITE("solve") {
     // The partitioned box refined where radiosity varies fast: the matrix methods compute front
     // and back rows for the new elements, progressive gathers both sides for them. Every leaf of
     // the paper ends with a back radiosity, and the two agree.
-    rad::Material wall, ceiling, paper;
-    wall.reflectance = rad::Rgb(0.6f);
-    ceiling.emission = rad::Rgb(2.0f);
-    ceiling.reflectance = rad::Rgb(0.2f);
-    paper.reflectance = rad::Rgb(0.3f);
-    paper.diffuse_transmittance = rad::Rgb(0.5f);
-    const rad::Scene scene = partitioned_box(wall, ceiling, paper);
+    const rad::Scene scene = paper_box();
     rad::Solution by[2];
     const rad::SolverMethod methods[2] = {rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive};
     for (int k = 0; k < 2; ++k) {
       CAPTURE(k);
-      rad::SolveOptions o;
-      o.method = methods[k];
-      o.form_factors.method = rad::FormFactorMethod::monte_carlo;
-      o.form_factors.hemisphere_rays = 4096;
-      o.mesh.max_patch_area = 0.1f;
-      o.mesh.max_element_area = 0.05f;
-      o.tolerance = 1e-5;
+      rad::SolveOptions o = box_options(methods[k]);
       o.adaptive.enabled = true;
       o.adaptive.threshold = 0.1f;
       by[k] = rad::solve(scene, o);
