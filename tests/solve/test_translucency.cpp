@@ -182,6 +182,21 @@ TEST_SUITE("solve") {
     }
   }
 
+  TEST_CASE("translucent solves are bit-identical at 1 and 2 threads") {
+    const rad::Scene scene = paper_box();
+    for (rad::SolverMethod method : {rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      rad::SolveOptions o = box_options(method);
+      o.form_factors.hemisphere_rays = 256;
+      o.threads = 1;
+      const rad::Solution one = rad::solve(scene, o);
+      o.threads = 2;
+      const rad::Solution two = rad::solve(scene, o);
+      CHECK(one.radiosity() == two.radiosity());
+      CHECK(one.back_radiosity() == two.back_radiosity());
+    }
+  }
+
   TEST_CASE("adaptive subdivision keeps both sides of translucent elements") {
     // The partitioned box refined where radiosity varies fast: the matrix methods compute front
     // and back rows for the new elements, progressive gathers both sides for them. Every leaf of
