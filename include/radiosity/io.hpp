@@ -62,7 +62,10 @@ RADIOSITY_API void write_png(const Image& image, const std::filesystem::path& pa
 /// Writes the solution's leaf elements as a binary little-endian PLY with per-vertex position,
 /// float radiosity (r, g, b properties named radiosity_r/g/b) and 8-bit display colours
 /// (red/green/blue, sRGB of B/pi x exposure), so MeshLab and Blender show the solution.
-/// Only vertices used by leaves are written; faces are triangles (quads split in two).
+/// Only vertices used by leaves are written; faces are triangles (quads split in two), facing
+/// like the polygons. With diffuse transmission (Solution::back_radiosity()), every leaf whose
+/// back sends light also gets a back face: its triangles reversed, over copies of its vertices
+/// that carry the back radiosity (coincident with the front, so view it with back-face culling).
 /// Throws Error{io_error} naming the path when the file cannot be written.
 RADIOSITY_API void write_ply(const Solution& solution, const std::filesystem::path& path,
                              const PngOptions& options = {});

@@ -15,6 +15,7 @@
 
 #include "io/srgb.hpp"
 #include "radiosity/io.hpp"
+#include "radiosity/radiosity.hpp"
 
 namespace {
 
@@ -179,6 +180,54 @@ TEST_CASE("write_ply writes the leaves as triangles over the vertices they use -
   }
   CHECK(area == doctest::Approx(leaf_area).epsilon(1e-5));
   CHECK(area == doctest::Approx(1.5).epsilon(1e-5));  // unit quad + half-unit triangle
+}
+
+TEST_CASE("write_ply gives translucent elements a reversed back face carrying their back radiosity") {
+  // A lamp above a translucent panel facing it (one element each): the panel's back sends
+  // tau H_front, so the PLY holds the lamp's and the panel's fronts plus the panel's back.
+  radiosity::Scene scene;
+  radiosity::Material lamp, paper;
+  lamp.emission = Rgb(10.0f);
+  paper.reflectance = Rgb(0.0f);
+  paper.diffuse_transmittance = Rgb(0.5f);
+  const radiosity::MaterialId l = scene.add_material(lamp), p = scene.add_material(paper);
+  radiosity::add_quad(scene, {0, 1, 2}, {1, 0, 0}, {0, -1, 0}, l, "lamp");  // faces down
+  radiosity::add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, p, "paper");  // faces up
+  radiosity::SolveOptions so;
+  so.form_factors.method = radiosity::FormFactorMethod::monte_carlo;
+  so.mesh.max_patch_area = so.mesh.max_element_area = 10.0f;
+  const radiosity::Solution sol = radiosity::solve(scene, so);
+  const Rgb back = sol.back_radiosity()[sol.hierarchy().patches()[1].root];
+  REQUIRE(back.x > 0.0f);
+
+  fs::create_directories(kTmp);
+  const fs::path path = kTmp / "translucent.ply";
+  radiosity::write_ply(sol, path);
+  const std::string bytes = read_all(path);
+  const std::size_t end = bytes.find("end_header\n");
+  REQUIRE(end != std::string::npos);
+  CHECK(bytes.find("element vertex 12\n") < end);  // 4 + 4 fronts, 4 back copies
+  CHECK(bytes.find("element face 6\n") < end);     // 2 + 2 fronts, 2 backs
+  const std::size_t body = end + std::string("end_header\n").size();
+  REQUIRE(bytes.size() == body + 27 * 12 + 13 * 6);
+  auto position = [&](std::uint32_t i) {
+    const std::size_t o = body + 27 * i;
+    return glm::vec3(get_le<float>(bytes, o), get_le<float>(bytes, o + 4), get_le<float>(bytes, o + 8));
+  };
+  // The last two faces are the back: over vertices 8..11, radiosity = the back's, facing -z.
+  for (std::size_t t = 4; t < 6; ++t) {
+    const std::size_t o = body + 27 * 12 + 13 * t;
+    std::uint32_t idx[3];
+    for (int k = 0; k < 3; ++k) {
+      idx[k] = get_le<std::uint32_t>(bytes, o + 1 + 4 * static_cast<std::size_t>(k));
+      REQUIRE(idx[k] >= 8);
+      REQUIRE(idx[k] < 12);
+      CHECK(get_le<float>(bytes, body + 27 * idx[k] + 12) == doctest::Approx(back.x));
+      CHECK(position(idx[k]).z == 1.0f);
+    }
+    const glm::vec3 a = position(idx[0]), b = position(idx[1]), c = position(idx[2]);
+    CHECK(glm::cross(b - a, c - a).z < 0.0f);  // the panel faces +z, its back -z
+  }
 }
 
 TEST_CASE("write_ply errors name the path") {
