@@ -87,18 +87,22 @@ int main(int argc, char** argv) {
         scene.set_camera(c);  // validates
         camera = c;
       }
+      // What the three renderers' options share; spp defaults per renderer.
+      auto image_options = [&](auto& o, int default_spp) {
+        o.width = width;
+        o.height = height;
+        o.spp = spp > 0 ? spp : default_spp;
+        o.camera = camera;
+        o.threads = render_args.threads;
+        o.seed = render_args.seed;
+        o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+      };
       rad::Image image;
       if (render_args.method == "path") {
         // The reference: an unbiased path tracer, no radiosity solve.
         rad::PathTraceOptions po;
-        po.width = width;
-        po.height = height;
-        po.spp = spp > 0 ? spp : 256;
+        image_options(po, 256);
         po.max_depth = max_depth;
-        po.camera = camera;
-        po.threads = render_args.threads;
-        po.seed = render_args.seed;
-        po.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
         image = rad::render_path_traced(scene, po);
         bar.finish();
         std::printf("path traced: %d samples per pixel\n", po.spp);
@@ -109,18 +113,12 @@ int main(int argc, char** argv) {
         bar.finish();
         print_summary(sol);
         rad::TwoPassOptions to;
-        to.width = width;
-        to.height = height;
-        to.spp = spp > 0 ? spp : 16;
-        to.threads = render_args.threads;
-        to.seed = render_args.seed;
+        image_options(to, 16);
         to.ambient = ambient;
-        to.camera = camera;
         to.caustics.photons = photons;
         to.content = direct_only  ? rad::TwoPassContent::direct_only
                      : pass1_only ? rad::TwoPassContent::pass1_only
                                   : rad::TwoPassContent::full;
-        to.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
         rad::TwoPassReport report;
         image = rad::render_two_pass(scene, sol, to, report);
         bar.finish();
@@ -131,15 +129,9 @@ int main(int argc, char** argv) {
         bar.finish();
         print_summary(sol);
         rad::RenderOptions ro;
-        ro.width = width;
-        ro.height = height;
-        ro.spp = spp > 0 ? spp : 4;
-        ro.threads = render_args.threads;
-        ro.seed = render_args.seed;
+        image_options(ro, 4);
         ro.wireframe = wireframe;
         ro.ambient = ambient;
-        ro.camera = camera;
-        ro.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
         image = rad::render(scene, sol, ro);
         bar.finish();
       }
