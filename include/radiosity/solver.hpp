@@ -85,8 +85,9 @@ class RADIOSITY_API Solution {
  public:
   Solution() = default;
   /// `radiosity`, `ambient_radiosity` and `back_radiosity` are indexed by element id (inner
-  /// nodes included); `ambient_radiosity` is reflectance x ambient per element, or empty for
-  /// none; `back_radiosity` is the radiosity leaving the backs of translucent elements (0
+  /// nodes included); `ambient_radiosity` is reflectance x ambient per element (reflectance +
+  /// diffuse transmittance for a translucent one, which the ambient reaches on both sides), or
+  /// empty for none; `back_radiosity` is the radiosity leaving the backs of translucent elements (0
   /// elsewhere), or empty when the scene has no translucent material.
   Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
            SolveStatus status, SolveReport report, Rgb ambient = Rgb(0.0f),
