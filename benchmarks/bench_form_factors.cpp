@@ -264,6 +264,12 @@ void overlap_section() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 2 || (argc == 2 && std::strcmp(argv[1], "--quick") != 0 && std::strcmp(argv[1], "--overlaps") != 0)) {
+    const bool help = argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0);
+    if (!help) std::fprintf(stderr, "bench_form_factors: bad argument '%s'\n", argv[argc - 1]);
+    std::fprintf(stderr, "usage: bench_form_factors [--quick | --overlaps]\n");
+    return help ? 0 : 2;
+  }
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   std::printf("bench_form_factors (radiosity %s), %u hardware threads\n", rad::version(),
               std::thread::hardware_concurrency());

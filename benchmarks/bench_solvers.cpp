@@ -125,21 +125,46 @@ void compare(std::size_t target_patches) {
 
 }  // namespace
 
+/// A positive integer argument, or 0 when `text` is not one.
+std::size_t count_arg(const char* text) {
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(text, &end, 10);
+  return (end != text && *end == '\0' && text[0] != '-') ? static_cast<std::size_t>(v) : 0;
+}
+
+int usage(const char* bad) {
+  if (bad) std::fprintf(stderr, "bench_solvers: bad argument '%s'\n", bad);
+  std::fprintf(stderr,
+               "usage: bench_solvers [--ray-cast] [--rays N] [--only jacobi|gauss-seidel|progressive] [PATCHES...]\n"
+               "       bench_solvers --compare PATCHES\n");
+  return bad ? 2 : 0;
+}
+
 int main(int argc, char** argv) {
   std::vector<std::size_t> sizes;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--compare" && i + 1 < argc) {
-      compare(std::strtoul(argv[++i], nullptr, 10));
+    const bool has_value = i + 1 < argc;
+    if (arg == "--help" || arg == "-h") return usage(nullptr);
+    if (arg == "--compare" && has_value) {
+      const std::size_t n = count_arg(argv[++i]);
+      if (n == 0) return usage(argv[i]);
+      compare(n);
       return 0;
     }
-    if (arg == "--only" && i + 1 < argc) {
+    if (arg == "--only" && has_value) {
       g_only = argv[++i];
-      continue;
+      if (g_only != "jacobi" && g_only != "gauss-seidel" && g_only != "progressive") return usage(argv[i]);
+    } else if (arg == "--ray-cast") {
+      g_estimator = radiosity::FormFactorMethod::ray_cast;
+    } else if (arg == "--rays" && has_value) {
+      g_rays = static_cast<std::uint32_t>(count_arg(argv[++i]));
+      if (g_rays == 0) return usage(argv[i]);
+    } else {
+      const std::size_t n = count_arg(argv[i]);
+      if (n == 0) return usage(argv[i]);
+      sizes.push_back(n);
     }
-    if (arg == "--ray-cast") g_estimator = radiosity::FormFactorMethod::ray_cast;
-    else if (arg == "--rays" && i + 1 < argc) g_rays = static_cast<std::uint32_t>(std::strtoul(argv[++i], nullptr, 10));
-    else sizes.push_back(std::strtoul(arg.c_str(), nullptr, 10));
   }
   if (sizes.empty()) sizes = {4000};
   const struct {

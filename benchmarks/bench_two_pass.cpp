@@ -15,12 +15,46 @@
 
 #include <radiosity/radiosity.hpp>
 
+namespace {
+
+int usage(const char* bad) {
+  if (bad) std::fprintf(stderr, "bench_two_pass: bad argument '%s'\n", bad);
+  std::fprintf(stderr, "usage: bench_two_pass [width [spp [photons [max_patch_area [gather]]]]]\n");
+  return bad ? 2 : 0;
+}
+
+/// A non-negative number, or -1 when `text` is not one.
+double number_arg(const char* text) {
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  return (end != text && *end == '\0' && v >= 0.0) ? v : -1.0;
+}
+
+int run(int width, int spp, std::size_t photons, float patch_area, bool gather);
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  const int width = argc > 1 ? std::atoi(argv[1]) : 512;
-  const int spp = argc > 2 ? std::atoi(argv[2]) : 16;
-  const std::size_t photons = argc > 3 ? std::strtoul(argv[3], nullptr, 10) : 200000;
-  const float patch_area = argc > 4 ? static_cast<float>(std::atof(argv[4])) : 0.0f;
-  const bool gather = argc > 5 && std::string(argv[5]) == "gather";
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) return usage(nullptr);
+  if (argc > 6) return usage(argv[6]);
+  double v[4] = {512, 16, 200000, 0};
+  for (int i = 1; i < argc && i <= 4; ++i) {
+    v[i - 1] = number_arg(argv[i]);
+    if (v[i - 1] < 0.0 || (i <= 2 && v[i - 1] < 1.0)) return usage(argv[i]);
+  }
+  if (argc > 5 && std::string(argv[5]) != "gather") return usage(argv[5]);
+  try {
+    return run(static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<std::size_t>(v[2]),
+               static_cast<float>(v[3]), argc > 5);
+  } catch (const radiosity::Error& e) {
+    std::fprintf(stderr, "bench_two_pass: error: %s\n", e.what());
+    return 1;
+  }
+}
+
+namespace {
+
+int run(int width, int spp, std::size_t photons, float patch_area, bool gather) {
   const radiosity::Scene scene = radiosity::cornell_box_specular();
 
   // Wall time per phase, and the process's CPU time (all threads), which a busy shared machine
@@ -65,3 +99,5 @@ int main(int argc, char** argv) {
               cpu_pass1, cpu_pass2);
   return image.pixels.empty() ? 1 : 0;
 }
+
+}  // namespace
