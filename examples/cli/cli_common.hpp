@@ -93,7 +93,6 @@ struct SolveArgs {
   bool adaptive = false;
   float adaptive_threshold = 0.3f;
   int adaptive_passes = 3;
-  CLI::Option* form_factors_option = nullptr;  ///< to tell whether --form-factors was given
 };
 
 /// The estimator a `--form-factors` / `--method` name (as the CLI spells it) selects.
@@ -117,11 +116,9 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--method", a.method, with_path ? "Solver, or path for the reference path tracer" : "Solver")
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
-  a.form_factors_option =
-      cmd.add_option("--form-factors", a.form_factors,
-                     "Form-factor estimator (default ray-cast; monte-carlo for scenes with translucent materials)")
-          ->check(CLI::IsMember(form_factor_names()))
-          ->capture_default_str();
+  cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
+      ->check(CLI::IsMember(form_factor_names()))
+      ->capture_default_str();
   cmd.add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo estimator: rays per element, 16..1048576")
       ->check(CLI::Range(16u, 1u << 20))
       ->capture_default_str();
@@ -149,18 +146,6 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)");
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->capture_default_str();
-}
-
-/// Without --form-factors, a scene with translucent materials (diffuse_transmittance), which only
-/// the Monte Carlo estimator carries, gets it, with a note on stderr.
-inline void choose_estimator(SolveArgs& a, const rad::Scene& scene) {
-  if (a.form_factors_option != nullptr && a.form_factors_option->count() > 0) return;
-  for (const rad::Material& m : scene.materials())
-    if (m.diffuse_transmittance.x > 0.0f || m.diffuse_transmittance.y > 0.0f || m.diffuse_transmittance.z > 0.0f) {
-      std::fprintf(stderr, "note: material '%s' is translucent: using --form-factors monte-carlo\n", m.name.c_str());
-      a.form_factors = "monte-carlo";
-      return;
-    }
 }
 
 inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {

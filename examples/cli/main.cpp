@@ -76,7 +76,6 @@ int main(int argc, char** argv) {
     if (*render) {
       rad::Scene scene = load(render_args.scene);
       print_warnings(scene.warnings());
-      choose_estimator(render_args, scene);
       std::optional<rad::Camera> camera;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
         rad::Camera c = scene.camera();
@@ -147,7 +146,6 @@ int main(int argc, char** argv) {
     } else if (*solve) {
       rad::Scene scene = load(solve_args.scene);
       print_warnings(scene.warnings());
-      choose_estimator(solve_args, scene);
       const rad::SolveOptions options = to_options(solve_args, bar);
       rad::Solution sol = rad::solve(scene, options);
       bar.finish();

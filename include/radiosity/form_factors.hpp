@@ -137,7 +137,7 @@ class RADIOSITY_API FormFactorEstimator {
   /// store F sparse, and the matrix methods' memory check uses max_row_entries().
   virtual bool sparse() const;
 
-  /// An upper bound of the non-zero entries of any row; the patch count for dense estimators.
+  /// An upper bound of the non-zero entries of any row; target_count() for dense estimators.
   virtual std::size_t max_row_entries() const;
 
   /// With FormFactorOptions::diffuse_transmission: the translucent patches, increasing; the

@@ -26,9 +26,10 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   if (o.specular_depth > 0 && o.method != FormFactorMethod::monte_carlo)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth > 0 (mirror and window form factors) needs FormFactorMethod::monte_carlo");
-  if (o.diffuse_transmission && o.method != FormFactorMethod::monte_carlo)
+  if (o.diffuse_transmission && o.method == FormFactorMethod::hemicube)
     throw Error(ErrorCode::invalid_argument,
-                "form_factors.diffuse_transmission (translucent materials) needs FormFactorMethod::monte_carlo");
+                "form_factors.diffuse_transmission (translucent materials) is not available with the hemicube; use "
+                "ray_cast, analytic or monte_carlo");
   return o;
 }
 
@@ -83,13 +84,13 @@ void FormFactorEstimator::sparse_patch_columns(const std::vector<std::uint32_t>&
 
 void FormFactorEstimator::sparse_back_rows(const std::vector<std::uint32_t>&, std::vector<SparseFactors>&) const {
   throw Error(ErrorCode::invalid_argument,
-              "sparse_back_rows: this estimator has no diffuse transmission (FormFactorOptions::diffuse_transmission "
-              "with FormFactorMethod::monte_carlo)");
+              "sparse_back_rows: this estimator has no diffuse transmission (FormFactorOptions::diffuse_transmission, "
+              "not available with the hemicube)");
 }
 
 bool FormFactorEstimator::sparse() const { return false; }
 
-std::size_t FormFactorEstimator::max_row_entries() const { return patch_count_; }
+std::size_t FormFactorEstimator::max_row_entries() const { return target_count(); }
 
 std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                                 const FormFactorOptions& options) {

@@ -46,8 +46,8 @@ struct RayCastCounters {
 /// Fills `out` and returns true when `estimator` is a ray-cast or analytic estimator.
 bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& out);
 
-/// patch_column() of an analytic estimator from the backs of the elements (each a Lambertian
-/// surface facing -normal): the unoccluded F(back of e -> patch) for diffuse transmission.
+/// patch_column() of a ray-cast or analytic estimator from the backs of the elements (each a
+/// Lambertian surface facing -normal): F(back of e -> patch) for diffuse transmission.
 void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch,
                        const std::vector<std::uint32_t>& elements, float* out);
 

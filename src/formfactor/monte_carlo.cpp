@@ -183,7 +183,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   bool sparse() const override { return true; }
 
   std::size_t max_row_entries() const override {
-    return std::min<std::size_t>(hierarchy_.patches().size(), options_.hemisphere_rays + emitters_.size());
+    return std::min<std::size_t>(target_count(), options_.hemisphere_rays + emitters_.size());
   }
 
   void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {

@@ -16,6 +16,10 @@
 // the estimate is the exact factor up to the quadrature over e. Pairs whose first rays disagree
 // (a penumbra) are sampled again with more rays, in proportion to their unoccluded factor.
 // The rays of a pass all join one element to one patch and are traced together as packets.
+//
+// Diffuse transmission (FormFactorOptions::diffuse_transmission): the back of a translucent
+// patch is a receiver facing -normal, and an element's back is a source facing -normal
+// (backward form factors); both go through the same code with the normal flipped.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -32,6 +36,7 @@
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
 #include "geometry/ray_scene.hpp"
+#include "scene/specular_transport.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -92,6 +97,12 @@ class SampledEstimator final : public FormFactorEstimator {
     // the shaft test's "touching" tolerance.
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
+    if (options.diffuse_transmission) {
+      std::vector<std::uint32_t> translucent;
+      for (std::uint32_t j = 0; j < patches.size(); ++j)
+        if (pass1_translucent(scene.material(patches[j].material))) translucent.push_back(j);
+      set_translucent_patches(std::move(translucent));
+    }
     corners_.resize(patches.size());
     for (std::size_t j = 0; j < patches.size(); ++j) {
       const Element& root = hierarchy.element(patches[j].root);
@@ -149,20 +160,67 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
   /// patch_column() for the backs of the elements: each treated as a Lambertian surface facing
-  /// -normal (diffuse transmission's backward form factors). Unoccluded factors only: the
-  /// shaft verdicts cached per patch pair are the fronts'.
+  /// -normal (diffuse transmission's backward form factors).
   void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
-    if (visibility_) throw Error(ErrorCode::internal, "back_patch_column: needs the analytic estimator");
     parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
       Source source;
       RayCastCounters counts;
       for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source);
-        source.normal = -source.normal;
+        prepare(elements[k], source, true);
         out[k] = static_cast<float>(factor(source, patch, counts));
       }
       add(counts);
     });
+  }
+
+  // With diffuse transmission, rows run over every target (backs after the patches).
+  void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
+    if (translucent_patches().empty()) {
+      FormFactorEstimator::sparse_element_rows(elements, out);
+      return;
+    }
+    target_rows(elements, false, out);
+  }
+
+  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
+    for (std::uint32_t e : elements)
+      if (e >= hierarchy_.elements().size() || !is_translucent(hierarchy_.element(e).patch))
+        throw Error(ErrorCode::invalid_argument, "sparse_back_rows: element " + std::to_string(e) +
+                                                     " is not an element of a translucent patch");
+    target_rows(elements, true, out);
+  }
+
+  void sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
+                           SparseFactors& out) const override {
+    if (translucent_patches().empty()) {
+      FormFactorEstimator::sparse_patch_column(target, elements, out);
+      return;
+    }
+    if (target >= target_count())
+      throw Error(ErrorCode::invalid_argument, "sparse_patch_column: target " + std::to_string(target) +
+                                                   " out of range (" + std::to_string(target_count()) + " targets)");
+    // Fronts of all elements, then the backs of the translucent ones (index m + k).
+    const std::size_t m = elements.size();
+    std::vector<float> column(2 * m, 0.0f);
+    parallel_for(options_.threads, m, 64, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source);
+        column[k] = static_cast<float>(factor(source, target, counts));
+        if (!is_translucent(source.patch)) continue;
+        prepare(elements[k], source, true);
+        column[m + k] = static_cast<float>(factor(source, target, counts));
+      }
+      add(counts);
+    });
+    out.index.clear();
+    out.value.clear();
+    for (std::size_t k = 0; k < column.size(); ++k)
+      if (column[k] > 0.0f) {
+        out.index.push_back(static_cast<std::uint32_t>(k));
+        out.value.push_back(column[k]);
+      }
   }
 
   RayCastCounters counters() const {
@@ -174,6 +232,32 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
  private:
+  bool is_translucent(std::uint32_t patch) const {
+    const auto& t = translucent_patches();
+    return std::binary_search(t.begin(), t.end(), patch);
+  }
+
+  // The rows of the elements' fronts (or backs) over every target, non-zero entries only.
+  void target_rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
+    out.assign(elements.size(), SparseFactors{});
+    const auto targets = static_cast<std::uint32_t>(target_count());
+    parallel_for(options_.threads, elements.size(), 4, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source, back);
+        for (std::uint32_t t = 0; t < targets; ++t) {
+          const auto f = static_cast<float>(factor(source, t, counts));
+          if (f > 0.0f) {
+            out[k].index.push_back(t);
+            out[k].value.push_back(f);
+          }
+        }
+      }
+      add(counts);
+    });
+  }
+
   static constexpr int kMaxDepth = 5;
   // Absolute accuracy goal of each unoccluded factor: rows of a closed enclosure then sum to 1
   // within about 1e-4 even with tens of near neighbours.
@@ -202,15 +286,31 @@ class SampledEstimator final : public FormFactorEstimator {
     CellMap map;                            ///< polynomial map (quadrature)
     std::array<glm::vec3, 5> quadrature{};  ///< the 2x2 Gauss points, then the midpoint
     std::array<float, 5> density{};         ///< the map's area density at those points
+    bool back = false;                      ///< the element's back side (normal flipped)
   };
 
-  void prepare(std::uint32_t e, Source& s) const {
+  // A receiving patch, or the back of a translucent one (facing -normal).
+  struct Receiver {
+    std::uint32_t patch = 0;   ///< in the hierarchy
+    std::uint32_t target = 0;  ///< its index in a row: the patch, or patch count + k for a back
+    glm::vec3 normal{0.0f};
+  };
+
+  Receiver receiver(std::uint32_t target) const {
+    const std::size_t n = patch_count();
+    const std::uint32_t j = target < n ? target : translucent_patches()[target - n];
+    const glm::vec3 normal = hierarchy_.patches()[j].normal;
+    return Receiver{j, target, target < n ? normal : -normal};
+  }
+
+  void prepare(std::uint32_t e, Source& s, bool back = false) const {
     const Element& el = hierarchy_.element(e);
     const Patch& patch = hierarchy_.patches()[el.patch];
     s.element = e;
     s.patch = el.patch;
     s.polygon = patch.polygon;
-    s.normal = patch.normal;
+    s.normal = back ? -patch.normal : patch.normal;
+    s.back = back;
     s.centroid = el.centroid;
     s.corner_count = el.corner_count();
     s.radius = 0.0f;
@@ -235,13 +335,15 @@ class SampledEstimator final : public FormFactorEstimator {
     rays_cast_.fetch_add(c.rays, std::memory_order_relaxed);
   }
 
-  double factor(const Source& s, std::uint32_t j, RayCastCounters& counts) const {
+  // F(source -> target): `target` indexes a row (a patch, or a translucent patch's back).
+  double factor(const Source& s, std::uint32_t target_index, RayCastCounters& counts) const {
     ++counts.factors;
-    const Patch& target = hierarchy_.patches()[j];
+    const Receiver r = receiver(target_index);
+    const Patch& target = hierarchy_.patches()[r.patch];
     // Patches of one planar polygon cannot see each other.
     if (s.polygon == target.polygon) return 0.0;
-    const glm::vec3 nx = s.normal, ny = target.normal;
-    const PatchCorners& poly = corners_[j];
+    const glm::vec3 nx = s.normal, ny = r.normal;
+    const PatchCorners& poly = corners_[r.patch];
 
     // Whole-pair culling: the receiver entirely below the element's plane, or the element
     // entirely behind the receiver.
@@ -254,20 +356,22 @@ class SampledEstimator final : public FormFactorEstimator {
       any_in_front |= glm::dot(s.corners[static_cast<std::size_t>(k)] - target.centroid, ny) > epsilon_;
     if (!any_in_front) return 0.0;
 
-    const double unoccluded = unoccluded_factor(s, target, poly);
-    if (!visibility_ || unoccluded <= 0.0 || !may_be_shadowed(s, j)) return unoccluded;
+    const double unoccluded = unoccluded_factor(s, target, ny, poly);
+    if (!visibility_ || unoccluded <= 0.0 || !may_be_shadowed(s, r)) return unoccluded;
     ++counts.shadowed;
-    return unoccluded * visible_fraction(s, j, unoccluded, counts.rays);
+    return unoccluded * visible_fraction(s, r, unoccluded, counts.rays);
   }
 
   // Whether any polygon but the pair's own can enter the convex hull of source and receiver.
   // With the cache, the hull of the source's whole patch is tested once for all its elements.
-  bool may_be_shadowed(const Source& s, std::uint32_t j) const {
+  // The cache holds front-to-front pairs; pairs involving a back are tested each time.
+  bool may_be_shadowed(const Source& s, const Receiver& r) const {
+    const std::uint32_t j = r.patch;
     const Patch& target = hierarchy_.patches()[j];
     const PatchCorners& poly = corners_[j];
     Shaft shaft;
-    if (!verdicts_) {
-      return shaft.build(s.corners.data(), s.corner_count, s.normal, poly.p.data(), poly.count, target.normal,
+    if (!verdicts_ || s.back || r.target != r.patch) {
+      return shaft.build(s.corners.data(), s.corner_count, s.normal, poly.p.data(), poly.count, r.normal,
                          epsilon_) &&
              occluders_.any(shaft, s.polygon, target.polygon);
     }
@@ -300,12 +404,12 @@ class SampledEstimator final : public FormFactorEstimator {
   // proportion to F minimises the variance of sums of factors (a row, a group's factor, the
   // gathered radiosity) for a given number of rays: small factors keep ns x nv rays, large ones
   // get up to 64 x 64.
-  double visible_fraction(const Source& s, std::uint32_t j, double unoccluded, std::uint64_t& rays_cast) const {
-    const Patch& target = hierarchy_.patches()[j];
-    const PatchCorners& poly = corners_[j];
-    const glm::vec3 nx = s.normal, ny = target.normal;
+  double visible_fraction(const Source& s, const Receiver& receiver, double unoccluded, std::uint64_t& rays_cast) const {
+    const Patch& target = hierarchy_.patches()[receiver.patch];
+    const PatchCorners& poly = corners_[receiver.patch];
+    const glm::vec3 nx = s.normal, ny = receiver.normal;
     const std::uint32_t ns = options_.source_samples, nv = options_.visibility_rays;
-    Rng rng(options_.seed, s.element, 0x100000000ull + j);
+    Rng rng(options_.seed, s.element, (s.back ? 0x180000000ull : 0x100000000ull) + receiver.target);
     RayBatch& batch = ray_batch();
     // A pass of about `budget` rays: S = g^2 stratified source points, T = h^2 rays from each
     // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays. All rays of a pass
@@ -420,8 +524,8 @@ class SampledEstimator final : public FormFactorEstimator {
   // element. Far pairs have a smooth integrand and one 2x2 Gauss rule suffices; near pairs
   // (shared edges, where the integrand has a logarithmic singularity) are refined adaptively
   // until two levels agree, so closed-enclosure rows sum to 1 and reciprocity holds to ~1e-4.
-  double unoccluded_factor(const Source& s, const Patch& target, const PatchCorners& poly) const {
-    const glm::vec3 nx = s.normal, ny = target.normal;
+  double unoccluded_factor(const Source& s, const Patch& target, const glm::vec3& ny, const PatchCorners& poly) const {
+    const glm::vec3 nx = s.normal;
     auto at = [&](const glm::vec3& x) -> double {
       if (glm::dot(x - target.centroid, ny) <= 0.0f) return 0.0;  // sees the receiver's back
       return point_to_polygon_factor_fast(x, nx, poly.p.data(), poly.count);
@@ -463,7 +567,7 @@ bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& ou
 void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                        float* out) {
   const auto* e = dynamic_cast<const SampledEstimator*>(&estimator);
-  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not an analytic estimator");
+  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not a ray-cast or analytic estimator");
   e->back_column(patch, elements, out);
 }
 

@@ -40,9 +40,8 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
     if (slot_of(u) == kNone) missing.push_back(static_cast<std::uint32_t>(u));
   // Memory, stated before anything is computed: dense rows hold a float per patch, sparse rows
   // an index and a float per entry, at most max_row_entries() of them.
-  const bool sparse = ctx.estimator.sparse();
-  if (sys.has_backs() && !sparse)
-    throw Error(ErrorCode::internal, "solve: diffuse transmission needs an estimator with sparse rows");
+  // Rows with backs come from the sparse calls (the dense ones keep to fronts).
+  const bool sparse = ctx.estimator.sparse() || sys.has_backs();
   const std::size_t row_bytes =
       sparse ? std::min(n, ctx.estimator.max_row_entries()) * 2 * sizeof(float) : n * sizeof(float);
   std::size_t rows_held = 0;

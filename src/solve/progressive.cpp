@@ -41,7 +41,8 @@ SolverResult solve_progressive(const SolverContext& ctx) {
   // Columns are kept once computed while they fit the memory budget: a patch is usually shot
   // several times, and recomputing its column is the whole cost of a step.
   // Sparse estimators (monte_carlo) give sparse columns, so a step costs O(entries).
-  const bool sparse = ctx.estimator.sparse();
+  // Columns with backs come from the sparse calls (the dense ones keep to fronts).
+  const bool sparse = ctx.estimator.sparse() || sys.has_backs();
   std::vector<FactorVector> cache(n);
   std::vector<std::uint8_t> cached(n, 0);  // a column may be cached and empty (a patch that sees nothing)
   std::size_t cached_bytes = 0, peak_scratch = 0;
