@@ -404,12 +404,12 @@ class SampledEstimator final : public FormFactorEstimator {
   // proportion to F minimises the variance of sums of factors (a row, a group's factor, the
   // gathered radiosity) for a given number of rays: small factors keep ns x nv rays, large ones
   // get up to 64 x 64.
-  double visible_fraction(const Source& s, const Receiver& receiver, double unoccluded, std::uint64_t& rays_cast) const {
-    const Patch& target = hierarchy_.patches()[receiver.patch];
-    const PatchCorners& poly = corners_[receiver.patch];
-    const glm::vec3 nx = s.normal, ny = receiver.normal;
+  double visible_fraction(const Source& s, const Receiver& to, double unoccluded, std::uint64_t& rays_cast) const {
+    const Patch& target = hierarchy_.patches()[to.patch];
+    const PatchCorners& poly = corners_[to.patch];
+    const glm::vec3 nx = s.normal, ny = to.normal;
     const std::uint32_t ns = options_.source_samples, nv = options_.visibility_rays;
-    Rng rng(options_.seed, s.element, (s.back ? 0x180000000ull : 0x100000000ull) + receiver.target);
+    Rng rng(options_.seed, s.element, (s.back ? 0x180000000ull : 0x100000000ull) + to.target);
     RayBatch& batch = ray_batch();
     // A pass of about `budget` rays: S = g^2 stratified source points, T = h^2 rays from each
     // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays. All rays of a pass
