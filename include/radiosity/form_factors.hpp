@@ -72,9 +72,8 @@ struct FormFactorOptions {
   /// specular parts are ignored and every polygon is opaque. Glossy lobes are not carried. In
   /// [0, 16].
   std::uint32_t specular_depth = 0;
-  /// Diffuse transmission (Rushmeier & Torrance 1990), for ray_cast, analytic and monte_carlo
-  /// (the hemicube refuses it: Error{invalid_argument}). A patch whose material has
-  /// diffuse_transmittance > 0 is translucent: a thin sheet with two sides. Its back becomes a
+  /// Diffuse transmission (Rushmeier & Torrance 1990), for every method. A patch whose material
+  /// has diffuse_transmittance > 0 is translucent: a thin sheet with two sides. Its back becomes a
   /// second target, numbered patch count + k for the k-th translucent patch
   /// (FormFactorEstimator::translucent_patches()), which sparse rows and columns then report,
   /// and its elements get a second row over the back hemisphere (sparse_back_rows(): Rushmeier's

@@ -147,9 +147,7 @@ RADIOSITY_API void validate(const SolveOptions& options);
 /// options or when the matrix methods would exceed memory_budget_bytes (the message gives the
 /// size and suggests progressive or a coarser mesh), and Error{invalid_scene} naming two
 /// polygons for coincident or interpenetrating surfaces (find_overlaps(); checked when the form
-/// factors are set up, so a scene that emits nothing returns B = 0 without the check), and
-/// Error{invalid_argument} naming the material for a translucent one (diffuse_transmittance > 0)
-/// with the hemicube, which cannot carry diffuse transmission. A cancelled solve returns the last
+/// factors are set up, so a scene that emits nothing returns B = 0 without the check). A cancelled solve returns the last
 /// consistent estimate with status cancelled.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});

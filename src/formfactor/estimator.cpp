@@ -26,10 +26,6 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   if (o.specular_depth > 0 && o.method != FormFactorMethod::monte_carlo)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth > 0 (mirror and window form factors) needs FormFactorMethod::monte_carlo");
-  if (o.diffuse_transmission && o.method == FormFactorMethod::hemicube)
-    throw Error(ErrorCode::invalid_argument,
-                "form_factors.diffuse_transmission (translucent materials) is not available with the hemicube; use "
-                "ray_cast, analytic or monte_carlo");
   return o;
 }
 
@@ -84,8 +80,7 @@ void FormFactorEstimator::sparse_patch_columns(const std::vector<std::uint32_t>&
 
 void FormFactorEstimator::sparse_back_rows(const std::vector<std::uint32_t>&, std::vector<SparseFactors>&) const {
   throw Error(ErrorCode::invalid_argument,
-              "sparse_back_rows: this estimator has no diffuse transmission (FormFactorOptions::diffuse_transmission, "
-              "not available with the hemicube)");
+              "sparse_back_rows: this estimator was made without FormFactorOptions::diffuse_transmission");
 }
 
 bool FormFactorEstimator::sparse() const { return false; }

@@ -16,9 +16,14 @@
 // averages F(dx -> j) over Gauss-Legendre points x of the element (weights from the product
 // rule), each hemicube turned about the normal by its own random angle so that the pixel grid's
 // aliasing does not line up with the scene's edges.
+//
+// Diffuse transmission (FormFactorOptions::diffuse_transmission): a translucent patch seen from
+// behind writes its back target into the item buffer instead of nothing, and an element's back
+// row is the hemicube over its back side (the frame's normal flipped).
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -28,6 +33,7 @@
 #include "formfactor/estimators.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
+#include "scene/specular_transport.hpp"
 
 namespace radiosity::detail {
 
@@ -80,7 +86,8 @@ struct Projected {
   int count = 0;
   glm::vec3 normal{0.0f};        // the patch's normal in the frame
   float plane = 0.0f;            // dot(normal, q[0]): < 0 when the eye is in front
-  std::uint32_t item = kNoItem;  // the patch id when the eye sees its front, else kNoItem
+  std::uint32_t item = kNoItem;  // the patch id when the eye sees its front, its back target
+                                 // when it sees a translucent patch's back, else kNoItem
 };
 
 // Face k's view of a frame vector (a, b, c) = components along (T1, T2, N).
@@ -135,6 +142,16 @@ class HemicubeEstimator final : public FormFactorEstimator {
     delta_forms();
 
     const auto& patches = hierarchy.patches();
+    back_item_.assign(patches.size(), kNoItem);
+    if (options.diffuse_transmission) {
+      std::vector<std::uint32_t> translucent;
+      for (std::uint32_t j = 0; j < patches.size(); ++j)
+        if (pass1_translucent(scene.material(patches[j].material))) {
+          back_item_[j] = static_cast<std::uint32_t>(patches.size() + translucent.size());
+          translucent.push_back(j);
+        }
+      set_translucent_patches(std::move(translucent));
+    }
     std::vector<std::vector<glm::vec3>> polygons;
     std::vector<glm::vec3> normals;
     corners_.resize(patches.size());
@@ -173,31 +190,60 @@ class HemicubeEstimator final : public FormFactorEstimator {
     }
   }
 
+  // Dense rows keep to the fronts of patches (FormFactorOptions::diffuse_transmission).
   void element_rows(const std::vector<std::uint32_t>& elements, float* out) const override {
     const std::size_t n = hierarchy_.patches().size();
-    parallel_for(options_.threads, elements.size(), 4, [&](std::size_t begin, std::size_t end) {
+    rows(elements, false, [&](std::size_t k, const std::vector<double>& row) {
+      for (std::size_t j = 0; j < n; ++j) out[k * n + j] = static_cast<float>(std::min(row[j], 1.0));
+    });
+  }
+
+  // With diffuse transmission, rows run over every target (backs after the patches).
+  void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
+    if (translucent_patches().empty()) {
+      FormFactorEstimator::sparse_element_rows(elements, out);
+      return;
+    }
+    sparse_rows(elements, false, out);
+  }
+
+  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
+    for (std::uint32_t e : elements)
+      if (e >= hierarchy_.elements().size() || back_item_[hierarchy_.element(e).patch] == kNoItem)
+        throw Error(ErrorCode::invalid_argument, "sparse_back_rows: element " + std::to_string(e) +
+                                                     " is not an element of a translucent patch");
+    sparse_rows(elements, true, out);
+  }
+
+  void sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
+                           SparseFactors& out) const override {
+    if (translucent_patches().empty()) {
+      FormFactorEstimator::sparse_patch_column(target, elements, out);
+      return;
+    }
+    if (target >= target_count())
+      throw Error(ErrorCode::invalid_argument, "sparse_patch_column: target " + std::to_string(target) +
+                                                   " out of range (" + std::to_string(target_count()) + " targets)");
+    // Fronts of all elements, then the backs of the translucent ones (index m + k).
+    const std::size_t m = elements.size();
+    std::vector<float> column(2 * m, 0.0f);
+    parallel_for(options_.threads, m, 16, [&](std::size_t begin, std::size_t end) {
       Raster raster;
-      const std::size_t pixels = static_cast<std::size_t>(faces_[0].width) * static_cast<std::size_t>(faces_[0].height);
-      raster.depth.assign(pixels, 0.0f);
-      raster.item.assign(pixels, kNoItem);
+      std::vector<std::uint32_t> candidates;
       std::vector<Projected> projected;
-      std::vector<double> row(n);
       for (std::size_t k = begin; k < end; ++k) {
-        std::fill(row.begin(), row.end(), 0.0);
-        for (std::size_t s = 0; s < uv_.size(); ++s) {
-          const Frame frame = sample_frame(elements[k], s);
-          project_all(frame, projected);
-          for (int f = 0; f < 5; ++f) {
-            const FaceGeometry& face = faces_[f];
-            const Scissor all{0, 0, face.width, face.height};
-            raster.touched = Scissor{face.width, face.height, 0, 0};
-            for (const Projected& p : projected) draw(f, p, all, raster);
-            gather(f, raster.touched, frame.weight, raster, row);
-          }
-        }
-        for (std::size_t j = 0; j < n; ++j) out[k * n + j] = static_cast<float>(std::min(row[j], 1.0));
+        column[k] = static_cast<float>(column_entry(elements[k], target, false, raster, candidates, projected));
+        if (back_item_[hierarchy_.element(elements[k]).patch] != kNoItem)
+          column[m + k] = static_cast<float>(column_entry(elements[k], target, true, raster, candidates, projected));
       }
     });
+    out.index.clear();
+    out.value.clear();
+    for (std::size_t k = 0; k < column.size(); ++k)
+      if (column[k] > 0.0f) {
+        out.index.push_back(static_cast<std::uint32_t>(k));
+        out.value.push_back(column[k]);
+      }
   }
 
   // Only the pixels that patch j covers matter, and only patches inside the pyramid from the
@@ -210,11 +256,51 @@ class HemicubeEstimator final : public FormFactorEstimator {
       std::vector<std::uint32_t> candidates;
       std::vector<Projected> projected;
       for (std::size_t k = begin; k < end; ++k)
-        out[k] = static_cast<float>(column_entry(elements[k], patch, raster, candidates, projected));
+        out[k] = static_cast<float>(column_entry(elements[k], patch, false, raster, candidates, projected));
     });
   }
 
  private:
+  // Calls emit(k, row) with the full hemicube row (every target) of each element's front, or
+  // back when `back`, from parallel workers.
+  template <typename Emit>
+  void rows(const std::vector<std::uint32_t>& elements, bool back, const Emit& emit) const {
+    parallel_for(options_.threads, elements.size(), 4, [&](std::size_t begin, std::size_t end) {
+      Raster raster;
+      const std::size_t pixels = static_cast<std::size_t>(faces_[0].width) * static_cast<std::size_t>(faces_[0].height);
+      raster.depth.assign(pixels, 0.0f);
+      raster.item.assign(pixels, kNoItem);
+      std::vector<Projected> projected;
+      std::vector<double> row(target_count());
+      for (std::size_t k = begin; k < end; ++k) {
+        std::fill(row.begin(), row.end(), 0.0);
+        for (std::size_t s = 0; s < uv_.size(); ++s) {
+          const Frame frame = sample_frame(elements[k], s, back);
+          project_all(frame, projected);
+          for (int f = 0; f < 5; ++f) {
+            const FaceGeometry& face = faces_[f];
+            const Scissor all{0, 0, face.width, face.height};
+            raster.touched = Scissor{face.width, face.height, 0, 0};
+            for (const Projected& p : projected) draw(f, p, all, raster);
+            gather(f, raster.touched, frame.weight, raster, row);
+          }
+        }
+        emit(k, row);
+      }
+    });
+  }
+
+  void sparse_rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
+    out.assign(elements.size(), SparseFactors{});
+    rows(elements, back, [&](std::size_t k, const std::vector<double>& row) {
+      for (std::size_t t = 0; t < row.size(); ++t)
+        if (row[t] > 0.0) {
+          out[k].index.push_back(static_cast<std::uint32_t>(t));
+          out[k].value.push_back(static_cast<float>(std::min(row[t], 1.0)));
+        }
+    });
+  }
+
   struct Frame {
     glm::vec3 eye{0.0f}, t1{0.0f}, t2{0.0f}, n{0.0f};
     PolygonId polygon = 0;
@@ -297,7 +383,8 @@ class HemicubeEstimator final : public FormFactorEstimator {
   // The hemicube at sample s of element e: its eye (lifted off the surface by offset_ so that
   // the source's own plane is strictly below the horizon) and its frame, turned about the
   // normal by an angle from the element's own stream.
-  Frame sample_frame(std::uint32_t e, std::size_t s) const {
+  // `back`: the hemicube over the element's back side.
+  Frame sample_frame(std::uint32_t e, std::size_t s, bool back = false) const {
     const Element& el = hierarchy_.element(e);
     const Patch& patch = hierarchy_.patches()[el.patch];
     std::array<glm::vec3, 4> c;
@@ -305,13 +392,13 @@ class HemicubeEstimator final : public FormFactorEstimator {
       c[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
     const CellMap map(c.data(), el.corner_count());
     Frame f;
-    f.n = patch.normal;
+    f.n = back ? -patch.normal : patch.normal;
     f.eye = map.point(uv_[s]) + offset_ * f.n;
     f.weight = weight_[s] * static_cast<double>(map.density(uv_[s]));
     f.polygon = patch.polygon;
     const glm::vec3 helper = std::fabs(f.n.x) < 0.6f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
     const glm::vec3 u = glm::normalize(glm::cross(helper, f.n)), v = glm::cross(f.n, u);
-    Rng rng(options_.seed, e, 0x4e3cc0beull + s);
+    Rng rng(options_.seed, e, (back ? 0x5e3cc0beull : 0x4e3cc0beull) + s);
     const float phi = static_cast<float>(kTwoPi) * rng.uniform();
     f.t1 = std::cos(phi) * u + std::sin(phi) * v;
     f.t2 = glm::cross(f.n, f.t1);
@@ -333,7 +420,7 @@ class HemicubeEstimator final : public FormFactorEstimator {
         glm::vec3(glm::dot(patch.normal, frame.t1), glm::dot(patch.normal, frame.t2), glm::dot(patch.normal, frame.n));
     p.plane = glm::dot(p.normal, p.q[0]);
     if (std::fabs(p.plane) <= edge_on_) return false;  // seen edge-on: covers no pixel
-    p.item = p.plane < 0.0f ? j : kNoItem;
+    p.item = p.plane < 0.0f ? j : back_item_[j];
     return true;
   }
 
@@ -452,16 +539,20 @@ class HemicubeEstimator final : public FormFactorEstimator {
     }
   }
 
-  double column_entry(std::uint32_t e, std::uint32_t j, Raster& raster, std::vector<std::uint32_t>& candidates,
-                      std::vector<Projected>& projected) const {
+  // F(e -> target) (from e's back when `back`); `target` is a patch or a translucent patch's back.
+  double column_entry(std::uint32_t e, std::uint32_t t, bool back, Raster& raster,
+                      std::vector<std::uint32_t>& candidates, std::vector<Projected>& projected) const {
+    const std::size_t n = hierarchy_.patches().size();
+    const std::uint32_t j = t < n ? t : translucent_patches()[t - n];
+    const glm::vec3 receiver_normal = t < n ? hierarchy_.patches()[j].normal : -hierarchy_.patches()[j].normal;
     double sum = 0.0;
     for (std::size_t s = 0; s < uv_.size(); ++s) {
-      const Frame frame = sample_frame(e, s);
+      const Frame frame = sample_frame(e, s, back);
       Projected target;
-      if (!project(frame, j, target) || target.item == kNoItem) continue;
+      if (!project(frame, j, target) || target.item != t) continue;
       // The patches that can hide part of j from the eye are inside the pyramid eye -> j.
       Shaft shaft;
-      if (!shaft.build(&frame.eye, 1, frame.n, corners_[j].data(), counts_[j], hierarchy_.patches()[j].normal, offset_))
+      if (!shaft.build(&frame.eye, 1, frame.n, corners_[j].data(), counts_[j], receiver_normal, offset_))
         continue;
       candidates.clear();
       patch_culler_.collect(shaft, j, candidates);
@@ -506,8 +597,8 @@ class HemicubeEstimator final : public FormFactorEstimator {
           const float* sums = prefix + static_cast<std::size_t>(r) * stride;
           for (int c = box.x0; c < box.x1;) {
             const int start = c;
-            const bool mine = items[c] == j;
-            while (c < box.x1 && (items[c] == j) == mine) ++c;
+            const bool mine = items[c] == t;
+            while (c < box.x1 && (items[c] == t) == mine) ++c;
             if (mine) face_sum += static_cast<double>(sums[c] - sums[start]);
           }
         }
@@ -527,6 +618,7 @@ class HemicubeEstimator final : public FormFactorEstimator {
   ShaftCuller patch_culler_;
   std::vector<glm::vec2> uv_;
   std::vector<double> weight_;
+  std::vector<std::uint32_t> back_item_;  // per patch: its back target when translucent, else kNoItem
 };
 
 }  // namespace

@@ -54,18 +54,12 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
 
   SolveOptions o = options;
   if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
-  // Translucent materials in use switch diffuse transmission on; the hemicube cannot carry it.
-  for (const Polygon& polygon : scene.polygons()) {
-    const Material& mat = scene.material(polygon.material);
-    if (!detail::pass1_translucent(mat)) continue;
-    if (o.form_factors.method == FormFactorMethod::hemicube)
-      throw Error(ErrorCode::invalid_argument,
-                  "solve: material '" + mat.name +
-                      "' has diffuse_transmittance > 0; diffuse transmission needs form_factors.method ray_cast, "
-                      "analytic or monte_carlo, not hemicube");
-    o.form_factors.diffuse_transmission = true;
-    break;
-  }
+  // Translucent materials in use switch diffuse transmission on.
+  for (const Polygon& polygon : scene.polygons())
+    if (detail::pass1_translucent(scene.material(polygon.material))) {
+      o.form_factors.diffuse_transmission = true;
+      break;
+    }
   o.form_factors.seed = o.seed;
   o.form_factors.threads = o.threads;
 
