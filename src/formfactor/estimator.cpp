@@ -29,6 +29,33 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   return o;
 }
 
+void check_back_rows(const FormFactorEstimator& estimator, const PatchHierarchy& hierarchy,
+                     const std::vector<std::uint32_t>& elements) {
+  const std::vector<std::uint32_t>& translucent = estimator.translucent_patches();
+  for (std::uint32_t e : elements)
+    if (e >= hierarchy.elements().size() ||
+        !std::binary_search(translucent.begin(), translucent.end(), hierarchy.element(e).patch))
+      throw Error(ErrorCode::invalid_argument,
+                  "sparse_back_rows: element " + std::to_string(e) + " is not an element of a translucent patch");
+}
+
+void check_target(const FormFactorEstimator& estimator, std::uint32_t target) {
+  if (target >= estimator.target_count())
+    throw Error(ErrorCode::invalid_argument, "sparse_patch_column: target " + std::to_string(target) +
+                                                 " out of range (" + std::to_string(estimator.target_count()) +
+                                                 " targets)");
+}
+
+void compress(const float* dense, std::size_t count, SparseFactors& out) {
+  out.index.clear();
+  out.value.clear();
+  for (std::size_t k = 0; k < count; ++k)
+    if (dense[k] > 0.0f) {
+      out.index.push_back(static_cast<std::uint32_t>(k));
+      out.value.push_back(dense[k]);
+    }
+}
+
 }  // namespace radiosity::detail
 
 namespace radiosity {
@@ -62,13 +89,7 @@ void FormFactorEstimator::sparse_patch_column(std::uint32_t patch, const std::ve
                                               SparseFactors& out) const {
   std::vector<float> dense(elements.size());
   patch_column(patch, elements, dense.data());
-  out.index.clear();
-  out.value.clear();
-  for (std::size_t k = 0; k < dense.size(); ++k)
-    if (dense[k] > 0.0f) {
-      out.index.push_back(static_cast<std::uint32_t>(k));
-      out.value.push_back(dense[k]);
-    }
+  detail::compress(dense.data(), dense.size(), out);
 }
 
 void FormFactorEstimator::sparse_patch_columns(const std::vector<std::uint32_t>& patches,

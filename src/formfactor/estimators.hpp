@@ -15,6 +15,16 @@ namespace radiosity::detail {
 /// Options with defaults filled in and checked (throws Error{invalid_argument}).
 FormFactorOptions resolve(const FormFactorOptions& options);
 
+/// What sparse_back_rows() accepts: throws Error{invalid_argument} naming the first element that
+/// is not an element of one of estimator.translucent_patches().
+void check_back_rows(const FormFactorEstimator& estimator, const PatchHierarchy& hierarchy,
+                     const std::vector<std::uint32_t>& elements);
+/// What sparse_patch_column() accepts: throws Error{invalid_argument} unless target <
+/// estimator.target_count().
+void check_target(const FormFactorEstimator& estimator, std::uint32_t target);
+/// The entries of dense[0, count) that are > 0, with their positions, into `out` (cleared).
+void compress(const float* dense, std::size_t count, SparseFactors& out);
+
 /// Wallace et al.'s ray-cast estimator with the exact unoccluded part and shaft culling
 /// (ray_cast.cpp). `options` must come from resolve().
 std::unique_ptr<FormFactorEstimator> make_ray_cast_estimator(const Scene&, const PatchHierarchy&,

@@ -191,10 +191,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   }
 
   void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    for (std::uint32_t e : elements)
-      if (e >= hierarchy_.elements().size() || back_target_[hierarchy_.element(e).patch] == kNone)
-        throw Error(ErrorCode::invalid_argument, "sparse_back_rows: element " + std::to_string(e) +
-                                                     " is not an element of a translucent patch");
+    check_back_rows(*this, hierarchy_, elements);
     rows(elements, true, out);
   }
 
@@ -213,18 +210,12 @@ class MonteCarloEstimator final : public FormFactorEstimator {
                            SparseFactors& out) const override {
     out.index.clear();
     out.value.clear();
-    if (patch >= target_count())
-      throw Error(ErrorCode::invalid_argument, "sparse_patch_column: target " + std::to_string(patch) +
-                                                   " out of range (" + std::to_string(target_count()) + " targets)");
+    check_target(*this, patch);
     if (exact_[patch]) {
       std::vector<float> column(elements.size());
       SparseFactors backs;
       emitter_column(patch, elements, column.data(), &backs);
-      for (std::size_t k = 0; k < column.size(); ++k)
-        if (column[k] > 0.0f) {
-          out.index.push_back(static_cast<std::uint32_t>(k));
-          out.value.push_back(column[k]);
-        }
+      compress(column.data(), column.size(), out);
       // Arrivals at backs: indices past the fronts, already increasing.
       out.index.insert(out.index.end(), backs.index.begin(), backs.index.end());
       out.value.insert(out.value.end(), backs.value.begin(), backs.value.end());

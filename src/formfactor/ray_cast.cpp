@@ -183,10 +183,7 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
   void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    for (std::uint32_t e : elements)
-      if (e >= hierarchy_.elements().size() || !is_translucent(hierarchy_.element(e).patch))
-        throw Error(ErrorCode::invalid_argument, "sparse_back_rows: element " + std::to_string(e) +
-                                                     " is not an element of a translucent patch");
+    check_back_rows(*this, hierarchy_, elements);
     target_rows(elements, true, out);
   }
 
@@ -196,9 +193,7 @@ class SampledEstimator final : public FormFactorEstimator {
       FormFactorEstimator::sparse_patch_column(target, elements, out);
       return;
     }
-    if (target >= target_count())
-      throw Error(ErrorCode::invalid_argument, "sparse_patch_column: target " + std::to_string(target) +
-                                                   " out of range (" + std::to_string(target_count()) + " targets)");
+    check_target(*this, target);
     // Fronts of all elements, then the backs of the translucent ones (index m + k).
     const std::size_t m = elements.size();
     std::vector<float> column(2 * m, 0.0f);
@@ -214,13 +209,7 @@ class SampledEstimator final : public FormFactorEstimator {
       }
       add(counts);
     });
-    out.index.clear();
-    out.value.clear();
-    for (std::size_t k = 0; k < column.size(); ++k)
-      if (column[k] > 0.0f) {
-        out.index.push_back(static_cast<std::uint32_t>(k));
-        out.value.push_back(column[k]);
-      }
+    compress(column.data(), column.size(), out);
   }
 
   RayCastCounters counters() const {
