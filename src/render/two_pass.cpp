@@ -40,6 +40,9 @@ namespace {
 constexpr float kInvPi = 1.0f / glm::pi<float>();
 /// Rows per band: progress and cancel are checked between bands.
 constexpr int kBandRows = 16;
+/// Delta events with two branches (glass) are split into both for the first this many events of
+/// a camera path: at most 2^kSplitDepth paths per camera ray, only where it meets glass.
+constexpr int kSplitDepth = 3;
 /// The layers, in the order they appear in Image::layers.
 enum Layer { kDirect = 0, kIndirect, kSpecular, kCaustic, kLayers };
 const char* const kLayerNames[kLayers] = {"direct", "indirect", "specular", "caustic"};
@@ -198,34 +201,53 @@ class TwoPassRenderer {
   };
 
   /// Scatters a ray that arrived along `dir` at `h` through the surface's specular part: `samples`
-  /// directions, each traced on with throughput beta * weight / samples.
+  /// directions, each traced on with throughput beta * weight / samples. A delta model with two
+  /// events (a glass interface: reflection with probability R, refraction with 1 - R) is split
+  /// instead, for the first kSplitDepth events of a camera path: both branches are traced, with
+  /// throughput beta * weight * probability each. That removes the variance of the random
+  /// choice, which is most of the grain seen through glass.
   void scatter(const SurfaceHit& h, const glm::vec3& dir, const Rgb& beta, int depth, int samples,
                const Strata& strata, detail::Rng& rng, Radiance& out) const {
     const detail::SplitSurface& s = *h.surface;
     const glm::vec3 n = (!h.front && s.two_sided) ? -s.normal : s.normal;
     const ShadingFrame frame = ShadingFrame::from_normal(n);
     const glm::vec3 wo = frame.to_local(-dir);
+    // Traces one sampled event on with throughput beta * weight * scale.
+    auto follow = [&](const BrdfSample& sample, float scale) {
+      Rgb throughput = beta * sample.weight * scale;
+      // A refraction carries radiance from the index of wi's side n_i into wo's side n_o, scaled
+      // by (n_o / n_i)^2 (Veach 1997, ch. 5), which the models leave out (brdf.hpp). It cancels on
+      // a path that enters and leaves glass, but not on one that ends on a diffuse surface inside
+      // it (the floor under a glass block), whose light mostly stays trapped by total internal
+      // reflection. The same rule as the reference path tracer.
+      if (sample.delta && sample.wi.z * wo.z < 0.0f) {
+        const float n_o = wo.z > 0.0f ? 1.0f : s.ior, n_i = sample.wi.z > 0.0f ? 1.0f : s.ior;
+        throughput *= (n_o * n_o) / (n_i * n_i);
+      }
+      if (!(max_channel(throughput) > 0.0f)) return;
+      const glm::vec3 wi = glm::normalize(frame.to_world(sample.wi));
+      const glm::vec3 origin = h.x + scene_.epsilon() * (glm::dot(wi, s.normal) > 0.0f ? s.normal : -s.normal);
+      trace_specular(origin, wi, throughput, depth + 1, strata.caustic_weight, rng, out);
+    };
+    if (s.specular_is_delta && depth < kSplitDepth) {
+      // The model's first and last events in its choice dimension; exactly two delta events
+      // whose probabilities add up to 1 are a split.
+      const auto first = s.specular->sample(wo, glm::vec2(0.0f, 0.5f));
+      const auto last = s.specular->sample(wo, glm::vec2(std::nextafter(1.0f, 0.0f), 0.5f));
+      if (first && last && first->delta && last->delta && first->pdf < 1.0f && last->pdf < 1.0f &&
+          std::fabs(first->pdf + last->pdf - 1.0f) < 1e-5f) {
+        follow(*first, first->pdf);
+        follow(*last, last->pdf);
+        return;
+      }
+    }
     for (int j = 0; j < samples; ++j) {
       glm::vec2 u = rng.uniform2();
       const float total = static_cast<float>(strata.count) * samples;
       u.x = (static_cast<float>(strata.index * samples + j) + u.x) / total + strata.shift;
       if (u.x >= 1.0f) u.x -= 1.0f;
       const auto sample = s.specular->sample(wo, u);
-      if (!sample) continue;
-      Rgb throughput = beta * sample->weight / static_cast<float>(samples);
-      // A refraction carries radiance from the index of wi's side n_i into wo's side n_o, scaled
-      // by (n_o / n_i)^2 (Veach 1997, ch. 5), which the models leave out (brdf.hpp). It cancels on
-      // a path that enters and leaves glass, but not on one that ends on a diffuse surface inside
-      // it (the floor under a glass block), whose light mostly stays trapped by total internal
-      // reflection. The same rule as the reference path tracer.
-      if (sample->delta && sample->wi.z * wo.z < 0.0f) {
-        const float n_o = wo.z > 0.0f ? 1.0f : s.ior, n_i = sample->wi.z > 0.0f ? 1.0f : s.ior;
-        throughput *= (n_o * n_o) / (n_i * n_i);
-      }
-      if (!(max_channel(throughput) > 0.0f)) continue;
-      const glm::vec3 wi = glm::normalize(frame.to_world(sample->wi));
-      const glm::vec3 origin = h.x + scene_.epsilon() * (glm::dot(wi, s.normal) > 0.0f ? s.normal : -s.normal);
-      trace_specular(origin, wi, throughput, depth + 1, strata.caustic_weight, rng, out);
+      if (sample) follow(*sample, 1.0f / static_cast<float>(samples));
     }
   }
 

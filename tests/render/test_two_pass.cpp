@@ -439,3 +439,44 @@ TEST_SUITE("two_pass") {
     CHECK_THROWS_AS(rad::render_two_pass(scene, other_sol, to), rad::Error);
   }
 }
+
+TEST_SUITE("two_pass") {
+  TEST_CASE("glass interfaces are split into reflection and refraction so glass renders without grain") {
+    // The glass Cornell box at 64 x 64, 4 camera rays per pixel, no photons, rendered at two
+    // seeds: with delta events split (the first three of a camera path) the specular layers
+    // differ only by the pixel jitter and the deeper random choices. Measured: 9.0 % relative
+    // RMS difference over the pixels that see through the glass; 29 % without splitting.
+    const rad::Scene scene = rad::cornell_box_specular(rad::CornellSpecular::glass);
+    rad::SolveOptions so;
+    so.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    so.form_factors.specular_depth = 1;
+    so.mesh.max_patch_area = 20000.0f;
+    const rad::Solution sol = rad::solve(scene, so);
+    rad::TwoPassOptions to;
+    to.width = to.height = 64;
+    to.spp = 4;
+    to.caustics.photons = 0;
+    to.seed = 1;
+    const rad::Image a = rad::render_two_pass(scene, sol, to);
+    to.seed = 2;
+    const rad::Image b = rad::render_two_pass(scene, sol, to);
+    // Over the pixels whose light went through the glass (a specular layer in either image).
+    const std::vector<rad::Rgb>&sa = layer(a, "specular"), &sb = layer(b, "specular");
+    double squared = 0.0, sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < sa.size(); ++i) {
+      if (sa[i] == rad::Rgb(0.0f) && sb[i] == rad::Rgb(0.0f)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(sa[i][c]) - sb[i][c];
+        squared += d * d;
+        sum += 0.5 * (double(sa[i][c]) + sb[i][c]);
+      }
+      ++count;
+    }
+    REQUIRE(count > 50);
+    const double difference = std::sqrt(squared / (3.0 * count)) / (sum / (3.0 * count));
+    MESSAGE("glass box at 4 spp: relative RMS difference of the specular layer between seeds "
+            << difference << " over " << count << " pixels");
+    CHECK(difference < 0.15);
+  }
+}
