@@ -5,6 +5,7 @@
 
 #include "formfactor/estimators.hpp"
 #include "geometry/overlap.hpp"
+#include "scene/specular_transport.hpp"
 
 namespace radiosity::detail {
 
@@ -27,6 +28,20 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth > 0 (mirror and window form factors) needs FormFactorMethod::monte_carlo");
   return o;
+}
+
+std::vector<std::uint32_t> find_translucent_patches(const Scene& scene, const PatchHierarchy& hierarchy) {
+  std::vector<std::uint32_t> out;
+  const std::vector<Patch>& patches = hierarchy.patches();
+  for (std::uint32_t j = 0; j < patches.size(); ++j)
+    if (pass1_translucent(scene.material(patches[j].material))) out.push_back(j);
+  return out;
+}
+
+std::vector<std::uint32_t> back_targets(std::size_t patch_count, const std::vector<std::uint32_t>& translucent) {
+  std::vector<std::uint32_t> out(patch_count, kNone);
+  for (std::size_t k = 0; k < translucent.size(); ++k) out[translucent[k]] = static_cast<std::uint32_t>(patch_count + k);
+  return out;
 }
 
 void check_back_rows(const FormFactorEstimator& estimator, const PatchHierarchy& hierarchy,

@@ -15,6 +15,12 @@ namespace radiosity::detail {
 /// Options with defaults filled in and checked (throws Error{invalid_argument}).
 FormFactorOptions resolve(const FormFactorOptions& options);
 
+/// The patches whose material is translucent (pass1_translucent()), increasing: the k-th one's
+/// back is target patch count + k, for every estimator and for the solvers.
+std::vector<std::uint32_t> find_translucent_patches(const Scene& scene, const PatchHierarchy& hierarchy);
+/// Per patch: its back target (patch_count + k for translucent[k]), or kNone for an opaque patch.
+std::vector<std::uint32_t> back_targets(std::size_t patch_count, const std::vector<std::uint32_t>& translucent);
+
 /// What sparse_back_rows() accepts: throws Error{invalid_argument} naming the first element that
 /// is not an element of one of estimator.translucent_patches().
 void check_back_rows(const FormFactorEstimator& estimator, const PatchHierarchy& hierarchy,

@@ -33,7 +33,6 @@
 #include "formfactor/estimators.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
-#include "scene/specular_transport.hpp"
 
 namespace radiosity::detail {
 
@@ -142,16 +141,8 @@ class HemicubeEstimator final : public FormFactorEstimator {
     delta_forms();
 
     const auto& patches = hierarchy.patches();
-    back_item_.assign(patches.size(), kNoItem);
-    if (options.diffuse_transmission) {
-      std::vector<std::uint32_t> translucent;
-      for (std::uint32_t j = 0; j < patches.size(); ++j)
-        if (pass1_translucent(scene.material(patches[j].material))) {
-          back_item_[j] = static_cast<std::uint32_t>(patches.size() + translucent.size());
-          translucent.push_back(j);
-        }
-      set_translucent_patches(std::move(translucent));
-    }
+    if (options.diffuse_transmission) set_translucent_patches(find_translucent_patches(scene, hierarchy));
+    back_item_ = back_targets(patches.size(), translucent_patches());  // kNone == kNoItem
     std::vector<std::vector<glm::vec3>> polygons;
     std::vector<glm::vec3> normals;
     corners_.resize(patches.size());

@@ -141,16 +141,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       specular_[p].glass = pass1_glass(m);
       specular_[p].ior = m.ior;
     }
-    back_target_.assign(patches.size(), kNone);
-    if (options.diffuse_transmission) {
-      std::vector<std::uint32_t> translucent;
-      for (std::uint32_t j = 0; j < patches.size(); ++j)
-        if (pass1_translucent(scene.material(polygons[patches[j].polygon].material))) {
-          back_target_[j] = static_cast<std::uint32_t>(patches.size() + translucent.size());
-          translucent.push_back(j);
-        }
-      set_translucent_patches(std::move(translucent));
-    }
+    if (options.diffuse_transmission) set_translucent_patches(find_translucent_patches(scene, hierarchy));
+    back_target_ = back_targets(patches.size(), translucent_patches());
     exact_.assign(target_count(), 0);  // backs never emit
     emitter_of_.assign(patches.size(), kNone);
     std::vector<std::uint32_t> polygon_slot(polygons.size(), kNone);
@@ -337,19 +329,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
                       SparseFactors* backs) const {
     analytic_->patch_column(patch, elements, out);
     const std::uint32_t light = emitter_of_[patch];
-    {
-      std::lock_guard<std::mutex> lock(visible_mutex_);
-      std::vector<float>& cache = visible_[light];
-      if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
-      parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-          if (!(out[k] > 0.0f)) continue;
-          float& v = cache[elements[k]];
-          if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light));
-          out[k] *= v;
-        }
-      });
-    }
+    times_visibility(light, false, elements, out);
     // Arrivals at the backs of translucent elements: exact as well (backward factors).
     std::vector<float> back;
     if (backs && !translucent_patches().empty()) {
@@ -361,18 +341,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         }
       std::vector<float> column(translucent.size());
       back_patch_column(*analytic_, patch, translucent, column.data());
+      times_visibility(light, true, translucent, column.data());
       back.assign(elements.size(), 0.0f);
-      std::lock_guard<std::mutex> lock(visible_mutex_);
-      std::vector<float>& cache = visible_back_[light];
-      if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
-      parallel_for(options_.threads, translucent.size(), 64, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-          if (!(column[k] > 0.0f)) continue;
-          float& v = cache[translucent[k]];
-          if (v < 0.0f) v = static_cast<float>(visibility(translucent[k], light, true));
-          back[where[k]] = column[k] * v;
-        }
-      });
+      for (std::size_t k = 0; k < translucent.size(); ++k) back[where[k]] = column[k];
     }
     if (specular_depth_ > 0) {
       // What the patch sends through mirrors and windows is shot like any other patch's.
@@ -391,6 +362,23 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         backs->index.push_back(static_cast<std::uint32_t>(elements.size() + k));
         backs->value.push_back(back[k]);
       }
+  }
+
+  /// Multiplies each factor column[k] > 0 of elements[k] by the element's visible fraction of
+  /// light polygon `light` (from its back when `back`), kept per element for later columns.
+  void times_visibility(std::uint32_t light, bool back, const std::vector<std::uint32_t>& elements,
+                        float* column) const {
+    std::lock_guard<std::mutex> lock(visible_mutex_);
+    std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
+    if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
+    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        if (!(column[k] > 0.0f)) continue;
+        float& v = cache[elements[k]];
+        if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light, back));
+        column[k] *= v;
+      }
+    });
   }
 
   /// Kernel-weighted fraction of shadow rays from element e (from its back side when `back`) to

@@ -36,7 +36,6 @@
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
 #include "geometry/ray_scene.hpp"
-#include "scene/specular_transport.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -97,12 +96,8 @@ class SampledEstimator final : public FormFactorEstimator {
     // the shaft test's "touching" tolerance.
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
-    if (options.diffuse_transmission) {
-      std::vector<std::uint32_t> translucent;
-      for (std::uint32_t j = 0; j < patches.size(); ++j)
-        if (pass1_translucent(scene.material(patches[j].material))) translucent.push_back(j);
-      set_translucent_patches(std::move(translucent));
-    }
+    if (options.diffuse_transmission) set_translucent_patches(find_translucent_patches(scene, hierarchy));
+    back_target_ = back_targets(patches.size(), translucent_patches());
     corners_.resize(patches.size());
     for (std::size_t j = 0; j < patches.size(); ++j) {
       const Element& root = hierarchy.element(patches[j].root);
@@ -203,7 +198,7 @@ class SampledEstimator final : public FormFactorEstimator {
       for (std::size_t k = begin; k < end; ++k) {
         prepare(elements[k], source);
         column[k] = static_cast<float>(factor(source, target, counts));
-        if (!is_translucent(source.patch)) continue;
+        if (back_target_[source.patch] == kNone) continue;
         prepare(elements[k], source, true);
         column[m + k] = static_cast<float>(factor(source, target, counts));
       }
@@ -221,11 +216,6 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
  private:
-  bool is_translucent(std::uint32_t patch) const {
-    const auto& t = translucent_patches();
-    return std::binary_search(t.begin(), t.end(), patch);
-  }
-
   // The rows of the elements' fronts (or backs) over every target, non-zero entries only.
   void target_rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
     out.assign(elements.size(), SparseFactors{});
@@ -542,6 +532,7 @@ class SampledEstimator final : public FormFactorEstimator {
   mutable std::atomic<std::uint64_t> factors_{0}, shadowed_{0}, rays_cast_{0};
   float epsilon_ = 0.0f;
   std::vector<PatchCorners> corners_;
+  std::vector<std::uint32_t> back_target_;  // per patch: its back target when translucent, else kNone
 };
 
 }  // namespace

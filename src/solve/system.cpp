@@ -1,5 +1,6 @@
 #include "solve/system.hpp"
 
+#include "formfactor/estimators.hpp"
 #include "scene/specular_transport.hpp"
 
 namespace radiosity::detail {
@@ -7,13 +8,11 @@ namespace radiosity::detail {
 RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission)
     : leaves(hierarchy.leaves()) {
   const std::size_t m = leaves.size(), n = hierarchy.patches().size();
-  // Back targets first, so each back unknown knows its target.
-  std::vector<std::uint32_t> back_target(n, kNone);
-  std::uint32_t targets = static_cast<std::uint32_t>(n);
-  if (diffuse_transmission)
-    for (std::uint32_t j = 0; j < n; ++j)
-      if (pass1_translucent(scene.material(hierarchy.patches()[j].material))) back_target[j] = targets++;
-  patch_area.assign(targets, 0.0f);
+  // Back targets first, numbered as the estimators number them, so each back unknown knows its target.
+  const std::vector<std::uint32_t> translucent_patches =
+      diffuse_transmission ? find_translucent_patches(scene, hierarchy) : std::vector<std::uint32_t>{};
+  const std::vector<std::uint32_t> back_target = back_targets(n, translucent_patches);
+  patch_area.assign(n + translucent_patches.size(), 0.0f);
   auto add = [&](std::uint32_t target, float a, const Rgb& E, const Rgb& rho, const Rgb& tau, std::uint32_t other) {
     area.push_back(a);
     emission.push_back(E);
