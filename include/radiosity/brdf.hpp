@@ -166,6 +166,12 @@ RADIOSITY_API std::unique_ptr<Brdf> make_mirror(Rgb reflectance);
 /// tint channel outside [0, 1]. Thread safety: may be called concurrently.
 RADIOSITY_API std::unique_ptr<Brdf> make_dielectric(float eta, Rgb tint);
 
+/// As make_dielectric(eta, tint), with the reflected sample weighted by `reflection_tint`
+/// (each channel in [0, 1]; white is the plain interface): albedo R * reflection_tint +
+/// (1 - R) * tint. For materials that tint the Fresnel reflection (MTL `Ks` of a refracting
+/// `illum`). Throws and is thread-safe as make_dielectric().
+RADIOSITY_API std::unique_ptr<Brdf> make_dielectric(float eta, Rgb tint, Rgb reflection_tint);
+
 /// Weighted mixture f = (1 - weight_second) * first + weight_second * second, e.g. a Lambertian
 /// base under a microfacet coat. Energy-conserving when both parts are. sample() picks a part
 /// with those probabilities and reports the mixture pdf (one-sample MIS), so delta parts mix too.

@@ -13,19 +13,36 @@
 namespace radiosity {
 inline namespace v1 {
 
-/// Loads a scene, choosing the reader by extension (.obj with its .mtl files).
+/// How forgiving the scene readers are (load_scene(), parse_scene_json()).
+struct LoadOptions {
+  /// false (the default): the readers step over what a renderer would and say so, each kind of
+  /// problem in one warning in Scene::warnings() (how many, the first "file:line: ", the next
+  /// few places): degenerate (zero-area) faces and faces of fewer than 3 vertices are dropped;
+  /// a diffuse reflectance of 1 or more is clamped to 0.99 and Kd + Ks above 0.99 scaled down;
+  /// negative colours are clamped to 0; a missing MTL file or an undefined material gives the
+  /// default grey; non-planar or non-convex faces are triangulated. true: each such problem
+  /// is an Error naming the file and line instead, so a loaded scene has no warnings.
+  bool strict = false;
+};
+
+/// Loads a scene, choosing the reader by extension (.obj with its .mtl files, .json).
 /// OBJ: `o`/`g` names become groups, `Kd` the diffuse reflectance, `Ke` emitted radiance (so
-/// E = pi * Ke); without materials everything is grey 0.5. Non-planar or non-convex faces are
-/// triangulated with a warning. Throws Error naming the file, line and problem for a missing
-/// file or MTL, a bad index, a NaN/infinite coordinate, a zero-area face or a reflectance >= 1.
-/// MTL details: `Ks` -> specular with `Ns` as Phong exponent; `illum` 3/5 with `Ks` -> ideal
-/// mirror; `illum` 4/6/7/9 with `Tf` -> transmittance, `Ni` -> ior; when Kd + Ks would reach 1,
-/// Ks is scaled down with a warning. Warnings in Scene::warnings() start with "file:line: ".
+/// E = pi * Ke); without materials everything is grey 0.5. MTL `illum` modes map as the format
+/// means them (docs/SCENE_OBJ.md has the table): 0/1 diffuse; 2 (or none, with Ks) Phong from
+/// Ks and Ns; 3/5/8 an ideal mirror of reflectance Ks; 4/6/7/9 a smooth dielectric of index Ni
+/// (1.5 when absent) transmitting Tf (white when absent), with Fresnel's reflection tinted by
+/// Ks and no other lobe; `d` < 1 (or `Tr` > 0) a straight window (ior 1) transmitting 1 - d;
+/// `Pr`/`Pm` (the PBR extension) a GGX microfacet coat over a diffuse base for the view pass.
+/// Malformed input that cannot mean anything is an Error naming file, line and problem: a
+/// missing OBJ file, a bad or out-of-range index, a NaN/infinite coordinate, a number that is
+/// not one, an OBJ without faces. What a renderer would step over is fixed with a warning (or
+/// an Error under `options.strict`): see LoadOptions. Warnings start with "file:line: ".
 /// JSON (.json): the scene format of docs/SCENE_JSON.md (materials with any model of brdf.hpp,
 /// polygons, quads, boxes, spheres, OBJ includes, a camera); see parse_scene_json().
-/// Throws Error{invalid_argument} for an unsupported extension.
+/// Throws Error{invalid_argument} for an unsupported extension, and only radiosity::Error (or
+/// std::bad_alloc) whatever the file holds.
 /// Thread safety: may be called concurrently.
-RADIOSITY_API Scene load_scene(const std::filesystem::path& path);
+RADIOSITY_API Scene load_scene(const std::filesystem::path& path, const LoadOptions& options = {});
 
 /// Reads a scene in the JSON format of docs/SCENE_JSON.md from `text`. Relative file names in
 /// it (OBJ includes, measured BRDFs) are resolved against `base_dir`; `source_name` starts every
@@ -35,9 +52,13 @@ RADIOSITY_API Scene load_scene(const std::filesystem::path& path);
 /// key, a wrong type, a missing field, an unknown material name or format version;
 /// Error{invalid_scene} for a value out of range or unusable geometry; the reader's own error
 /// (with the place in front) for a missing or broken OBJ or measured-BRDF file.
+/// Forgiving as LoadOptions says: a degenerate polygon is dropped, a reflectance of 1 or more
+/// clamped to 0.99 (and reflectance + specular + diffuse_transmittance scaled below 1), each
+/// with a warning naming its place; under `options.strict` these are errors too. OBJ includes
+/// are read with the same options.
 /// Thread safety: may be called concurrently.
 RADIOSITY_API Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_dir = {},
-                                     std::string_view source_name = "<string>");
+                                     std::string_view source_name = "<string>", const LoadOptions& options = {});
 
 /// Writes linear float RGB (channels R, G, B) and each layer as LAYER.R/.G/.B. Throws
 /// Error{io_error} naming the path when the file cannot be written, Error{invalid_argument}

@@ -46,7 +46,8 @@ class MirrorBrdf final : public Brdf {
 /// Smooth interface between the medium above (index 1 relative) and below (index eta).
 class DielectricBrdf final : public Brdf {
  public:
-  DielectricBrdf(float eta, const Rgb& tint) : eta_(eta), tint_(tint) {}
+  DielectricBrdf(float eta, const Rgb& tint, const Rgb& reflection_tint)
+      : eta_(eta), tint_(tint), reflection_tint_(reflection_tint) {}
 
   Rgb eval(const glm::vec3&, const glm::vec3&) const override { return Rgb(0.0f); }
   float pdf(const glm::vec3&, const glm::vec3&) const override { return 0.0f; }
@@ -56,15 +57,16 @@ class DielectricBrdf final : public Brdf {
     if (cos_o == 0.0f || !std::isfinite(cos_o)) return std::nullopt;
     const glm::vec2 u = db::clamp01(u_in);
     // Choose reflection with probability R (exactly 1 under total internal reflection), so that
-    // the weight of either event is its Fresnel factor over its probability: 1 or tint.
+    // the weight of either event is its Fresnel factor over its probability (1 or tint),
+    // times its tint.
     const float R = fresnel_dielectric(cos_o, eta_);
-    if (u.x < R) return BrdfSample{db::reflect_z(wo), Rgb(1.0f), R, true};
+    if (u.x < R) return BrdfSample{db::reflect_z(wo), reflection_tint_, R, true};
 
     // Snell's law, eta_rel = eta_t / eta_i seen from wo's side; n is the normal on wo's side.
     const float eta_rel = cos_o > 0.0f ? eta_ : 1.0f / eta_;
     const float cos_i = std::abs(cos_o);
     const float sin2_t = (1.0f - cos_i * cos_i) / (eta_rel * eta_rel);
-    if (sin2_t >= 1.0f) return BrdfSample{db::reflect_z(wo), Rgb(1.0f), 1.0f, true};  // R rounded below 1
+    if (sin2_t >= 1.0f) return BrdfSample{db::reflect_z(wo), reflection_tint_, 1.0f, true};  // R rounded below 1
     const float cos_t = std::sqrt(1.0f - sin2_t);
     const glm::vec3 n(0.0f, 0.0f, cos_o > 0.0f ? 1.0f : -1.0f);
     // Refracted direction: tangential part -wo_t / eta_rel, normal part -cos_t n.
@@ -75,7 +77,7 @@ class DielectricBrdf final : public Brdf {
   Rgb albedo(const glm::vec3& wo) const override {
     if (wo.z == 0.0f || !std::isfinite(wo.z)) return Rgb(0.0f);
     const float R = fresnel_dielectric(wo.z, eta_);
-    return Rgb(R) + (1.0f - R) * tint_;
+    return R * reflection_tint_ + (1.0f - R) * tint_;
   }
 
   bool is_delta() const override { return true; }
@@ -83,6 +85,7 @@ class DielectricBrdf final : public Brdf {
  private:
   float eta_;
   Rgb tint_;
+  Rgb reflection_tint_;
 };
 
 }  // namespace
@@ -92,11 +95,14 @@ std::unique_ptr<Brdf> make_mirror(Rgb reflectance) {
   return std::make_unique<MirrorBrdf>(reflectance);
 }
 
-std::unique_ptr<Brdf> make_dielectric(float eta, Rgb tint) {
+std::unique_ptr<Brdf> make_dielectric(float eta, Rgb tint) { return make_dielectric(eta, tint, Rgb(1.0f)); }
+
+std::unique_ptr<Brdf> make_dielectric(float eta, Rgb tint, Rgb reflection_tint) {
   constexpr const char* kWhere = "make_dielectric";
   db::check_positive(kWhere, "eta", eta);
   db::check_unit_rgb(kWhere, "tint", tint);
-  return std::make_unique<DielectricBrdf>(eta, tint);
+  db::check_unit_rgb(kWhere, "reflection_tint", reflection_tint);
+  return std::make_unique<DielectricBrdf>(eta, tint, reflection_tint);
 }
 
 }  // namespace v1

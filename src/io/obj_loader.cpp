@@ -1,17 +1,23 @@
-// Wavefront OBJ/MTL reader. tinyobjloader parses the files (faces kept as polygons, not
-// triangulated). Our own light pre-scan of the same text maps every face and material key to its
-// line and checks what tinyobjloader would accept silently or only warn about (out-of-range
-// indices, NaN coordinates, missing MTL files, faces it would drop), so that every error names
-// the file, the line and the problem.
+// Wavefront OBJ/MTL reader. tinyobjloader parses the OBJ (faces kept as polygons, not
+// triangulated); a light pre-scan of the same text maps every face to its line and checks what
+// tinyobjloader would accept silently (out-of-range indices, NaN coordinates), so that every
+// error names the file, the line and the problem. MTL files are read here (key-value lines),
+// and their materials handed to tinyobjloader by name. What a renderer would step over
+// (degenerate faces, Kd 1, a missing MTL) follows the forgiving policy of reader_warnings.hpp.
+// The MTL mapping follows the format's own description of the illumination models (Wavefront's
+// MTL specification) and the PBR extension as tinyobjloader and Blender read it.
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cfloat>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -20,7 +26,9 @@
 #include <system_error>
 #include <vector>
 
+#include "io/reader_warnings.hpp"
 #include "io/readers.hpp"
+#include "radiosity/brdf.hpp"
 
 namespace radiosity::detail {
 namespace {
@@ -29,7 +37,7 @@ namespace fs = std::filesystem;
 
 constexpr float kPi = 3.14159265358979323846f;
 /// Largest diffuse + specular albedo an MTL material keeps; Ks is scaled down to fit (see below).
-constexpr float kMaxAlbedo = 0.99f;
+constexpr float kMaxAlbedo = kMaxForgivenAlbedo;
 
 // ---------------------------------------------------------------------------------------------
 // Text helpers
@@ -38,6 +46,9 @@ constexpr float kMaxAlbedo = 0.99f;
 std::string at(const fs::path& file, std::size_t line) {
   return file.string() + ":" + std::to_string(line) + ": ";
 }
+
+/// "file:line", the location that ReaderWarnings takes.
+std::string loc(const fs::path& file, std::size_t line) { return file.string() + ":" + std::to_string(line); }
 
 [[noreturn]] void fail(ErrorCode code, const fs::path& file, std::size_t line, const std::string& problem) {
   throw Error(code, at(file, line) + problem);
@@ -129,11 +140,12 @@ std::string describe(const Rgb& c) {
 std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
 // ---------------------------------------------------------------------------------------------
-// MTL pre-scan: where each material and each of the keys we map is, with the values checked.
+// MTL reader: our own, since it is a list of "key values" lines and we need every key's line for
+// messages; tinyobjloader gets the materials' names from us (PreloadedMaterials below), so the
+// two can never disagree about which materials exist.
 
 struct MtlKey {
   std::size_t line = 0;
-  int count = 0;         ///< numbers given (1 or 3 for colours, 1 for scalars)
   float value[3] = {0.0f, 0.0f, 0.0f};
 };
 
@@ -141,7 +153,7 @@ struct MtlInfo {
   fs::path file;
   std::size_t line = 0;  ///< of its `newmtl`
   std::string name;
-  std::map<std::string, MtlKey, std::less<>> keys;  ///< Kd, Ke, Ks, Tf (also from Kt), Ns, Ni, illum
+  std::map<std::string, MtlKey, std::less<>> keys;  ///< Kd Ke Ks Tf (also from Kt) Ns Ni d Tr Pr Pm illum map_Kd
 
   const MtlKey* key(std::string_view k) const {
     auto it = keys.find(k);
@@ -151,139 +163,230 @@ struct MtlInfo {
     const MtlKey* m = key(k);
     return m ? m->line : line;
   }
+  std::string where(std::string_view k) const { return loc(file, line_of(k)); }
+  std::string what() const { return "material " + in_quotes(name) + ": "; }
 };
 
-/// Appends one MtlInfo per material that tinyobj::LoadMtl will produce from `text` (it keeps a
-/// material only if `newmtl` gave it a name), in the same order.
+/// Appends one MtlInfo per named `newmtl` of `text`, in order. Values are checked to be numbers
+/// here (a value that is not one cannot mean anything); their ranges in to_material().
 void scan_mtl(const fs::path& file, std::string_view text, std::vector<MtlInfo>& out) {
   std::vector<std::string_view> lines = split_lines(text);
   MtlInfo* current = nullptr;
   for (std::size_t n = 0; n < lines.size(); ++n) {
     const std::size_t line_no = n + 1;
-    // LoadMtl trims trailing blanks and then requires a blank after "newmtl".
     std::string_view line = trim(lines[n]);
     if (line.empty() || line.front() == '#') continue;
-    if (line.size() > 6 && line.substr(0, 6) == "newmtl" && is_blank(line[6])) {
-      std::string_view name = line.substr(7);
-      if (name.empty()) continue;
+    std::vector<std::string_view> tok = tokens(line);
+    if (tok[0] == "newmtl") {
+      std::string_view name = trim(line.substr(6));
+      current = nullptr;
+      if (name.empty()) continue;  // a material without a name cannot be used
       out.push_back(MtlInfo{file, line_no, std::string(name), {}});
       current = &out.back();
       continue;
     }
-    std::vector<std::string_view> tok = tokens(line);
     std::string key(tok[0]);
     if (key == "Kt") key = "Tf";
+    if (key == "map_Kd") {
+      if (current != nullptr) current->keys[key] = MtlKey{line_no, {}};
+      continue;
+    }
     const bool colour = key == "Kd" || key == "Ke" || key == "Ks" || key == "Tf";
-    const bool scalar = key == "Ns" || key == "Ni";
+    const bool scalar = key == "Ns" || key == "Ni" || key == "d" || key == "Tr" || key == "Pr" || key == "Pm";
     if (!colour && !scalar && key != "illum") continue;
-    if (current == nullptr) continue;  // before the first newmtl: LoadMtl drops it too
+    if (current == nullptr) continue;  // before the first newmtl: belongs to no material
 
     MtlKey k;
     k.line = line_no;
     if (key == "illum") {
       std::optional<long long> v = tok.size() == 2 ? parse_int(tok[1]) : std::nullopt;
-      if (!v) fail(ErrorCode::parse_error, file, line_no, "material " + in_quotes(current->name) + ": illum needs one integer");
-      k.count = 1;
+      if (!v) fail(ErrorCode::parse_error, file, line_no, current->what() + "illum needs one integer");
       k.value[0] = static_cast<float>(*v);
     } else {
       if (colour && tok.size() > 1 && (tok[1] == "spectral" || tok[1] == "xyz"))
         fail(ErrorCode::parse_error, file, line_no,
-             "material " + in_quotes(current->name) + ": " + key + " " + std::string(tok[1]) +
-                 " is not supported (give r g b)");
+             current->what() + key + " " + std::string(tok[1]) + " is not supported (give r g b)");
       const std::size_t given = tok.size() - 1;
       if (colour ? (given != 1 && given != 3) : given != 1)
         fail(ErrorCode::parse_error, file, line_no,
-             "material " + in_quotes(current->name) + ": " + key + (colour ? " needs 1 or 3 numbers" : " needs 1 number") +
-                 ", got " + std::to_string(given));
+             current->what() + key + (colour ? " needs 1 or 3 numbers" : " needs 1 number") + ", got " +
+                 std::to_string(given));
       for (std::size_t i = 0; i < given; ++i) {
         std::optional<float> v = parse_finite_float(tok[i + 1]);
         if (!v)
           fail(ErrorCode::parse_error, file, line_no,
-               "material " + in_quotes(current->name) + ": " + key + " value " + in_quotes(tok[i + 1]) +
-                   " is not a finite number");
+               current->what() + key + " value " + in_quotes(tok[i + 1]) + " is not a finite number");
         k.value[i] = *v;
       }
-      k.count = static_cast<int>(given);
-      // A single value means grey (r = g = b), as the MTL specification says; tinyobjloader
-      // would set g = b = 0.
+      // A single value means grey (r = g = b), as the MTL specification says.
       if (given == 1) k.value[1] = k.value[2] = k.value[0];
     }
     current->keys[key] = k;
   }
 }
 
-/// The colour of `key` (from the pre-scan, which handles single values) or tinyobjloader's
-/// default when the material does not set it.
-Rgb colour(const MtlInfo& info, std::string_view key, const tinyobj::real_t* fallback) {
+/// The colour of `key`, or `fallback` when the material does not set it.
+Rgb colour(const MtlInfo& info, std::string_view key, Rgb fallback) {
   if (const MtlKey* k = info.key(key)) return Rgb(k->value[0], k->value[1], k->value[2]);
-  return Rgb(static_cast<float>(fallback[0]), static_cast<float>(fallback[1]), static_cast<float>(fallback[2]));
+  return fallback;
 }
 
-void check_range(const MtlInfo& info, std::string_view key, const Rgb& v, bool upper_inclusive, const char* meaning) {
-  for (int c = 0; c < 3; ++c) {
-    const bool ok = v[c] >= 0.0f && (upper_inclusive ? v[c] <= 1.0f : v[c] < 1.0f);
-    if (!ok)
-      fail(ErrorCode::invalid_scene, info.file, info.line_of(key),
-           "material " + in_quotes(info.name) + ": " + std::string(key) + " " + describe(v) + " is " + meaning +
-               " and must be in [0, 1" + (upper_inclusive ? "]" : ")") + " per channel");
+float scalar(const MtlInfo& info, std::string_view key, float fallback) {
+  const MtlKey* k = info.key(key);
+  return k ? k->value[0] : fallback;
+}
+
+/// `c` with every channel clamped into [0, upper]: below 0 always, above `upper` when it is
+/// at least `at_or_above` (Kd 1 is clamped to 0.99, Kd 0.995 kept). Each clamp is forgiven
+/// with a warning (an Error under strict, worded as the range check it replaces).
+Rgb clamped(const MtlInfo& info, std::string_view key, Rgb c, float upper, float at_or_above, const char* meaning,
+            const char* range, ReaderWarnings& warnings) {
+  Rgb out = c;
+  for (int i = 0; i < 3; ++i) out[i] = c[i] < 0.0f ? 0.0f : c[i] >= at_or_above ? upper : c[i];
+  if (out != c) {
+    std::ostringstream problem, action;
+    problem << info.what() << key << ' ' << describe(c) << " is " << meaning << " and must be " << range
+            << " per channel";
+    action << "clamped to " << describe(out);
+    warnings.forgive(std::string("MTL ") + std::string(key) + " out of range", ErrorCode::invalid_scene,
+                     info.where(key), problem.str(), action.str());
   }
+  return out;
 }
 
-/// Converts one MTL material. Mapping: Kd -> reflectance; Ke -> emission E = pi * Ke (Ke is a
-/// radiance); Ks -> specular with Ns as its Phong exponent (at least 1, since 0 means a mirror
-/// here); illum 3 or 5 with Ks -> ideal mirror (exponent 0); illum 4, 6, 7 or 9 with Tf ->
-/// transmittance = Tf and ior = Ni. When Kd + Ks would reach 1 (common in exported files),
-/// Ks is scaled down with a warning so the surface does not create energy; Kd >= 1 is an error.
-Material to_material(const tinyobj::material_t& tm, const MtlInfo& info, std::vector<std::string>& warnings) {
+float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+/// f = (1 - w) first + w second with the two parts' albedos `a` and `b` kept (w = max b /
+/// (max a + max b)); `build_first(scale)` and `build_second(scale)` make the parts with their
+/// coefficients multiplied by scale = 1 / weight. Used for the MTL models that make_brdf() has
+/// no field for (a tinted Fresnel reflection, a PBR coat).
+std::shared_ptr<const Brdf> mixture(float a, float b, const std::function<std::shared_ptr<const Brdf>(float)>& build_first,
+                                    const std::function<std::shared_ptr<const Brdf>(float)>& build_second) {
+  if (a <= 0.0f) return build_second(1.0f);
+  if (b <= 0.0f) return build_first(1.0f);
+  const float w = b / (a + b);
+  return make_mix(build_first(1.0f / (1.0f - w)), build_second(1.0f / w), w);
+}
+
+/// Converts one MTL material as the format means it (docs/SCENE_OBJ.md has the table).
+Material to_material(const MtlInfo& info, ReaderWarnings& warnings) {
   Material m;
-  m.name = tm.name;
-  const Rgb kd = colour(info, "Kd", tm.diffuse);
-  const Rgb ke = colour(info, "Ke", tm.emission);
-  check_range(info, "Kd", kd, false, "a diffuse reflectance (1 or more would create energy)");
-  for (int c = 0; c < 3; ++c)
-    if (ke[c] < 0.0f)
-      fail(ErrorCode::invalid_scene, info.file, info.line_of("Ke"),
-           "material " + in_quotes(info.name) + ": Ke " + describe(ke) + " is an emitted radiance and must be >= 0");
+  m.name = info.name;
+  // Without Kd the diffuse colour is 0, or 0.6 under a diffuse texture (tinyobjloader's rule:
+  // the texture's mean is unknown here).
+  const Rgb kd_default(info.key("map_Kd") ? 0.6f : 0.0f);
+  const Rgb kd = clamped(info, "Kd", colour(info, "Kd", kd_default), kMaxAlbedo, 1.0f,
+                         "a diffuse reflectance (1 or more would create energy)", "in [0, 1)", warnings);
+  const Rgb ke = clamped(info, "Ke", colour(info, "Ke", Rgb(0.0f)), FLT_MAX, FLT_MAX, "an emitted radiance", ">= 0", warnings);
   m.reflectance = kd;
   m.emission = kPi * ke;
 
-  const int illum = info.key("illum") ? static_cast<int>(info.key("illum")->value[0]) : tm.illum;
-  if (info.key("Ks")) {
-    const Rgb ks = colour(info, "Ks", tm.specular);
-    check_range(info, "Ks", ks, true, "a specular reflectance");
+  const int illum = static_cast<int>(scalar(info, "illum", -1.0f));  // -1: not given
+  const bool refracts = illum == 4 || illum == 6 || illum == 7 || illum == 9;
+  const bool mirror = illum == 3 || illum == 5 || illum == 8;
+  const bool pbr = !refracts && (info.key("Pr") || info.key("Pm"));
+  const bool has_ks = info.key("Ks") != nullptr && illum != 0 && illum != 1;  // 0/1: no highlights
+  const Rgb ks = has_ks ? clamped(info, "Ks", colour(info, "Ks", Rgb(0.0f)), 1.0f, 1.0f + 1e-6f,
+                                  "a specular reflectance", "in [0, 1]", warnings)
+                        : Rgb(0.0f);
+
+  auto positive_ni = [&]() -> std::optional<float> {
+    const MtlKey* ni = info.key("Ni");
+    if (!ni) return std::nullopt;
+    if (ni->value[0] > 0.0f) return ni->value[0];
+    warnings.forgive("MTL Ni out of range", ErrorCode::invalid_scene, loc(info.file, ni->line),
+                     info.what() + "Ni " + std::to_string(ni->value[0]) + " must be > 0", "1.5 used");
+    return std::nullopt;
+  };
+
+  if (refracts) {
+    // A smooth dielectric: Fresnel's reflection (tinted by Ks when given) and refraction
+    // (tinted by Tf, white when absent); no Phong lobe on top, which would double the
+    // reflection and darken the glass.
+    m.transmittance = clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f, "a transmittance", "in [0, 1]", warnings);
+    m.ior = positive_ni().value_or(1.5f);
+    const Rgb tint = info.key("Ks") ? ks : Rgb(1.0f);
+    if (tint != Rgb(1.0f)) {
+      const float ior = m.ior;
+      const Rgb tf = m.transmittance;
+      m.brdf = mixture(
+          max_channel(kd), max_channel(glm::max(tf, tint)),
+          [&](float scale) { return std::shared_ptr<const Brdf>(make_lambertian(glm::min(kd * scale, Rgb(1.0f)))); },
+          [&](float scale) {
+            return std::shared_ptr<const Brdf>(
+                make_dielectric(ior, glm::min(tf * scale, Rgb(1.0f)), glm::min(tint * scale, Rgb(1.0f))));
+          });
+    }
+    return m;
+  }
+
+  if (pbr) {
+    // The PBR extension: base colour Kd, metallic Pm, roughness Pr (GGX alpha = Pr^2, the
+    // usual perceptual mapping), dielectric F0 from Ni (1.5 when absent). The view pass gets a
+    // microfacet coat mixed with the diffuse base; radiosity sees the diffuse base.
+    const float metallic = std::clamp(scalar(info, "Pm", 0.0f), 0.0f, 1.0f);
+    const float roughness = std::clamp(scalar(info, "Pr", 0.5f), 0.0f, 1.0f);
+    const float n = positive_ni().value_or(1.5f);
+    const float f0_dielectric = ((n - 1.0f) / (n + 1.0f)) * ((n - 1.0f) / (n + 1.0f));
+    const Rgb f0 = glm::mix(Rgb(f0_dielectric), kd, metallic);
+    const float w = std::clamp(max_channel(f0), 1e-3f, 0.999f);
+    const Rgb base = glm::min(kd * (1.0f - metallic), Rgb((1.0f - w) * kMaxAlbedo));
+    const float alpha = std::max(roughness * roughness, 1e-3f);
+    m.reflectance = base;
+    // A mixture keeps each part's albedo when the coat is built with f0 / w at weight w; its
+    // rise towards grazing angles is then scaled by w too (an approximation of the layered
+    // model that the library has no BRDF for). A pure metal is the microfacet model itself.
+    if (max_channel(base) <= 0.0f)
+      m.brdf = make_microfacet(f0, alpha, alpha);
+    else
+      m.brdf = make_mix(make_lambertian(base / (1.0f - w)), make_microfacet(glm::min(f0 / w, Rgb(1.0f)), alpha, alpha), w);
+    return m;
+  }
+
+  if (has_ks && max_channel(ks) > 0.0f) {
     m.specular = ks;
-    if (illum == 3 || illum == 5) {
+    if (mirror) {
       m.specular_exponent = 0.0f;
     } else {
-      const float ns = info.key("Ns") ? info.key("Ns")->value[0] : static_cast<float>(tm.shininess);
-      if (ns < 0.0f)
-        fail(ErrorCode::invalid_scene, info.file, info.line_of("Ns"),
-             "material " + in_quotes(info.name) + ": Ns " + std::to_string(ns) + " must be >= 0");
-      m.specular_exponent = std::max(ns, 1.0f);
+      float ns = scalar(info, "Ns", 1.0f);
+      if (ns < 0.0f) {
+        warnings.forgive("MTL Ns out of range", ErrorCode::invalid_scene, info.where("Ns"),
+                         info.what() + "Ns " + std::to_string(ns) + " must be >= 0", "1 used");
+        ns = 1.0f;
+      }
+      m.specular_exponent = std::max(ns, 1.0f);  // 0 would mean a mirror here
     }
-    // Keep Kd + Ks below 1 per channel by scaling Ks (hue kept).
+    // Keep Kd + Ks below 1 per channel by scaling Ks (hue kept): exported files often have
+    // Kd 0.8 and Ks 0.5.
     float scale = 1.0f;
     for (int c = 0; c < 3; ++c)
       if (ks[c] > 0.0f && kd[c] + ks[c] > kMaxAlbedo) scale = std::min(scale, std::max(0.0f, (kMaxAlbedo - kd[c]) / ks[c]));
     if (scale < 1.0f) {
       m.specular = ks * scale;
-      std::ostringstream s;
-      s << at(info.file, info.line_of("Ks")) << "material " << in_quotes(info.name) << ": Kd + Ks exceeds "
-        << kMaxAlbedo << " (1 or more would create energy); Ks scaled by " << scale << " to "
-        << describe(m.specular);
-      warnings.push_back(s.str());
+      std::ostringstream problem, action;
+      problem << info.what() << "Kd + Ks exceeds " << kMaxAlbedo << " (1 or more would create energy)";
+      action << "Ks scaled by " << scale << " to " << describe(m.specular);
+      warnings.forgive("MTL Kd + Ks", ErrorCode::invalid_scene, info.where("Ks"), problem.str(), action.str());
     }
   }
-  if ((illum == 4 || illum == 6 || illum == 7 || illum == 9) && info.key("Tf")) {
-    const Rgb tf = colour(info, "Tf", tm.transmittance);
-    check_range(info, "Tf", tf, true, "a transmittance");
-    m.transmittance = tf;
-    if (const MtlKey* ni = info.key("Ni")) {
-      if (!(ni->value[0] > 0.0f))
-        fail(ErrorCode::invalid_scene, info.file, ni->line,
-             "material " + in_quotes(info.name) + ": Ni " + std::to_string(ni->value[0]) + " must be > 0");
-      m.ior = ni->value[0];
-    }
+
+  // Dissolve (d, or Tr = 1 - d): a fraction 1 - d of the light passes straight through, as
+  // through a thin pane (ior 1); the surface's own parts keep the fraction d.
+  float opacity = info.key("d") ? scalar(info, "d", 1.0f) : 1.0f - scalar(info, "Tr", 0.0f);
+  if (opacity < 0.0f || opacity > 1.0f) {
+    const char* key = info.key("d") ? "d" : "Tr";
+    const float clamped_opacity = std::clamp(opacity, 0.0f, 1.0f);
+    warnings.forgive("MTL d out of range", ErrorCode::invalid_scene, info.where(key),
+                     info.what() + key + " " + std::to_string(scalar(info, key, 0.0f)) + " must be in [0, 1]",
+                     "clamped");
+    opacity = clamped_opacity;
+  }
+  if (opacity < 1.0f) {
+    m.reflectance *= opacity;
+    m.specular *= opacity;
+    m.transmittance = (1.0f - opacity) * clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f,
+                                                 "a transmittance", "in [0, 1]", warnings);
+    m.ior = 1.0f;
   }
   return m;
 }
@@ -302,7 +405,6 @@ struct ObjScan {
   std::vector<FaceInfo> faces;     ///< in file order, which is tinyobjloader's face order
   std::vector<fs::path> mtl_files; ///< resolved, each once, in order of mention
   std::size_t vertex_count = 0;
-  std::vector<std::string> warnings;
 };
 
 /// mtllib names, split like tinyobjloader does: on spaces, with "\ " escaping a space.
@@ -360,12 +462,11 @@ void check_corner(const fs::path& file, std::size_t line_no, std::string_view co
   }
 }
 
-ObjScan scan_obj(const fs::path& file, std::string_view text) {
+ObjScan scan_obj(const fs::path& file, std::string_view text, ReaderWarnings& warnings) {
   ObjScan scan;
   std::set<fs::path> seen_mtl;
   std::string_view material;
   std::size_t material_line = 0;
-  std::size_t ignored = 0, first_ignored = 0;
   const std::vector<std::string_view> lines = split_lines(text);
   for (std::size_t n = 0; n < lines.size(); ++n) {
     const std::size_t line_no = n + 1;
@@ -382,38 +483,45 @@ ObjScan scan_obj(const fs::path& file, std::string_view text) {
       ++scan.vertex_count;
     } else if (key == "f") {
       for (std::size_t i = 1; i < tok.size(); ++i) check_corner(file, line_no, tok[i], scan.vertex_count);
+      // tinyobjloader drops such a face too, so it is left out of the face list.
       if (tok.size() < 4)
-        fail(ErrorCode::parse_error, file, line_no,
-             "face has " + std::to_string(tok.size() - 1) + " vertices; a polygon needs at least 3");
-      scan.faces.push_back(FaceInfo{line_no, tok.size() - 1, material, material_line});
+        warnings.forgive("short face", ErrorCode::parse_error, loc(file, line_no),
+                         "face has " + std::to_string(tok.size() - 1) + " vertices; a polygon needs at least 3",
+                         "dropped");
+      else
+        scan.faces.push_back(FaceInfo{line_no, tok.size() - 1, material, material_line});
     } else if (key == "usemtl") {
       material = tok.size() > 1 ? tok[1] : std::string_view();
       material_line = line_no;
     } else if (key == "mtllib") {
       const std::string_view line = trim(lines[n]);
       const std::vector<std::string> names = mtllib_names(line.substr(std::min<std::size_t>(line.size(), 7)));
-      if (names.empty()) scan.warnings.push_back(at(file, line_no) + "mtllib without a file name ignored");
+      if (names.empty())
+        warnings.forgive("empty mtllib", ErrorCode::parse_error, loc(file, line_no), "mtllib without a file name",
+                         "ignored");
       for (const std::string& name : names) {
         fs::path p(name);
         if (p.is_relative()) p = file.parent_path() / p;
         std::error_code ec;
-        if (!fs::is_regular_file(p, ec))
-          fail(ErrorCode::file_not_found, file, line_no,
-               "material library " + in_quotes(name) + " not found (looked for '" + p.string() + "')");
+        if (!fs::is_regular_file(p, ec)) {
+          warnings.forgive("missing mtllib", ErrorCode::file_not_found, loc(file, line_no),
+                           "material library " + in_quotes(name) + " not found (looked for '" + p.string() + "')",
+                           "its materials are the default grey");
+          continue;
+        }
         if (seen_mtl.insert(p.lexically_normal()).second) scan.mtl_files.push_back(p);
       }
     } else if (key == "l" || key == "p") {
-      if (ignored++ == 0) first_ignored = line_no;
+      warnings.forgive("line or point element", ErrorCode::parse_error, loc(file, line_no),
+                       "line/point element has no area", "ignored");
     }
   }
-  if (ignored > 0)
-    scan.warnings.push_back(at(file, first_ignored) + std::to_string(ignored) +
-                            " line/point element(s) ignored: they have no area");
   return scan;
 }
 
-/// Hands tinyobjloader the materials we loaded from every mtllib beforehand. tinyobjloader
-/// stops at the first file of a multi-file `mtllib` line, and we want all of them.
+/// Hands tinyobjloader the materials we read from every mtllib beforehand (only their names
+/// matter to it: it maps usemtl to an index). tinyobjloader would stop at the first file of a
+/// multi-file `mtllib` line, and we want all of them.
 class PreloadedMaterials : public tinyobj::MaterialReader {
  public:
   PreloadedMaterials(const std::vector<tinyobj::material_t>& materials, const std::map<std::string, int>& map)
@@ -444,44 +552,47 @@ std::string without_polygon_prefix(const std::string& message) {
   return message;
 }
 
-/// Adds faces to the scene so that Scene's own warnings (triangulated faces) carry file:line.
-/// Each face first goes into a scratch scene; if that records a warning, the pieces it made are
-/// added instead of the face, and the warning is re-worded with the face's location.
+/// Adds faces to the scene so that what Scene would say about them (triangulated, degenerate)
+/// carries file:line and follows the forgiving policy. Each face first goes into a scratch
+/// scene; if that records a warning, the pieces it made are added instead of the face.
 class FaceAdder {
  public:
-  FaceAdder(Scene& scene, const fs::path& file) : scene_(scene), file_(file) { reset_scratch(); }
+  FaceAdder(Scene& scene, const fs::path& file, ReaderWarnings& warnings)
+      : scene_(scene), file_(file), warnings_(warnings) {
+    reset_scratch();
+  }
 
   void add(const std::vector<glm::vec3>& vertices, MaterialId material, const std::string& group, std::size_t line) {
-    const std::string where = at(file_, line) + "face (group '" + (group.empty() ? "default" : group) + "'): ";
+    const std::string face = "face (group '" + (group.empty() ? std::string("default") : group) + "'): ";
     const std::size_t warnings_before = scratch_.warnings().size();
     PolygonRange pieces;
     try {
       pieces = scratch_.add_polygon(vertices, 0);
     } catch (const Error& e) {
-      throw Error(e.code(), where + without_polygon_prefix(e.what()));
+      // The vertices are finite (the scan checked), so Scene refuses only degenerate faces.
+      warnings_.forgive("degenerate face", e.code(), loc(file_, line), face + without_polygon_prefix(e.what()),
+                        "dropped");
+      return;
     }
-    try {
-      if (scratch_.warnings().size() == warnings_before) {
-        scene_.add_polygon(vertices, material, group);
-      } else {
-        // A piece is a triangle Scene accepted once; one so thin that Scene's collinearity test
-        // rejects it on its own carries no area worth keeping, and the warning says so.
-        std::size_t slivers = 0;
-        for (std::uint32_t i = 0; i < pieces.count; ++i) {
-          try {
-            scene_.add_polygon(scratch_.polygons()[pieces.first + i].vertices, material, group);
-          } catch (const Error&) {
-            ++slivers;
-          }
+    if (scratch_.warnings().size() == warnings_before) {
+      scene_.add_polygon(vertices, material, group);
+    } else {
+      // A piece is a triangle Scene accepted once; one so thin that Scene's collinearity test
+      // rejects it on its own carries no area worth keeping.
+      std::size_t slivers = 0;
+      for (std::uint32_t i = 0; i < pieces.count; ++i) {
+        try {
+          scene_.add_polygon(scratch_.polygons()[pieces.first + i].vertices, material, group);
+        } catch (const Error&) {
+          ++slivers;
         }
-        for (std::size_t w = warnings_before; w < scratch_.warnings().size(); ++w)
-          scene_.add_warning(where + without_polygon_prefix(scratch_.warnings()[w]) +
-                             (slivers > 0 && w + 1 == scratch_.warnings().size()
-                                  ? " (" + std::to_string(slivers) + " sliver triangle(s) dropped)"
-                                  : std::string()));
       }
-    } catch (const Error& e) {
-      throw Error(e.code(), where + without_polygon_prefix(e.what()));
+      for (std::size_t w = warnings_before; w < scratch_.warnings().size(); ++w)
+        warnings_.forgive("triangulated face", ErrorCode::invalid_scene, loc(file_, line),
+                          face + without_polygon_prefix(scratch_.warnings()[w]),
+                          slivers > 0 && w + 1 == scratch_.warnings().size()
+                              ? std::to_string(slivers) + " sliver triangle(s) dropped"
+                              : std::string());
     }
     if (scratch_.polygons().size() > 4096) reset_scratch();
   }
@@ -494,29 +605,25 @@ class FaceAdder {
 
   Scene& scene_;
   const fs::path& file_;
+  ReaderWarnings& warnings_;
   Scene scratch_;
 };
 
 }  // namespace
 
-Scene load_obj(const fs::path& path) {
+Scene load_obj(const fs::path& path, const LoadOptions& options) {
   const std::string text = read_text(path, "OBJ file");
-  ObjScan scan = scan_obj(path, text);
+  ReaderWarnings warnings(options.strict);
+  ObjScan scan = scan_obj(path, text, warnings);
 
-  // Every MTL file, in order of mention, into one list and name map (the first definition of a
-  // name wins, as in tinyobjloader).
-  std::vector<tinyobj::material_t> tmaterials;
-  std::map<std::string, int> tmaterial_map;
+  // Every MTL file, in order of mention, into one list; the first definition of a name wins.
   std::vector<MtlInfo> infos;
-  for (const fs::path& mtl : scan.mtl_files) {
-    const std::string mtl_text = read_text(mtl, "MTL file");
-    scan_mtl(mtl, mtl_text, infos);
-    std::istringstream in(mtl_text);
-    std::string warn, err;
-    tinyobj::LoadMtl(&tmaterial_map, &tmaterials, &in, &warn, &err);
-    if (infos.size() != tmaterials.size())
-      throw Error(ErrorCode::internal, "load_scene: '" + mtl.string() + "': found " + std::to_string(infos.size()) +
-                                           " materials, tinyobjloader read " + std::to_string(tmaterials.size()));
+  for (const fs::path& mtl : scan.mtl_files) scan_mtl(mtl, read_text(mtl, "MTL file"), infos);
+  std::vector<tinyobj::material_t> tmaterials(infos.size());
+  std::map<std::string, int> tmaterial_map;
+  for (std::size_t i = 0; i < infos.size(); ++i) {
+    tmaterials[i].name = infos[i].name;
+    tmaterial_map.emplace(infos[i].name, static_cast<int>(i));
   }
 
   tinyobj::attrib_t attrib;
@@ -531,76 +638,73 @@ Scene load_obj(const fs::path& path) {
       throw Error(ErrorCode::parse_error, path.string() + ": " + (first.empty() ? "cannot parse" : first));
     }
   }
-  if (attrib.vertices.size() != 3 * scan.vertex_count)
-    throw Error(ErrorCode::internal, "load_scene: '" + path.string() + "': found " + std::to_string(scan.vertex_count) +
-                                         " vertices, tinyobjloader read " + std::to_string(attrib.vertices.size() / 3));
+  // Invariants of the scan agreeing with tinyobjloader (both read the same text).
+  assert(attrib.vertices.size() == 3 * scan.vertex_count);
 
   Scene scene;
-  for (std::string& w : scan.warnings) scene.add_warning(std::move(w));
 
   // Materials: MTL material i becomes scene material ids[i]; "default" grey is added on demand.
   std::vector<MaterialId> ids;
-  ids.reserve(tmaterials.size());
-  for (std::size_t i = 0; i < tmaterials.size(); ++i) {
-    std::vector<std::string> warnings;
-    Material m = to_material(tmaterials[i], infos[i], warnings);
+  ids.reserve(infos.size());
+  for (const MtlInfo& info : infos) {
     try {
-      ids.push_back(scene.add_material(m));
+      ids.push_back(scene.add_material(to_material(info, warnings)));
     } catch (const Error& e) {
-      throw Error(e.code(), at(infos[i].file, infos[i].line) + e.what());
+      throw Error(e.code(), at(info.file, info.line) + e.what());
     }
-    for (std::string& w : warnings) scene.add_warning(std::move(w));
   }
   std::optional<MaterialId> default_material;
-  std::set<std::string_view> unknown_reported;
+  auto material_of = [&](int mid, const FaceInfo& face) -> MaterialId {
+    if (mid >= 0 && static_cast<std::size_t>(mid) < ids.size()) return ids[static_cast<std::size_t>(mid)];
+    if (!face.material.empty())
+      warnings.forgive("undefined material", ErrorCode::invalid_scene, loc(path, face.material_line),
+                       "material " + in_quotes(face.material) + " is not defined by the mtllib files read",
+                       "its faces use the default grey");
+    if (!default_material) {
+      Material grey;
+      grey.name = "default";
+      default_material = scene.add_material(grey);
+    }
+    return *default_material;
+  };
 
   // Faces, in file order: tinyobjloader's shapes are consecutive runs of the file's faces. The
   // per-face vertex counts come from our scan (tinyobjloader stores them in an unsigned char).
-  FaceAdder adder(scene, path);
+  FaceAdder adder(scene, path, warnings);
   std::size_t face = 0;
-  bool matched = true;
   std::vector<glm::vec3> vertices;
+  std::set<std::string_view> undefined_reported;
   for (const tinyobj::shape_t& shape : shapes) {
     const std::string group(trim(shape.name));
     std::size_t corner = 0;
-    for (std::size_t f = 0; f < shape.mesh.material_ids.size() && matched; ++f, ++face) {
-      matched = face < scan.faces.size() && corner + scan.faces[face].vertex_count <= shape.mesh.indices.size();
-      if (!matched) break;
+    for (std::size_t f = 0; f < shape.mesh.material_ids.size(); ++f, ++face) {
+      if (face >= scan.faces.size() || corner + scan.faces[face].vertex_count > shape.mesh.indices.size())
+        throw Error(ErrorCode::internal, "load_scene: '" + path.string() +
+                                             "': could not match tinyobjloader's faces to the file's f lines");
       const FaceInfo& info = scan.faces[face];
       vertices.clear();
       for (std::size_t k = 0; k < info.vertex_count; ++k) {
         const int v = shape.mesh.indices[corner + k].vertex_index;
-        if (v < 0 || static_cast<std::size_t>(v) >= scan.vertex_count)
-          fail(ErrorCode::internal, path, info.line, "tinyobjloader returned vertex index " + std::to_string(v));
+        assert(v >= 0 && static_cast<std::size_t>(v) < scan.vertex_count);  // check_corner() ensured it
         const std::size_t o = 3 * static_cast<std::size_t>(v);
         vertices.emplace_back(attrib.vertices[o], attrib.vertices[o + 1], attrib.vertices[o + 2]);
       }
       corner += info.vertex_count;
-
       const int mid = shape.mesh.material_ids[f];
-      MaterialId material;
-      if (mid >= 0 && static_cast<std::size_t>(mid) < ids.size()) {
-        material = ids[static_cast<std::size_t>(mid)];
-      } else {
-        if (!default_material) {
-          Material grey;
-          grey.name = "default";
-          default_material = scene.add_material(grey);
-        }
-        material = *default_material;
-        if (!info.material.empty() && unknown_reported.insert(info.material).second)
-          scene.add_warning(at(path, info.material_line) + "material " + in_quotes(info.material) +
-                            " is not defined by the mtllib files read so far; its faces use the default grey");
-      }
-      adder.add(vertices, material, group, info.line);
+      // An undefined material is reported once per name, not once per face.
+      const bool undefined = !(mid >= 0 && static_cast<std::size_t>(mid) < ids.size());
+      FaceInfo quiet = info;
+      if (undefined && !undefined_reported.insert(info.material).second) quiet.material = {};
+      adder.add(vertices, material_of(mid, quiet), group, info.line);
     }
-    matched = matched && corner == shape.mesh.indices.size();
   }
-  if (!matched || face != scan.faces.size())
+  if (face != scan.faces.size())
     throw Error(ErrorCode::internal, "load_scene: '" + path.string() + "': could not match tinyobjloader's faces to the file's " +
                                          std::to_string(scan.faces.size()) + " f lines");
-  if (scan.faces.empty())
-    throw Error(ErrorCode::parse_error, "load_scene: '" + path.string() + "' has no faces (f lines)");
+  if (scene.polygons().empty())
+    throw Error(ErrorCode::parse_error, "load_scene: '" + path.string() + "' has no faces (f lines)" +
+                                            (scan.faces.empty() ? "" : " that are not degenerate"));
+  warnings.move_to(scene);
   return scene;
 }
 

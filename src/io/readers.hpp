@@ -4,14 +4,15 @@
 
 #include <filesystem>
 
+#include "radiosity/io.hpp"
 #include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
 
 /// Wavefront OBJ with its MTL libraries (see load_scene() in io.hpp for the mapping).
-Scene load_obj(const std::filesystem::path& path);
+Scene load_obj(const std::filesystem::path& path, const LoadOptions& options);
 
 /// The JSON scene format of docs/SCENE_JSON.md (reads the file, then parse_scene_json()).
-Scene load_scene_json(const std::filesystem::path& path);
+Scene load_scene_json(const std::filesystem::path& path, const LoadOptions& options);
 
 }  // namespace radiosity::detail

@@ -22,6 +22,7 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "io/reader_warnings.hpp"
 #include "io/readers.hpp"
 #include "radiosity/brdf.hpp"
 #include "radiosity/io.hpp"
@@ -113,7 +114,8 @@ class DuplicateKeyCheck {
 /// Walks one parsed document. Every accessor takes the value's document path for messages.
 class SceneReader {
  public:
-  SceneReader(std::string source, fs::path base_dir) : source_(std::move(source)), base_dir_(std::move(base_dir)) {}
+  SceneReader(std::string source, fs::path base_dir, const LoadOptions& options)
+      : source_(std::move(source)), base_dir_(std::move(base_dir)), options_(options), warnings_(options.strict) {}
 
   Scene read(const json& root);
 
@@ -239,8 +241,27 @@ class SceneReader {
   MaterialId material_ref(const json& obj, const std::string& loc) const;
   void include_obj(const json& j, const std::string& loc, Scene& scene) const;
 
+  /// A material's radiosity reflectance: [0, 1) per channel; 1 or more is clamped to 0.99
+  /// under the forgiving policy (exported scenes say "white" as 1).
+  Rgb reflectance(const json& j, const std::string& loc) const {
+    const Rgb c = colour(j, loc);
+    if (c.x < 0.0f || c.y < 0.0f || c.z < 0.0f)
+      fail(ErrorCode::invalid_scene, loc, "each channel must be in [0, 1) (got " + rgb_text(c) + ")");
+    const Rgb out = glm::min(c, Rgb(kMaxForgivenAlbedo));
+    for (int k = 0; k < 3; ++k)
+      if (c[k] >= 1.0f) {
+        warnings_.forgive("reflectance >= 1", ErrorCode::invalid_scene, source_ + ": " + loc,
+                          "each channel must be in [0, 1) (got " + rgb_text(c) + ")", "clamped to " + rgb_text(out));
+        return out;
+      }
+    return c;
+  }
+
   std::string source_;
   fs::path base_dir_;
+  LoadOptions options_;
+  /// Filled while reading (also from the const members that add surfaces), moved into the scene.
+  mutable ReaderWarnings warnings_;
   std::map<std::string, MaterialId> material_ids_;
   std::vector<std::string> material_names_;
 };
@@ -386,7 +407,7 @@ void SceneReader::materials(const json& j, Scene& scene) {
     Rgb brdf_diffuse(0.0f);
     if (const json* b = find(m, "brdf")) mat.brdf = brdf(*b, key_path(loc, "brdf"), brdf_diffuse);
     if (const json* r = find(m, "reflectance")) {
-      mat.reflectance = bounded_colour(*r, key_path(loc, "reflectance"), 1.0f, true);
+      mat.reflectance = reflectance(*r, key_path(loc, "reflectance"));
     } else if (mat.brdf) {
       for (int k = 0; k < 3; ++k)
         if (brdf_diffuse[k] >= 1.0f)
@@ -402,8 +423,22 @@ void SceneReader::materials(const json& j, Scene& scene) {
     if (const json* ior = find(m, "ior")) mat.ior = positive(*ior, key_path(loc, "ior"));
     mat.diffuse_transmittance = optional_colour(m, loc, "diffuse_transmittance", mat.diffuse_transmittance, 1.0f, false);
     if (const json* t = find(m, "two_sided")) mat.two_sided = boolean(*t, key_path(loc, "two_sided"));
-    check_sum(mat.reflectance + mat.specular + mat.diffuse_transmittance, loc,
-              "reflectance + specular + diffuse_transmittance", 1.0f, true);
+    // The parts that leave the surface in pass 1 must stay below 1; forgiven by scaling the
+    // specular and diffuse transmittance down, as the OBJ reader scales Ks.
+    const Rgb sum = mat.reflectance + mat.specular + mat.diffuse_transmittance;
+    float scale = 1.0f;
+    for (int k = 0; k < 3; ++k) {
+      const float rest = mat.specular[k] + mat.diffuse_transmittance[k];
+      if (sum[k] >= 1.0f && rest > 0.0f) scale = std::min(scale, std::max(0.0f, (kMaxForgivenAlbedo - mat.reflectance[k]) / rest));
+    }
+    if (scale < 1.0f) {
+      warnings_.forgive("reflectance sum >= 1", ErrorCode::invalid_scene, source_ + ": " + loc,
+                        "reflectance + specular + diffuse_transmittance must be < 1 in every channel (got " +
+                            rgb_text(sum) + ")",
+                        "specular and diffuse_transmittance scaled by " + number_text(scale));
+      mat.specular *= scale;
+      mat.diffuse_transmittance *= scale;
+    }
 
     MaterialId id = 0;
     try {
@@ -467,7 +502,7 @@ void SceneReader::include_obj(const json& j, const std::string& loc, Scene& scen
   const fs::path file = file_path(require(j, loc, "file"), key_path(loc, "file"));
   Scene obj;
   try {
-    obj = load_obj(file);
+    obj = load_obj(file, options_);
   } catch (const Error& e) {
     fail(e.code(), key_path(loc, "file"), e.what());
   }
@@ -489,12 +524,23 @@ void SceneReader::surface(const json& j, const std::string& loc, Scene& scene) c
     const json* g = find(j, "group");
     return g ? string(*g, key_path(loc, "group")) : std::string();
   };
+  // Under strict, what Scene would only warn about (a polygon triangulated) is an error too.
   auto add = [&](auto build) {
+    const std::size_t warnings_before = scene.warnings().size();
     try {
       build();
     } catch (const Error& e) {
       rethrow(e, loc);
     }
+    if (options_.strict && scene.warnings().size() > warnings_before)
+      fail(ErrorCode::invalid_scene, loc, scene.warnings()[warnings_before]);
+  };
+  // As `add`, but Scene's own error escapes unchanged, for the caller to forgive.
+  auto add_strict = [&](auto build) {
+    const std::size_t warnings_before = scene.warnings().size();
+    build();
+    if (options_.strict && scene.warnings().size() > warnings_before)
+      fail(ErrorCode::invalid_scene, loc, scene.warnings()[warnings_before]);
   };
 
   if (type == "polygon") {
@@ -506,7 +552,13 @@ void SceneReader::surface(const json& j, const std::string& loc, Scene& scene) c
     for (std::size_t i = 0; i < v.size(); ++i) points.push_back(vec3(v[i], index_path(vloc, i)));
     const MaterialId m = material_ref(j, loc);
     const std::string g = group();
-    add([&] { scene.add_polygon(points, m, g); });
+    // A degenerate polygon is dropped (vertices are finite here, so that is all Scene refuses).
+    try {
+      add_strict([&] { scene.add_polygon(points, m, g); });
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::invalid_scene) throw;
+      warnings_.forgive("degenerate polygon", e.code(), source_ + ": " + loc, e.what(), "dropped");
+    }
   } else if (type == "quad") {
     object(j, loc, {"type", "origin", "edge_u", "edge_v", "material", "group"});
     const glm::vec3 o = vec3(require(j, loc, "origin"), key_path(loc, "origin"));
@@ -560,12 +612,13 @@ Scene SceneReader::read(const json& root) {
   for (std::size_t i = 0; i < surfaces.size(); ++i) surface(surfaces[i], index_path("surfaces", i), scene);
   if (scene.polygons().empty()) fail(ErrorCode::invalid_scene, "surfaces", "the scene has no polygons");
   if (const json* c = find(root, "camera")) camera(*c, scene);
+  warnings_.move_to(scene);
   return scene;
 }
 
 }  // namespace
 
-Scene load_scene_json(const fs::path& path) {
+Scene load_scene_json(const fs::path& path, const LoadOptions& options) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
     throw Error(ErrorCode::file_not_found, "load_scene: cannot open JSON scene '" + path.string() +
@@ -574,14 +627,15 @@ Scene load_scene_json(const fs::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (!in) throw Error(ErrorCode::file_not_found, "load_scene: cannot read JSON scene '" + path.string() + "'");
-  return parse_scene_json(text.str(), path.parent_path(), path.string());
+  return parse_scene_json(text.str(), path.parent_path(), path.string(), options);
 }
 
 }  // namespace detail
 
 inline namespace v1 {
 
-Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_dir, std::string_view source_name) {
+Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_dir, std::string_view source_name,
+                       const LoadOptions& options) {
   const std::string source(source_name);
   nlohmann::json root;
   try {
@@ -596,8 +650,17 @@ Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_
     if (colon != std::string::npos) what = what.substr(colon + 2);
     throw Error(ErrorCode::parse_error, source + ":" + detail::line_column(text, e.byte > 0 ? e.byte - 1 : 0) +
                                             ": JSON syntax error: " + what);
+  } catch (const nlohmann::json::exception& e) {
+    // Not a syntax error but a value the JSON library cannot hold (a number such as 1e999).
+    throw Error(ErrorCode::parse_error, source + ": JSON value error: " + e.what());
   }
-  return detail::SceneReader(source, base_dir).read(root);
+  try {
+    return detail::SceneReader(source, base_dir, options).read(root);
+  } catch (const nlohmann::json::exception& e) {
+    // A value the reader's checks let through to the JSON library (a number too large for its
+    // type, ...): still the caller's bad input, reported as ours.
+    throw Error(ErrorCode::parse_error, source + ": " + e.what());
+  }
 }
 
 }  // namespace v1

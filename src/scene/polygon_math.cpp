@@ -58,6 +58,11 @@ CleanPolygon clean_polygon(const std::vector<glm::vec3>& input) {
   if (len <= 0.0f) return out;
   out.normal = n / len;
 
+  // A triangle is planar and convex by definition; the tests below could say otherwise only
+  // through rounding (a thin triangle far from the origin), and then a valid triangle would be
+  // "triangulated into 1 triangle" with a warning.
+  if (out.vertices.size() == 3) return out;
+
   glm::vec3 centre(0.0f);
   for (const glm::vec3& p : out.vertices) centre += p;
   centre /= static_cast<float>(out.vertices.size());

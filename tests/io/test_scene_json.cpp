@@ -113,9 +113,11 @@ fs::path write_merl(const fs::path& path) {
   return path;
 }
 
-Error parse_error_of(const std::string& doc, const fs::path& base = {}) {
+Error parse_error_of(const std::string& doc, const fs::path& base = {}, bool strict = false) {
   try {
-    rad::parse_scene_json(doc, base, "scene.json");
+    rad::LoadOptions options;
+    options.strict = strict;
+    rad::parse_scene_json(doc, base, "scene.json", options);
   } catch (const Error& e) {
     return e;
   }
@@ -123,9 +125,10 @@ Error parse_error_of(const std::string& doc, const fs::path& base = {}) {
   return Error(ErrorCode::internal, "");
 }
 
-void check_error(const std::string& doc, ErrorCode code, const std::string& part, const fs::path& base = {}) {
-  const Error e = parse_error_of(doc, base);
-  INFO("message: " << e.what());
+void check_error(const std::string& doc, ErrorCode code, const std::string& part, const fs::path& base = {},
+                 bool strict = false) {
+  const Error e = parse_error_of(doc, base, strict);
+  INFO("message: " << std::string(e.what()));
   CHECK(e.code() == code);
   CHECK(contains(e.what(), part));
 }
@@ -255,7 +258,7 @@ TEST_CASE("JSON bad values name the document path of the value") {
   check_error(with_materials(m0 + R"({"name": "w", "brdf": {"type": "ward", "specular": 0.2, "alpha_x": -0.1, "alpha_y": 0.1}})"),
               ErrorCode::invalid_scene, "scene.json: materials[2].brdf.alpha_x: must be > 0 (got -0.1)");
   check_error(with_materials(R"({"name": "m0", "reflectance": [0.5, 1.0, 0.5]})"), ErrorCode::invalid_scene,
-              "materials[0].reflectance: each channel must be in [0, 1)");
+              "materials[0].reflectance: each channel must be in [0, 1)", {}, /*strict=*/true);
   check_error(with_materials(R"({"name": "m0", "brdf": {"type": "phong", "diffuse": 0.6, "specular": 0.5, "exponent": 10}})"),
               ErrorCode::invalid_scene, "materials[0].brdf: diffuse + specular must be <= 1");
   check_error(with_materials(R"({"name": "m0", "brdf": {"type": "mix", "weight": 1.5,
@@ -264,7 +267,7 @@ TEST_CASE("JSON bad values name the document path of the value") {
   check_error(with_materials(R"({"name": "m0", "brdf": {"type": "lambertian", "reflectance": 1}})"),
               ErrorCode::invalid_scene, "materials[0].brdf: its diffuse part");
   check_error(with_materials(R"({"name": "m0", "reflectance": 0.6, "specular": 0.5})"), ErrorCode::invalid_scene,
-              "materials[0]: reflectance + specular + diffuse_transmittance must be < 1");
+              "materials[0]: reflectance + specular + diffuse_transmittance must be < 1", {}, /*strict=*/true);
   check_error(with_materials(R"({"name": "m0", "emission": [1, -1, 0]})"), ErrorCode::invalid_scene,
               "materials[0].emission: each channel must be >= 0 (got [1, -1, 0])");
   check_error(with_materials(R"({"name": "m0", "reflectance": 1e300})"), ErrorCode::invalid_scene,
@@ -277,7 +280,7 @@ TEST_CASE("JSON bad values name the document path of the value") {
               ErrorCode::invalid_scene, "surfaces[0].upper: must be above lower");
   check_error(R"({"version": 1, "materials": [{"name": "m0"}], "surfaces": [
                  {"type": "polygon", "vertices": [[0,0,0], [1,0,0], [2,0,0]], "material": "m0"}]})",
-              ErrorCode::invalid_scene, "surfaces[0]: polygon 0 (group 'default'): degenerate");
+              ErrorCode::invalid_scene, "surfaces[0]: polygon 0 (group 'default'): degenerate", {}, /*strict=*/true);
   check_error(R"({"version": 1, "materials": [{"name": "m0"}], "camera": {"eye": [0,0,0], "look_at": [0,0,0]},
                  "surfaces": [{"type": "quad", "origin": [0,0,0], "edge_u": [1,0,0], "edge_v": [0,1,0], "material": "m0"}]})",
               ErrorCode::invalid_scene, "scene.json: camera: ");
@@ -339,6 +342,31 @@ TEST_CASE("JSON syntax errors give the line and column of the offending characte
   CHECK(where == "scene.json:3:17: JSON syntax error");
   check_error(doc, ErrorCode::parse_error, where);
   check_error("{\"version\": 1,\n \"surfaces\": [\n", ErrorCode::parse_error, "scene.json:3:1: JSON syntax error");
+}
+
+TEST_CASE("JSON scenes forgive a reflectance of 1 and degenerate polygons with warnings - errors under strict") {
+  const std::string doc = R"({"version": 1,
+    "materials": [{"name": "m0", "reflectance": 1}, {"name": "m1", "reflectance": 0.9, "specular": 0.3}],
+    "surfaces": [{"type": "quad", "origin": [0,0,0], "edge_u": [0,0,1], "edge_v": [1,0,0], "material": "m0"},
+                 {"type": "polygon", "vertices": [[0,1,0], [1,1,0], [2,1,0]], "material": "m1"},
+                 {"type": "polygon", "vertices": [[0,2,0], [1,2,0], [1,2,1]], "material": "m1"}]})";
+  const rad::Scene scene = rad::parse_scene_json(doc, {}, "scene.json");
+  CHECK(scene.polygons().size() == 2);  // the collinear triangle is dropped
+  CHECK(scene.materials()[0].reflectance.x == doctest::Approx(0.99f));
+  const rad::Material& m1 = scene.materials()[1];
+  CHECK((m1.reflectance + m1.specular).x == doctest::Approx(0.99f));
+  REQUIRE(scene.warnings().size() == 3);
+  CHECK(contains(scene.warnings()[0], "scene.json: materials[0].reflectance: each channel must be in [0, 1)"));
+  CHECK(contains(scene.warnings()[0], "clamped"));
+  CHECK(contains(scene.warnings()[1], "scene.json: materials[1]: reflectance + specular"));
+  CHECK(contains(scene.warnings()[2], "scene.json: surfaces[1]:"));
+  CHECK(contains(scene.warnings()[2], "dropped"));
+  check_error(doc, ErrorCode::invalid_scene, "materials[0].reflectance", {}, /*strict=*/true);
+}
+
+TEST_CASE("a number too large for the JSON library is a radiosity::Error, not the library's exception") {
+  check_error(R"({"version": 1, "surfaces": [{"type": "sphere", "centre": [0, 0, 1e999], "radius": 1}]})",
+              ErrorCode::parse_error, "scene.json");
 }
 
 TEST_CASE("load_scene reads .json files and names the file in errors") {
