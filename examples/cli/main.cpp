@@ -28,21 +28,23 @@ int main(int argc, char** argv) {
   render->add_option("-o,--output", out, "EXR output")->capture_default_str();
   render->add_option("--png", png, "PNG preview (default: the EXR path with .png)");
   render->add_flag("--no-png", no_png, "Do not write a PNG preview");
-  render->add_option("--width", width, "Image width")->check(CLI::PositiveNumber)->capture_default_str();
-  render->add_option("--height", height, "Image height")->check(CLI::PositiveNumber)->capture_default_str();
+  render->add_option("--width", width, "Image width")->check(positive<int>())->capture_default_str();
+  render->add_option("--height", height, "Image height")->check(positive<int>())->capture_default_str();
   render->add_option("--spp", spp, "Stratified samples per pixel, rounded up to a square (default 4, path: 256)")
-      ->check(CLI::PositiveNumber);
-  render->add_option("--eye", eye, "Camera position x,y,z");
-  render->add_option("--look-at", look_at, "Camera target x,y,z");
-  render->add_option("--up", up, "Camera up vector x,y,z");
-  render->add_option("--fov", fov, "Vertical field of view, degrees")->check(CLI::Range(0.0f, 180.0f));
-  render->add_option("--exposure", exposure, "PNG exposure (linear scale)")->capture_default_str();
+      ->check(positive<int>());
+  render->add_option("--eye", eye, "Camera position x,y,z")->check(vec3_check());
+  render->add_option("--look-at", look_at, "Camera target x,y,z")->check(vec3_check());
+  render->add_option("--up", up, "Camera up vector x,y,z")->check(vec3_check());
+  render->add_option("--fov", fov, "Vertical field of view, degrees")->check(in_range<float>(0.0f, 180.0f));
+  render->add_option("--exposure", exposure, "PNG exposure (linear scale)")
+      ->check(any_number<float>())
+      ->capture_default_str();
   bool wireframe = false, ambient = false;
   render->add_flag("--wireframe", wireframe, "Draw the element mesh over the image");
   render->add_flag("--ambient", ambient, "Add progressive refinement's ambient term to the display");
   int max_depth = 0;
   render->add_option("--max-depth", max_depth, "Path tracer: reflections at most (0 = unlimited, Russian roulette)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<int>());
   bool two_pass = false, pass1_only = false, direct_only = false;
   std::size_t photons = 200000;
   render->add_flag("--two-pass", two_pass,
@@ -50,7 +52,9 @@ int main(int argc, char** argv) {
                    "photon-mapped caustics; the EXR gets layers direct, indirect, specular, caustic");
   render->add_flag("--pass1-only", pass1_only, "Two-pass: diffuse interreflection only, no specular pass");
   render->add_flag("--direct-only", direct_only, "Two-pass: direct illumination only");
-  render->add_option("--photons", photons, "Two-pass: caustic photons (0 = no caustics)")->capture_default_str();
+  render->add_option("--photons", photons, "Two-pass: caustic photons (0 = no caustics)")
+      ->check(any_number<std::size_t>())
+      ->capture_default_str();
   add_solve_options(*render, render_args, true);
 
   // solve
@@ -64,11 +68,7 @@ int main(int argc, char** argv) {
 
   Command factors = add_factors_command(app);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
   if (*factors.app) return factors.run();
 
   return run_guarded([&] {
