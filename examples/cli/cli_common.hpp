@@ -204,6 +204,46 @@ inline const std::vector<std::string>& form_factor_names() {
   return names;
 }
 
+/// The name form_factor_method() maps to `method` ("default" for one it has no name for).
+inline std::string form_factor_name(rad::FormFactorMethod method) {
+  for (const std::string& name : form_factor_names())
+    if (form_factor_method(name) == method) return name;
+  return "default";
+}
+
+/// The names of `render --mode`, as rad::to_string(RenderMode) spells them.
+inline const std::vector<std::string>& render_mode_names() {
+  static const std::vector<std::string> names = {"auto", "radiosity", "two-pass", "path"};
+  return names;
+}
+
+/// The mode a `--mode` name selects (automatic for "auto" and anything unknown).
+inline rad::RenderMode render_mode_from_name(const std::string& name) {
+  for (rad::RenderMode m : {rad::RenderMode::radiosity, rad::RenderMode::two_pass, rad::RenderMode::path})
+    if (name == rad::to_string(m)) return m;
+  return rad::RenderMode::automatic;
+}
+
+/// The render mode that the flags ask for (--mode and its aliases), and the first
+/// contradiction between them.
+struct ModeRequest {
+  rad::RenderMode mode = rad::RenderMode::automatic;
+  std::string source;    ///< the flag that asked for `mode`, e.g. "--two-pass"
+  std::string conflict;  ///< e.g. "--mode radiosity contradicts --two-pass"; empty if none
+
+  /// Records that flag `flag` asks for `m` (automatic: the flag asks for nothing).
+  ModeRequest& add(rad::RenderMode m, const std::string& flag) {
+    if (m == rad::RenderMode::automatic || !conflict.empty()) return *this;
+    if (mode == rad::RenderMode::automatic) {
+      mode = m;
+      source = flag;
+    } else if (m != mode) {
+      conflict = source + " contradicts " + flag;
+    }
+    return *this;
+  }
+};
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
@@ -211,15 +251,18 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--method", a.method, with_path ? "Solver, or path for the reference path tracer" : "Solver")
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
-  cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
+  cmd.add_option("--form-factors", a.form_factors,
+                 with_path ? "Form-factor estimator (two-pass mode on a scene with mirrors or glass: monte-carlo)"
+                           : "Form-factor estimator")
       ->check(CLI::IsMember(form_factor_names()))
       ->capture_default_str();
   cmd.add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo estimator: rays per element, 16..1048576")
       ->check(in_range<unsigned>(16u, 1u << 20))
       ->capture_default_str();
   cmd.add_option("--specular-depth", a.specular_depth,
-                 "Monte Carlo estimator: mirror reflections and window passages carried between diffuse surfaces "
-                 "(extended form factors), 0..16")
+                 std::string("Monte Carlo estimator: mirror reflections and window passages carried between "
+                             "diffuse surfaces (extended form factors), 0..16") +
+                     (with_path ? " (two-pass mode on a scene with mirrors or glass: 1 with monte-carlo)" : ""))
       ->check(in_range<unsigned>(0u, 16u))
       ->capture_default_str();
   cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
