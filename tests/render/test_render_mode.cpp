@@ -25,7 +25,7 @@ rad::Scene box_with(const rad::Material* extra) {
 }  // namespace
 
 TEST_SUITE("render") {
-  TEST_CASE("choose_render_mode: the Cornell box is diffuse, its specular variants need the two-pass view") {
+  TEST_CASE("choose_render_mode: the Cornell box is diffuse and its specular variants need the two-pass view") {
     const rad::Scene diffuse = rad::cornell_box();
     CHECK(rad::choose_render_mode(diffuse) == rad::RenderMode::radiosity);
     CHECK_FALSE(rad::needs_extended_first_pass(diffuse));
@@ -67,7 +67,7 @@ TEST_SUITE("render") {
     }
   }
 
-  TEST_CASE("choose_render_mode: what needs the two-pass view, and which of it the extended first pass carries") {
+  TEST_CASE("choose_render_mode: what needs the two-pass view and which of it the extended first pass carries") {
     rad::Material m;
     m.reflectance = rad::Rgb(0.3f);
     bool extended = false;
@@ -104,7 +104,7 @@ TEST_SUITE("render") {
     CHECK(rad::needs_extended_first_pass(scene) == extended);
   }
 
-  TEST_CASE("prepare_two_pass: monte-carlo and specular depth >= 1 for mirrors and glass, nothing otherwise") {
+  TEST_CASE("prepare_two_pass: monte-carlo and specular depth >= 1 for mirrors and glass and nothing otherwise") {
     rad::SolveOptions o;
     o.form_factors.method = rad::FormFactorMethod::hemicube;
     rad::prepare_two_pass(rad::cornell_box(), o);
