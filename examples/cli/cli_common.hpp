@@ -4,12 +4,18 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +25,95 @@
 namespace cli {
 
 namespace rad = radiosity;
+
+// Number checks with readable messages, for options of type T. CLI11's PositiveNumber,
+// NonNegativeNumber and Range print the bounds of `double` in full (hundreds of digits) and call
+// "abc" out of range; these say "'abc' is not a number" or "must be > 0 (got -1)", and CLI11
+// prefixes the option's name. The type's own range counts too (an unsigned option refuses -1).
+
+/// `s` as a number when all of it is one (an integer for integral T) and finite, else nullopt.
+template <typename T>
+std::optional<long double> parse_number(const std::string& s) {
+  if (s.empty() || std::isspace(static_cast<unsigned char>(s[0]))) return std::nullopt;
+  if constexpr (std::is_integral_v<T>) {
+    const std::size_t first = (s[0] == '-' || s[0] == '+') ? 1 : 0;
+    if (first == s.size() ||
+        !std::all_of(s.begin() + static_cast<std::ptrdiff_t>(first), s.end(),
+                     [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }))
+      return std::nullopt;
+  }
+  char* end = nullptr;
+  const long double v = std::strtold(s.c_str(), &end);
+  if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+template <typename T>
+std::string show_number(T v) {
+  std::ostringstream out;
+  out << +v;  // + prints a char-sized integer as a number
+  return out.str();
+}
+
+/// A number of type T in [lo, hi] (lo excluded when `lo_open`); a missing bound is the type's.
+template <typename T>
+CLI::Validator number_check(std::optional<T> lo, bool lo_open, std::optional<T> hi, const std::string& desc) {
+  auto check = [lo, lo_open, hi](std::string& s) -> std::string {
+    const std::optional<long double> v = parse_number<T>(s);
+    if (!v) return "'" + s + "' is not " + (std::is_integral_v<T> ? "an integer" : "a number");
+    const std::string got = " (got " + s + ")";
+    const bool below = lo && (lo_open ? !(*v > *lo) : *v < *lo), above = hi && *v > *hi;
+    if (lo && hi && (below || above))
+      return "must be in [" + show_number(*lo) + ", " + show_number(*hi) + "]" + got;
+    if (below) return std::string("must be ") + (lo_open ? "> " : ">= ") + show_number(*lo) + got;
+    if (above) return "must be <= " + show_number(*hi) + got;
+    constexpr T lowest = std::numeric_limits<T>::lowest(), highest = std::numeric_limits<T>::max();
+    if (*v < static_cast<long double>(lowest)) return "must be >= " + show_number(lowest) + got;
+    if (*v > static_cast<long double>(highest)) return "must be <= " + show_number(highest) + got;
+    return {};
+  };
+  return CLI::Validator(check, desc);
+}
+
+/// Any number of type T (an unsigned one is >= 0).
+template <typename T>
+CLI::Validator any_number() {
+  return number_check<T>(std::nullopt, false, std::nullopt, "");
+}
+/// > 0.
+template <typename T>
+CLI::Validator positive() {
+  return number_check<T>(T(0), true, std::nullopt, "POSITIVE");
+}
+/// >= 0.
+template <typename T>
+CLI::Validator non_negative() {
+  return number_check<T>(T(0), false, std::nullopt, "NONNEGATIVE");
+}
+/// In [lo, hi].
+template <typename T>
+CLI::Validator in_range(T lo, T hi) {
+  return number_check<T>(lo, false, hi, "in [" + show_number(lo) + ", " + show_number(hi) + "]");
+}
+
+/// `s` as x,y,z, or nullopt.
+inline std::optional<glm::vec3> try_parse_vec3(const std::string& s) {
+  glm::vec3 v;
+  char c1 = 0, c2 = 0;
+  std::istringstream in(s);
+  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !in.eof()) return std::nullopt;
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return std::nullopt;
+  return v;
+}
+
+/// A vector x,y,z (three numbers, commas, no spaces).
+inline CLI::Validator vec3_check() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        return try_parse_vec3(s) ? std::string() : "expected x,y,z (three numbers), got '" + s + "'";
+      },
+      "x,y,z");
+}
 
 /// A one-line progress bar with rate and ETA on a terminal; silent when stderr is not a tty.
 class ProgressBar {
@@ -109,6 +204,46 @@ inline const std::vector<std::string>& form_factor_names() {
   return names;
 }
 
+/// The name form_factor_method() maps to `method` ("default" for one it has no name for).
+inline std::string form_factor_name(rad::FormFactorMethod method) {
+  for (const std::string& name : form_factor_names())
+    if (form_factor_method(name) == method) return name;
+  return "default";
+}
+
+/// The names of `render --mode`, as rad::to_string(RenderMode) spells them.
+inline const std::vector<std::string>& render_mode_names() {
+  static const std::vector<std::string> names = {"auto", "radiosity", "two-pass", "path"};
+  return names;
+}
+
+/// The mode a `--mode` name selects (automatic for "auto" and anything unknown).
+inline rad::RenderMode render_mode_from_name(const std::string& name) {
+  for (rad::RenderMode m : {rad::RenderMode::radiosity, rad::RenderMode::two_pass, rad::RenderMode::path})
+    if (name == rad::to_string(m)) return m;
+  return rad::RenderMode::automatic;
+}
+
+/// The render mode that the flags ask for (--mode and its aliases), and the first
+/// contradiction between them.
+struct ModeRequest {
+  rad::RenderMode mode = rad::RenderMode::automatic;
+  std::string source;    ///< the flag that asked for `mode`, e.g. "--two-pass"
+  std::string conflict;  ///< e.g. "--mode radiosity contradicts --two-pass"; empty if none
+
+  /// Records that flag `flag` asks for `m` (automatic: the flag asks for nothing).
+  ModeRequest& add(rad::RenderMode m, const std::string& flag) {
+    if (m == rad::RenderMode::automatic || !conflict.empty()) return *this;
+    if (mode == rad::RenderMode::automatic) {
+      mode = m;
+      source = flag;
+    } else if (m != mode) {
+      conflict = source + " contradicts " + flag;
+    }
+    return *this;
+  }
+};
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
@@ -116,35 +251,39 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--method", a.method, with_path ? "Solver, or path for the reference path tracer" : "Solver")
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
-  cmd.add_option("--form-factors", a.form_factors, "Form-factor estimator")
+  cmd.add_option("--form-factors", a.form_factors,
+                 with_path ? "Form-factor estimator (two-pass mode on a scene with mirrors or glass: monte-carlo)"
+                           : "Form-factor estimator")
       ->check(CLI::IsMember(form_factor_names()))
       ->capture_default_str();
   cmd.add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo estimator: rays per element, 16..1048576")
-      ->check(CLI::Range(16u, 1u << 20))
+      ->check(in_range<unsigned>(16u, 1u << 20))
       ->capture_default_str();
   cmd.add_option("--specular-depth", a.specular_depth,
-                 "Monte Carlo estimator: mirror reflections and window passages carried between diffuse surfaces "
-                 "(extended form factors), 0..16")
-      ->check(CLI::Range(0u, 16u))
+                 std::string("Monte Carlo estimator: mirror reflections and window passages carried between "
+                             "diffuse surfaces (extended form factors), 0..16") +
+                     (with_path ? " (two-pass mode on a scene with mirrors or glass: 1 with monte-carlo)" : ""))
+      ->check(in_range<unsigned>(0u, 16u))
       ->capture_default_str();
   cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<float>());
   cmd.add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<float>());
   cmd.add_option("--tolerance", a.tolerance, "Stop when unshot/emitted power falls below this")
-      ->check(CLI::PositiveNumber)
+      ->check(positive<double>())
       ->capture_default_str();
   cmd.add_option("--max-iterations", a.max_iterations, "Sweeps or shooting steps at most (0 = default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<int>());
   cmd.add_flag("--adaptive", a.adaptive, "Subdivide elements where radiosity varies fast (shadow edges)");
   cmd.add_option("--adaptive-threshold", a.adaptive_threshold, "Relative contrast that splits an element")
-      ->check(CLI::Range(0.001f, 1.0f))
+      ->check(in_range<float>(0.001f, 1.0f))
       ->capture_default_str();
   cmd.add_option("--adaptive-passes", a.adaptive_passes, "Refinement passes at most")
-      ->check(CLI::Range(1, 16))
+      ->check(in_range<int>(1, 16))
       ->capture_default_str();
-  cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)");
+  cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)")->check(any_number<unsigned>());
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
+      ->check(any_number<std::uint64_t>())
       ->capture_default_str();
 }
 
@@ -201,12 +340,9 @@ inline void print_summary(const rad::Solution& sol) {
 }
 
 inline glm::vec3 parse_vec3(const std::string& s, const char* name) {
-  glm::vec3 v;
-  char c1 = 0, c2 = 0;
-  std::istringstream in(s);
-  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !in.eof())
-    throw CLI::ValidationError(name, "expected x,y,z, got '" + s + "'");
-  return v;
+  const std::optional<glm::vec3> v = try_parse_vec3(s);
+  if (!v) throw CLI::ValidationError(name, "expected x,y,z (three numbers), got '" + s + "'");
+  return *v;
 }
 
 /// Runs a command body and turns exceptions into the CLI's exit codes: 1 for a
@@ -224,6 +360,46 @@ inline int run_guarded(const std::function<int()>& body) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "radiosity: unexpected error: %s\n", e.what());
     return 3;
+  }
+}
+
+/// Reports a bad argument the CLI's way and returns its exit code, 2: one line
+/// `radiosity: error: MESSAGE` on stderr and a hint where to look (`command`: the subcommand's
+/// name, or empty before one was given).
+inline int argument_error(const std::string& command, const std::string& message) {
+  std::fprintf(stderr, "radiosity: error: %s\n", message.c_str());
+  if (command.empty())
+    std::fprintf(stderr, "Run 'radiosity --help' for the commands.\n");
+  else
+    std::fprintf(stderr, "Run 'radiosity %s --help' for the options.\n", command.c_str());
+  return 2;
+}
+
+/// Parses the command line. Returns nullopt to go on, else the exit code: 0 after --help or
+/// --help-all (CLI11 prints the help), 2 after any other CLI::ParseError (argument_error()).
+inline std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+    return std::nullopt;
+  } catch (const CLI::Success& e) {  // --help, --help-all, a version request
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    const std::vector<CLI::App*> chosen = app.get_subcommands();
+    const std::string command = chosen.empty() ? std::string() : chosen.front()->get_name();
+    std::string message = e.what();
+    if (chosen.empty() && dynamic_cast<const CLI::RequiredError*>(&e)) {
+      std::string names;
+      for (const CLI::App* sub : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + sub->get_name();
+      message = "expected a command (" + names + ")";
+      if (argc > 1) message += ", got '" + std::string(argv[1]) + "'";
+    } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) && message.size() > 8 &&
+               message.compare(message.size() - 8, 8, " missing") == 0) {
+      // "--width: 1 required INT:POSITIVE missing" -> "--width: needs a value"
+      message = message.substr(0, message.find(": ")) + ": needs a value";
+    }
+    // CLI11's messages can span lines; the contract is one line.
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    return argument_error(command, message);
   }
 }
 

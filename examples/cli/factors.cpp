@@ -91,24 +91,25 @@ Command add_factors_command(CLI::App& app) {
   cmd->add_option("--groups", a.groups, "Comma-separated groups to report, in this order (default: all)");
   cmd->add_option("--samples", a.samples,
                   "Points per source element, 1..64 (hemicube: a square count is a Gauss rule)")
-      ->check(CLI::Range(1u, 64u))
+      ->check(in_range<unsigned>(1u, 64u))
       ->capture_default_str();
   cmd->add_option("--rays", a.rays, "Ray cast: occlusion rays per source point, 1..64")
-      ->check(CLI::Range(1u, 64u))
+      ->check(in_range<unsigned>(1u, 64u))
       ->capture_default_str();
   cmd->add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo: rays per element, 16..1048576")
-      ->check(CLI::Range(16u, 1u << 20))
+      ->check(in_range<unsigned>(16u, 1u << 20))
       ->capture_default_str();
   cmd->add_option("--resolution", a.resolution, "Hemicube: top-face resolution in pixels, 2..8192")
-      ->check(CLI::Range(2u, 8192u))
+      ->check(in_range<unsigned>(2u, 8192u))
       ->capture_default_str();
   cmd->add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
+      ->check(any_number<std::uint64_t>())
       ->capture_default_str();
-  cmd->add_option("--threads", a.threads, "Worker threads (0 = all cores)");
+  cmd->add_option("--threads", a.threads, "Worker threads (0 = all cores)")->check(any_number<unsigned>());
   cmd->add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<float>());
   cmd->add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<float>());
   return Command{cmd, [args] { return run_factors(*args); }};
 }
 

@@ -28,30 +28,45 @@ int main(int argc, char** argv) {
   render->add_option("-o,--output", out, "EXR output")->capture_default_str();
   render->add_option("--png", png, "PNG preview (default: the EXR path with .png)");
   render->add_flag("--no-png", no_png, "Do not write a PNG preview");
-  render->add_option("--width", width, "Image width")->check(CLI::PositiveNumber)->capture_default_str();
-  render->add_option("--height", height, "Image height")->check(CLI::PositiveNumber)->capture_default_str();
-  render->add_option("--spp", spp, "Stratified samples per pixel, rounded up to a square (default 4, path: 256)")
-      ->check(CLI::PositiveNumber);
-  render->add_option("--eye", eye, "Camera position x,y,z");
-  render->add_option("--look-at", look_at, "Camera target x,y,z");
-  render->add_option("--up", up, "Camera up vector x,y,z");
-  render->add_option("--fov", fov, "Vertical field of view, degrees")->check(CLI::Range(0.0f, 180.0f));
-  render->add_option("--exposure", exposure, "PNG exposure (linear scale)")->capture_default_str();
+  render->add_option("--width", width, "Image width")->check(positive<int>())->capture_default_str();
+  render->add_option("--height", height, "Image height")->check(positive<int>())->capture_default_str();
+  render
+      ->add_option("--spp", spp,
+                   "Stratified samples per pixel, rounded up to a square (default 4, two-pass: 16, path: 256)")
+      ->check(positive<int>());
+  render->add_option("--eye", eye, "Camera position x,y,z")->check(vec3_check());
+  render->add_option("--look-at", look_at, "Camera target x,y,z")->check(vec3_check());
+  render->add_option("--up", up, "Camera up vector x,y,z")->check(vec3_check());
+  render->add_option("--fov", fov, "Vertical field of view, degrees")->check(in_range<float>(0.0f, 180.0f));
+  render->add_option("--exposure", exposure, "PNG exposure (linear scale)")
+      ->check(any_number<float>())
+      ->capture_default_str();
+  std::string mode_name = "auto";
+  render
+      ->add_option("--mode", mode_name,
+                   "Pipeline: auto (two-pass when some material is specular or transmitting, else radiosity), "
+                   "radiosity, two-pass or path (the reference path tracer)")
+      ->check(CLI::IsMember(render_mode_names()))
+      ->capture_default_str();
   bool wireframe = false, ambient = false;
   render->add_flag("--wireframe", wireframe, "Draw the element mesh over the image");
   render->add_flag("--ambient", ambient, "Add progressive refinement's ambient term to the display");
   int max_depth = 0;
   render->add_option("--max-depth", max_depth, "Path tracer: reflections at most (0 = unlimited, Russian roulette)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative<int>());
   bool two_pass = false, pass1_only = false, direct_only = false;
   std::size_t photons = 200000;
   render->add_flag("--two-pass", two_pass,
-                   "Two-pass compositor: radiosity, then ray-traced mirrors, glass and glossy lobes, and "
+                   "Same as --mode two-pass: radiosity, then ray-traced mirrors, glass and glossy lobes, and "
                    "photon-mapped caustics; the EXR gets layers direct, indirect, specular, caustic");
   render->add_flag("--pass1-only", pass1_only, "Two-pass: diffuse interreflection only, no specular pass");
   render->add_flag("--direct-only", direct_only, "Two-pass: direct illumination only");
-  render->add_option("--photons", photons, "Two-pass: caustic photons (0 = no caustics)")->capture_default_str();
+  render->add_option("--photons", photons, "Two-pass: caustic photons (0 = no caustics)")
+      ->check(any_number<std::size_t>())
+      ->capture_default_str();
   add_solve_options(*render, render_args, true);
+  CLI::Option* form_factors_option = render->get_option("--form-factors");
+  CLI::Option* specular_depth_option = render->get_option("--specular-depth");
 
   // solve
   SolveArgs solve_args;
@@ -64,12 +79,24 @@ int main(int argc, char** argv) {
 
   Command factors = add_factors_command(app);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
   if (*factors.app) return factors.run();
+
+  // What the user asked of the render pipeline; contradictions are argument errors.
+  ModeRequest requested;
+  if (*render) {
+    const std::string conflict =
+        pass1_only && direct_only
+            ? "--pass1-only and --direct-only exclude each other"
+            : requested.add(render_mode_from_name(mode_name), "--mode " + mode_name)
+                  .add(render_args.method == "path" ? rad::RenderMode::path : rad::RenderMode::automatic,
+                       "--method path")
+                  .add(two_pass ? rad::RenderMode::two_pass : rad::RenderMode::automatic, "--two-pass")
+                  .add(pass1_only ? rad::RenderMode::two_pass : rad::RenderMode::automatic, "--pass1-only")
+                  .add(direct_only ? rad::RenderMode::two_pass : rad::RenderMode::automatic, "--direct-only")
+                  .conflict;
+    if (!conflict.empty()) return argument_error("render", conflict);
+  }
 
   return run_guarded([&] {
     ProgressBar bar;
@@ -96,8 +123,35 @@ int main(int argc, char** argv) {
         o.seed = render_args.seed;
         o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
       };
+      // The pipeline: as asked, else the one the scene needs.
+      const rad::RenderMode needed = rad::choose_render_mode(scene);
+      const rad::RenderMode mode = requested.mode == rad::RenderMode::automatic ? needed : requested.mode;
+      std::string why = requested.mode == rad::RenderMode::automatic ? "automatic: " : requested.source;
+      if (requested.mode == rad::RenderMode::automatic)
+        why += mode == rad::RenderMode::radiosity  ? "every material is diffuse"
+               : rad::needs_extended_first_pass(scene) ? "the scene has mirror or glass materials"
+                                                       : "the scene has glossy materials";
+      else if (mode == rad::RenderMode::radiosity && needed == rad::RenderMode::two_pass)
+        why += "; specular materials are shown as diffuse";
+      rad::SolveOptions solve_options = to_options(render_args, bar);
+      if (mode == rad::RenderMode::two_pass) {
+        // The extended first pass (mirror and window form factors) where the scene has mirrors
+        // or glass, unless the user chose the estimator or the depth.
+        rad::SolveOptions recommended = solve_options;
+        rad::prepare_two_pass(scene, recommended);
+        const bool depth_given = specular_depth_option->count() > 0;
+        if (form_factors_option->count() == 0 && (!depth_given || render_args.specular_depth > 0))
+          solve_options.form_factors.method = recommended.form_factors.method;
+        if (!depth_given && solve_options.form_factors.method == recommended.form_factors.method)
+          solve_options.form_factors.specular_depth = recommended.form_factors.specular_depth;
+        why += "; pass 1 with " + form_factor_name(solve_options.form_factors.method) +
+               " form factors and specular depth " + std::to_string(solve_options.form_factors.specular_depth);
+      }
+      std::printf("mode: %s (%s)\n", rad::to_string(mode), why.c_str());
+      std::fflush(stdout);
+
       rad::Image image;
-      if (render_args.method == "path") {
+      if (mode == rad::RenderMode::path) {
         // The reference: an unbiased path tracer, no radiosity solve.
         rad::PathTraceOptions po;
         image_options(po, 256);
@@ -105,10 +159,10 @@ int main(int argc, char** argv) {
         image = rad::render_path_traced(scene, po);
         bar.finish();
         std::printf("path traced: %d samples per pixel\n", po.spp);
-      } else if (two_pass || pass1_only || direct_only) {
+      } else if (mode == rad::RenderMode::two_pass) {
         // Pass 1: radiosity; with the Monte Carlo estimator and --specular-depth it carries mirror
         // and window form factors (the extended first pass).
-        rad::Solution sol = rad::solve(scene, to_options(render_args, bar));
+        rad::Solution sol = rad::solve(scene, solve_options);
         bar.finish();
         print_summary(sol);
         rad::TwoPassOptions to;
@@ -124,7 +178,7 @@ int main(int argc, char** argv) {
         std::printf("two-pass: %d samples per pixel, %zu of %zu caustic photons stored\n", to.spp,
                     report.photons_stored, report.photons_emitted);
       } else {
-        rad::Solution sol = rad::solve(scene, to_options(render_args, bar));
+        rad::Solution sol = rad::solve(scene, solve_options);
         bar.finish();
         print_summary(sol);
         rad::RenderOptions ro;
@@ -135,7 +189,10 @@ int main(int argc, char** argv) {
         bar.finish();
       }
       rad::write_exr(image, out);
-      std::printf("wrote %s (%dx%d, linear float RGB)\n", std::filesystem::absolute(out).c_str(), width, height);
+      std::string layers;
+      for (const auto& layer : image.layers) layers += (layers.empty() ? "; layers " : ", ") + layer.first;
+      std::printf("wrote %s (%dx%d, linear float RGB%s)\n", std::filesystem::absolute(out).c_str(), width, height,
+                  layers.c_str());
       if (!no_png) {
         if (png.empty()) png = std::filesystem::path(out).replace_extension(".png").string();
         rad::PngOptions po;

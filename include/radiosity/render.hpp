@@ -52,5 +52,42 @@ struct RenderOptions {
 /// that was not made from this scene.
 RADIOSITY_API Image render(const Scene& scene, const Solution& solution, const RenderOptions& options = {});
 
+/// Which pipeline turns a scene into an image (`radiosity render --mode`).
+enum class RenderMode {
+  automatic,  ///< let choose_render_mode() decide
+  radiosity,  ///< solve(), then render(): every surface is shown as diffuse
+  two_pass,   ///< solve() (see prepare_two_pass()), then render_two_pass(): mirrors, glass, glossy lobes, caustics
+  path,       ///< render_path_traced(): the unbiased reference, no solve
+};
+
+/// The CLI's spelling of a mode: "auto", "radiosity", "two-pass" or "path".
+/// Thread safety: pure function.
+RADIOSITY_API const char* to_string(RenderMode mode);
+
+/// The cheapest mode that shows `scene` right: RenderMode::two_pass when some polygon's material
+/// is not purely diffuse, else RenderMode::radiosity (never automatic or path). A material is not
+/// purely diffuse when a channel of `specular` or `transmittance` is > 0, or when it has its own
+/// `brdf` that is not Lambertian: one that is_delta(), or whose eval() is not the same constant
+/// f with pi * f = albedo() at a few fixed pairs of directions (so a mix of a Lambertian and a
+/// mirror counts as specular). Emission and diffuse transmittance do not count (pass 1 carries
+/// them), nor do materials that no polygon uses.
+/// Thread safety: may be called concurrently (reads `scene` only).
+RADIOSITY_API RenderMode choose_render_mode(const Scene& scene);
+
+/// Whether the first pass of render_two_pass() over `scene` should be the extended one: some
+/// polygon's material is an ideal mirror (specular > 0 with specular_exponent 0), a window or
+/// glass (transmittance > 0), which FormFactorOptions::specular_depth > 0 carries between
+/// diffuse surfaces. Glossy lobes and a material's own `brdf` do not count (pass 1 ignores them).
+/// Thread safety: may be called concurrently.
+RADIOSITY_API bool needs_extended_first_pass(const Scene& scene);
+
+/// Sets up `options` for the first pass of the two-pass view of `scene`: when
+/// needs_extended_first_pass(scene), form_factors.method = FormFactorMethod::monte_carlo (the only
+/// estimator that carries specular events) and form_factors.specular_depth = at least 1 (a larger
+/// value is kept); otherwise `options` is left unchanged. Every other field is left as it is.
+/// Typical use: `SolveOptions o; prepare_two_pass(scene, o); render_two_pass(scene, solve(scene, o))`.
+/// Thread safety: may be called concurrently for different `options`.
+RADIOSITY_API void prepare_two_pass(const Scene& scene, SolveOptions& options);
+
 }  // namespace v1
 }  // namespace radiosity
