@@ -72,14 +72,16 @@ struct FormFactorOptions {
   /// specular parts are ignored and every polygon is opaque. Glossy lobes are not carried. In
   /// [0, 16].
   std::uint32_t specular_depth = 0;
-  /// Diffuse transmission (Rushmeier & Torrance 1990), for every method. A patch whose material
-  /// has diffuse_transmittance > 0 is translucent: a thin sheet with two sides. Its back becomes a
-  /// second target, numbered patch count + k for the k-th translucent patch
-  /// (FormFactorEstimator::translucent_patches()), which sparse rows and columns then report,
+  /// Back sides: diffuse transmission (Rushmeier & Torrance 1990) and two-sided surfaces, for
+  /// every method. A patch whose material has diffuse_transmittance > 0 (a translucent thin
+  /// sheet) or is two_sided (a single sheet that reflects on both sides: a partition wall, a
+  /// table top as one quad) has two sides. Its back becomes a second target, numbered patch
+  /// count + k for the k-th such patch (FormFactorEstimator::translucent_patches(), which
+  /// despite its name lists two-sided patches too), which sparse rows and columns then report,
   /// and its elements get a second row over the back hemisphere (sparse_back_rows(): Rushmeier's
   /// backward form factors). The dense calls (element_rows(), patch_column()) keep to the
-  /// fronts of patches. solve() sets this when the scene has a translucent material. false =
-  /// every polygon is opaque and sees nothing behind it.
+  /// fronts of patches. solve() sets this when the scene uses a translucent or two-sided
+  /// material. false = every polygon is one-sided: its back absorbs and sees nothing.
   bool diffuse_transmission = false;
   /// Seeds every random stream (ray-cast samples, hemicube orientations).
   std::uint64_t seed = 1;

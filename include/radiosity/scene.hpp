@@ -34,7 +34,10 @@ struct Material {
   Rgb transmittance{0.0f};          ///< specular transmission tint (glass), each channel in [0, 1]
   float ior = 1.5f;                 ///< index of refraction used when transmittance > 0
   Rgb diffuse_transmittance{0.0f};  ///< translucency, each channel in [0, 1]
-  bool two_sided = false;           ///< reflects on both sides (otherwise the back is black)
+  /// Reflects and emits on both sides, each side with a radiosity of its own (a single-sheet
+  /// partition wall, a table top as one quad, foliage cards); otherwise the back absorbs
+  /// everything and sends nothing.
+  bool two_sided = false;
   /// Optional full reflection model for the second pass; null means "derive from the fields
   /// above". Shared and immutable, so copying a Material is cheap.
   std::shared_ptr<const Brdf> brdf;
@@ -91,6 +94,11 @@ class RADIOSITY_API Scene {
   /// a zero-area (degenerate) polygon, or Error{invalid_argument} for an unknown material id.
   PolygonRange add_polygon(const std::vector<glm::vec3>& vertices, MaterialId material,
                            std::string_view group = {});
+
+  /// Makes every material two-sided (Material::two_sided), for models whose winding cannot be
+  /// trusted (CLI `--two-sided`): a closed room wound outwards then lights its inside. Costs a
+  /// second radiosity per element. Thread safety: mutates the scene.
+  void make_two_sided();
 
   const std::vector<Material>& materials() const { return materials_; }
   const Material& material(MaterialId id) const { return materials_.at(id); }

@@ -104,9 +104,11 @@ class RADIOSITY_API Solution {
   /// children. This is the front side's; a translucent element (Material::diffuse_transmittance)
   /// includes what its back receives and transmits.
   const std::vector<Rgb>& radiosity() const { return radiosity_; }
-  /// Diffuse transmission: the radiosity leaving the back side of each element id, tau times
-  /// what the front receives (plus what the back reflects for a two-sided material); 0 for
-  /// opaque elements. Empty when the scene has no translucent material: every back is black.
+  /// Back sides: the radiosity leaving the back side of each element id, rho' H_back + tau
+  /// H_front: what a translucent element's back transmits (tau, diffuse_transmittance) plus
+  /// what the back reflects (rho' = rho for a two-sided material, 0 for a one-sided one); 0 for
+  /// one-sided opaque elements. Empty when the scene has no translucent or two-sided material:
+  /// every back is black.
   const std::vector<Rgb>& back_radiosity() const { return back_radiosity_; }
   /// back_radiosity() per vertex for display (empty when it is empty); no ambient term.
   std::vector<Rgb> vertex_back_radiosity() const;

@@ -30,11 +30,11 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   return o;
 }
 
-std::vector<std::uint32_t> find_translucent_patches(const Scene& scene, const PatchHierarchy& hierarchy) {
+std::vector<std::uint32_t> find_back_patches(const Scene& scene, const PatchHierarchy& hierarchy) {
   std::vector<std::uint32_t> out;
   const std::vector<Patch>& patches = hierarchy.patches();
   for (std::uint32_t j = 0; j < patches.size(); ++j)
-    if (pass1_translucent(scene.material(patches[j].material))) out.push_back(j);
+    if (pass1_has_back(scene.material(patches[j].material))) out.push_back(j);
   return out;
 }
 

@@ -15,9 +15,9 @@ namespace radiosity::detail {
 /// Options with defaults filled in and checked (throws Error{invalid_argument}).
 FormFactorOptions resolve(const FormFactorOptions& options);
 
-/// The patches whose material is translucent (pass1_translucent()), increasing: the k-th one's
-/// back is target patch count + k, for every estimator and for the solvers.
-std::vector<std::uint32_t> find_translucent_patches(const Scene& scene, const PatchHierarchy& hierarchy);
+/// The patches with a back side (pass1_has_back(): translucent or two-sided), increasing: the
+/// k-th one's back is target patch count + k, for every estimator and for the solvers.
+std::vector<std::uint32_t> find_back_patches(const Scene& scene, const PatchHierarchy& hierarchy);
 /// Per patch: its back target (patch_count + k for translucent[k]), or kNone for an opaque patch.
 std::vector<std::uint32_t> back_targets(std::size_t patch_count, const std::vector<std::uint32_t>& translucent);
 

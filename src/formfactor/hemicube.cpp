@@ -141,7 +141,7 @@ class HemicubeEstimator final : public FormFactorEstimator {
     delta_forms();
 
     const auto& patches = hierarchy.patches();
-    if (options.diffuse_transmission) set_translucent_patches(find_translucent_patches(scene, hierarchy));
+    if (options.diffuse_transmission) set_translucent_patches(find_back_patches(scene, hierarchy));
     back_item_ = back_targets(patches.size(), translucent_patches());  // kNone == kNoItem
     std::vector<std::vector<glm::vec3>> polygons;
     std::vector<glm::vec3> normals;

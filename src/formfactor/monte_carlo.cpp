@@ -141,9 +141,10 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       specular_[p].glass = pass1_glass(m);
       specular_[p].ior = m.ior;
     }
-    if (options.diffuse_transmission) set_translucent_patches(find_translucent_patches(scene, hierarchy));
+    if (options.diffuse_transmission) set_translucent_patches(find_back_patches(scene, hierarchy));
     back_target_ = back_targets(patches.size(), translucent_patches());
-    exact_.assign(target_count(), 0);  // backs never emit
+    // Backs are never exact: those of two-sided emitters are counted by the rays that reach them.
+    exact_.assign(target_count(), 0);
     emitter_of_.assign(patches.size(), kNone);
     std::vector<std::uint32_t> polygon_slot(polygons.size(), kNone);
     for (std::uint32_t j = 0; j < patches.size(); ++j) {

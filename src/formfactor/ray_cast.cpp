@@ -96,7 +96,7 @@ class SampledEstimator final : public FormFactorEstimator {
     // the shaft test's "touching" tolerance.
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
-    if (options.diffuse_transmission) set_translucent_patches(find_translucent_patches(scene, hierarchy));
+    if (options.diffuse_transmission) set_translucent_patches(find_back_patches(scene, hierarchy));
     back_target_ = back_targets(patches.size(), translucent_patches());
     corners_.resize(patches.size());
     for (std::size_t j = 0; j < patches.size(); ++j) {

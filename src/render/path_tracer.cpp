@@ -66,7 +66,8 @@ float power_heuristic(float pdf_this, float pdf_other) {
 struct Surface {
   glm::vec3 normal{0.0f};
   glm::vec3 origin{0.0f};  ///< a vertex, to snap hit points onto the plane
-  Rgb emission{0.0f};      ///< exitance E, W/m^2, from the front only
+  Rgb emission{0.0f};      ///< exitance E, W/m^2, from the front (and the back when emits_back)
+  bool emits_back = false; ///< a two-sided material emits on both sides, as in pass 1
   std::uint32_t material = 0;
   std::int32_t mirror = -1;  ///< index into mirrors_ for a plain planar mirror, else -1
   /// Probability density per unit area with which next-event estimation picks a point here:
@@ -139,6 +140,7 @@ class PathTracer {
       s.normal = poly.normal;
       s.origin = poly.vertices[0];
       s.emission = m.emission;
+      s.emits_back = m.two_sided;
       s.material = poly.material;
       if (is_plain_mirror(m)) {
         s.mirror = static_cast<std::int32_t>(mirrors_.size());
@@ -261,21 +263,23 @@ class PathTracer {
       glm::vec3 x = origin + hit->t * dir;
       x -= s.normal * glm::dot(x - s.origin, s.normal);  // snap onto the polygon's plane
 
-      // Emission (front only) seen along the path: in full from the camera or after a delta
-      // event (no light sample can produce those paths); after any other bounce weighted
-      // against next-event estimation, which samples the same paths (Veach eq. 9.13).
-      if (front && s.light_pdf_area > 0.0f) {
+      // Emission (the front's, and a two-sided emitter's back) seen along the path: in full
+      // from the camera or after a delta event (no light sample can produce those paths);
+      // after any other bounce weighted against next-event estimation, which samples the same
+      // paths (Veach eq. 9.13).
+      if ((front || s.emits_back) && s.light_pdf_area > 0.0f) {
+        const float cos_light = std::abs(cos_in);
         if (depth == 0 || (prev_delta && !via_mirror.valid)) {
           L += beta * s.emission * kInvPi;
         } else if (prev_delta) {
           // Reached by one mirror reflection: mirror_light() samples this path too, with the
           // pdf of the emitter's image (path length through the mirror, 1/K for the face).
           const float D = glm::length(prev_x - via_mirror.x) + glm::length(x - prev_x);
-          const float pdf_mirror = s.light_pdf_area * D * D / cos_in / static_cast<float>(mirrors_.size());
+          const float pdf_mirror = s.light_pdf_area * D * D / cos_light / static_cast<float>(mirrors_.size());
           L += beta * s.emission * (kInvPi * power_heuristic(via_mirror.pdf_bsdf, pdf_mirror));
         } else {
           const glm::vec3 w = x - prev_x;
-          const float pdf_light = s.light_pdf_area * glm::dot(w, w) / cos_in;
+          const float pdf_light = s.light_pdf_area * glm::dot(w, w) / cos_light;
           L += beta * s.emission * (kInvPi * power_heuristic(prev_pdf, pdf_light));
         }
       }
@@ -428,6 +432,15 @@ class PathTracer {
     return true;
   }
 
+  /// The cosine at an emitter of light leaving it against `wi` (the direction from the lit
+  /// point towards the emitter), or <= 0 when that side does not emit; `lit_side` is the
+  /// normal of the side it leaves.
+  static float emitter_cosine(const Surface& light, const glm::vec3& wi, glm::vec3& lit_side) {
+    const float c = -glm::dot(light.normal, wi);
+    lit_side = c < 0.0f && light.emits_back ? -light.normal : light.normal;
+    return light.emits_back ? std::abs(c) : c;
+  }
+
   /// A uniform point on an emitter chosen by power, and that emitter.
   const Surface& sample_light(detail::Rng& rng, glm::vec3& y) const {
     const Emitter& e = emitters_[detail::sample_cdf(emitter_cdf_, rng.uniform())];
@@ -447,11 +460,12 @@ class PathTracer {
     const float d2 = glm::dot(w, w);
     if (!(d2 > 0.0f)) return Rgb(0.0f);
     const glm::vec3 wi = w / std::sqrt(d2);
-    const float cos_x = glm::dot(n, wi), cos_y = -glm::dot(light.normal, wi);
+    glm::vec3 lit_side;
+    const float cos_x = glm::dot(n, wi), cos_y = emitter_cosine(light, wi, lit_side);
     if (cos_x <= 0.0f || cos_y <= 0.0f) return Rgb(0.0f);
 
     // Shadow ray between the two offset points (both on the lit sides of their planes).
-    const glm::vec3 target = y + epsilon_ * light.normal;
+    const glm::vec3 target = y + epsilon_ * lit_side;
     const glm::vec3 sw = target - offset_origin;
     const float dist = glm::length(sw);
     if (rays_.occluded(offset_origin, sw / dist, 0.0f, dist)) return Rgb(0.0f);
@@ -476,7 +490,8 @@ class PathTracer {
     const float d2 = glm::dot(w, w);
     if (!(d2 > 0.0f)) return Rgb(0.0f);
     const glm::vec3 wi = w / std::sqrt(d2);
-    const float cos_y = -glm::dot(light.normal, wi);
+    glm::vec3 lit_side;
+    const float cos_y = emitter_cosine(light, wi, lit_side);
     if (cos_y <= 0.0f) return Rgb(0.0f);
     float pdf_bounce = 0.0f, cos_x = 0.0f;
     const Rgb f = bsdf(wi, pdf_bounce, cos_x);
@@ -484,7 +499,7 @@ class PathTracer {
 
     // Shadow ray from the side of x that wi leaves from to the lit side of the emitter.
     const glm::vec3 start = x + (glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
-    const glm::vec3 sw = y + epsilon_ * light.normal - start;
+    const glm::vec3 sw = y + epsilon_ * lit_side - start;
     const float dist = glm::length(sw);
     if (rays_.occluded(start, sw / dist, 0.0f, dist)) return Rgb(0.0f);
 
@@ -522,7 +537,8 @@ class PathTracer {
       if (glm::dot(glm::cross(m.vertices[(i + 1) % n] - a, p - a), m.normal) < 0.0f) return Rgb(0.0f);
     }
     const glm::vec3 wr = wi - 2.0f * glm::dot(wi, m.normal) * m.normal;  // from p towards y
-    const float cos_y = -glm::dot(light.normal, wr);
+    glm::vec3 lit_side;
+    const float cos_y = emitter_cosine(light, wr, lit_side);
     if (cos_y <= 0.0f) return Rgb(0.0f);
     float pdf_bounce = 0.0f, cos_x = 0.0f;
     const Rgb f = bsdf(wi, pdf_bounce, cos_x);
@@ -531,7 +547,7 @@ class PathTracer {
     // Both legs unoccluded: x to just in front of p, and from there to the emitter.
     const glm::vec3 start = x + (glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
     const glm::vec3 at_mirror = p + epsilon_ * m.normal;
-    const glm::vec3 leg1 = at_mirror - start, leg2 = y + epsilon_ * light.normal - at_mirror;
+    const glm::vec3 leg1 = at_mirror - start, leg2 = y + epsilon_ * lit_side - at_mirror;
     const float l1 = glm::length(leg1), l2 = glm::length(leg2);
     if (!(l1 > 0.0f) || !(l2 > 0.0f)) return Rgb(0.0f);
     if (rays_.occluded(start, leg1 / l1, 0.0f, l1) || rays_.occluded(at_mirror, leg2 / l2, 0.0f, l2))

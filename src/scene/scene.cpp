@@ -69,6 +69,10 @@ MaterialId Scene::add_material(const Material& material) {
   return static_cast<MaterialId>(materials_.size() - 1);
 }
 
+void Scene::make_two_sided() {
+  for (Material& m : materials_) m.two_sided = true;
+}
+
 GroupId Scene::intern_group(std::string_view name) {
   if (name.empty()) name = "default";
   if (auto id = find_group(name)) return *id;

@@ -31,6 +31,16 @@ inline bool pass1_translucent(const Material& m) {
   return m.diffuse_transmittance.x > 0.0f || m.diffuse_transmittance.y > 0.0f || m.diffuse_transmittance.z > 0.0f;
 }
 
+/// Whether a patch of `m` has a radiosity of its own on its back (FormFactorOptions::
+/// diffuse_transmission numbers such backs as targets): a translucent sheet, or a two-sided
+/// material, whose back reflects as its front does (an opaque one transmits nothing, tau = 0).
+inline bool pass1_has_back(const Material& m) { return pass1_translucent(m) || m.two_sided; }
+
+/// What the back of `m` emits: a two-sided material emits on both sides (as a double-sided
+/// emissive surface does in Blender and glTF, and in the path tracer), a one-sided one only
+/// on its front.
+inline Rgb pass1_back_emission(const Material& m) { return m.two_sided ? m.emission : Rgb(0.0f); }
+
 /// What the back of a translucent sheet of `m` reflects: like the front for a two-sided
 /// material, nothing for a one-sided one (its back transmits only, as in the path tracer).
 inline Rgb pass1_back_reflectance(const Material& m) { return m.two_sided ? m.reflectance : Rgb(0.0f); }

@@ -54,9 +54,9 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
 
   SolveOptions o = options;
   if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
-  // Translucent materials in use switch diffuse transmission on.
+  // Translucent and two-sided materials in use switch the back sides on.
   for (const Polygon& polygon : scene.polygons())
-    if (detail::pass1_translucent(scene.material(polygon.material))) {
+    if (detail::pass1_has_back(scene.material(polygon.material))) {
       o.form_factors.diffuse_transmission = true;
       break;
     }
@@ -197,7 +197,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
         std::vector<std::uint32_t> backs;
         if (translucency)
           for (std::uint32_t c : created)
-            if (detail::pass1_translucent(scene.material(hierarchy.patches()[hierarchy.element(c).patch].material)))
+            if (detail::pass1_has_back(scene.material(hierarchy.patches()[hierarchy.element(c).patch].material)))
               backs.push_back(c);
         auto tf = std::chrono::steady_clock::now();
         estimator->sparse_element_rows(created, rows);
@@ -218,7 +218,8 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
           const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
           const Rgb tau = mat.diffuse_transmittance;
           B_elements[c] += tau * H_back[c];
-          B_back[c] = detail::pass1_back_reflectance(mat) * H_back[c] + tau * H_elements[c];
+          B_back[c] =
+              detail::pass1_back_emission(mat) + detail::pass1_back_reflectance(mat) * H_back[c] + tau * H_elements[c];
         }
       }
     }

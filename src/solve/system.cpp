@@ -10,7 +10,7 @@ RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hiera
   const std::size_t m = leaves.size(), n = hierarchy.patches().size();
   // Back targets first, numbered as the estimators number them, so each back unknown knows its target.
   const std::vector<std::uint32_t> translucent_patches =
-      diffuse_transmission ? find_translucent_patches(scene, hierarchy) : std::vector<std::uint32_t>{};
+      diffuse_transmission ? find_back_patches(scene, hierarchy) : std::vector<std::uint32_t>{};
   const std::vector<std::uint32_t> back_target = back_targets(n, translucent_patches);
   patch_area.assign(n + translucent_patches.size(), 0.0f);
   auto add = [&](std::uint32_t target, float a, const Rgb& E, const Rgb& rho, const Rgb& tau, std::uint32_t other) {
@@ -37,7 +37,9 @@ RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hiera
   for (std::uint32_t i : backs) {
     const Element& e = hierarchy.element(leaves[i]);
     const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
-    add(back_target[e.patch], e.area, Rgb(0.0f), pass1_back_reflectance(mat), mat.diffuse_transmittance, i);
+    const Rgb E = pass1_back_emission(mat);
+    add(back_target[e.patch], e.area, E, pass1_back_reflectance(mat), mat.diffuse_transmittance, i);
+    emitted += static_cast<double>(e.area) * (E.x + E.y + E.z);
   }
   glm::dvec3 mean(0.0);
   for (std::size_t u = 0; u < area.size(); ++u)

@@ -43,7 +43,7 @@ struct RadiositySystem {
   Rgb interreflection{1.0f};
   double total_area = 0.0;            ///< of all sides
 
-  /// `diffuse_transmission`: give translucent patches (pass1_translucent()) their backs.
+  /// `diffuse_transmission`: give translucent and two-sided patches (pass1_has_back()) their backs.
   RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission);
   std::size_t unknowns() const { return area.size(); }
   std::size_t fronts() const { return leaves.size(); }
