@@ -147,9 +147,10 @@ struct PolygonOverlap {
 /// planarity) count as touching, so polygons that share edges or vertices, T-junctions, a block
 /// standing on a floor (touching it along its bottom edges) and the pieces of a triangulated
 /// polygon are not reported; two polygons stacked closer than that are (z-fighting).
-/// Form factors, view_factors() and solve() refuse such scenes with Error{invalid_scene}: rays
-/// and hemicubes cannot tell which of two coincident surfaces is in front, and a surface that
-/// passes through another sees and lights its back. Cost: a bounding-box hierarchy (Embree's
+/// A diagnostic: form factors, view_factors() and solve() accept such scenes and light them
+/// as the path tracer does (a ray that reaches a back face is blocked, so contact regions are
+/// dark); solve() warns about coincident pairs that face the same way (z-fighting), where which
+/// surface is in front is rounding. Cost: a bounding-box hierarchy (Embree's
 /// collision query) and an exact test per nearby pair, about linear in the number of polygons.
 /// Throws Error{internal} if Embree cannot create a device.
 /// Thread safety: concurrent calls are safe.

@@ -4,7 +4,6 @@
 #include <vector>
 
 #include "formfactor/estimators.hpp"
-#include "geometry/overlap.hpp"
 #include "scene/specular_transport.hpp"
 
 namespace radiosity::detail {
@@ -126,8 +125,6 @@ std::size_t FormFactorEstimator::max_row_entries() const { return target_count()
 std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                                 const FormFactorOptions& options) {
   const FormFactorOptions o = detail::resolve(options);
-  // Coincident or interpenetrating surfaces would give factors that are wrong without a sign.
-  detail::check_no_overlaps(scene, "form factors");
   switch (o.method) {
     case FormFactorMethod::ray_cast: return detail::make_ray_cast_estimator(scene, hierarchy, o);
     case FormFactorMethod::analytic: return detail::make_analytic_estimator(scene, hierarchy, o);

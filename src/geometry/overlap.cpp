@@ -210,24 +210,26 @@ std::string point_text(const glm::vec3& p) {
 
 }  // namespace
 
-void check_no_overlaps(const Scene& scene, const char* who) {
+std::vector<std::string> z_fighting_warnings(const Scene& scene) {
+  std::vector<std::string> out;
+  std::vector<const PolygonOverlap*> same_facing;
   const std::vector<PolygonOverlap> found = find_overlaps(scene);
-  if (found.empty()) return;
-  const PolygonOverlap& o = found.front();
+  for (const PolygonOverlap& o : found)
+    if (o.kind == OverlapKind::coincident &&
+        glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) > 0.0f)
+      same_facing.push_back(&o);
+  if (same_facing.empty()) return out;
+  const PolygonOverlap& o = *same_facing.front();
   auto name = [&](PolygonId p) {
     return "polygon " + std::to_string(p) + " (group '" + scene.groups()[scene.polygons()[p].group] + "')";
   };
-  std::string message = std::string(who) + ": " + name(o.first) + " and " + name(o.second);
-  if (o.kind == OverlapKind::coincident)
-    message += " are coincident (coplanar and overlapping) around " + point_text(o.point) +
-               "; remove one or move them apart";
-  else
-    message += " interpenetrate (one passes through the other) around " + point_text(o.point) +
-               "; cut them where they meet or move them apart";
-  if (found.size() > 1)
-    message += " (and " + std::to_string(found.size() - 1) + " more pair" + (found.size() > 2 ? "s" : "") +
-               "; radiosity::find_overlaps() lists them)";
-  throw Error(ErrorCode::invalid_scene, message);
+  std::string message = name(o.first) + " and " + name(o.second) +
+                        " are coincident and face the same way (z-fighting) around " + point_text(o.point) +
+                        ": which of them is in front is decided by rounding; remove one or move them apart";
+  if (same_facing.size() > 1)
+    message += " (" + std::to_string(same_facing.size()) + " such pairs in all; radiosity::find_overlaps() lists them)";
+  out.push_back(std::move(message));
+  return out;
 }
 
 }  // namespace radiosity::detail

@@ -1,6 +1,11 @@
-// Coincident and interpenetrating polygons: the check that form factors and solves run on a
-// scene before trusting it. The public face is radiosity::find_overlaps() (scene.hpp).
+// Coincident and interpenetrating polygons: a diagnostic. Contact (a box resting on a floor
+// with its bottom face, a prop sunk into the floor) is lit correctly by every estimator, since
+// rays and hemicubes that reach a back face are blocked there; only coincident surfaces facing
+// the same way (z-fighting) are ambiguous. The public face is radiosity::find_overlaps().
 #pragma once
+
+#include <string>
+#include <vector>
 
 namespace radiosity {
 inline namespace v1 {
@@ -15,9 +20,10 @@ namespace radiosity::detail {
 /// diagonal), so a surface closer than that to another cannot be told apart from it by rays.
 inline constexpr double kOverlapRelativeTolerance = 2e-5;
 
-/// Throws Error{invalid_scene} when find_overlaps(scene) is not empty; the message names the
-/// first pair (lowest polygon ids) by index and group, says where they meet and how many other
-/// pairs there are. `who` prefixes the message (e.g. "solve").
-void check_no_overlaps(const Scene& scene, const char* who);
+/// One warning (or none) for the coincident pairs of find_overlaps(scene) whose normals point
+/// the same way: it names the first pair by index and group, where they meet, and how many
+/// pairs there are. Coincident pairs facing each other (contact) and interpenetrating pairs
+/// are not warned about: they are lit correctly.
+std::vector<std::string> z_fighting_warnings(const Scene& scene);
 
 }  // namespace radiosity::detail

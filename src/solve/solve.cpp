@@ -6,6 +6,7 @@
 #include <string>
 
 #include "formfactor/estimators.hpp"
+#include "geometry/overlap.hpp"
 #include "radiosity/solver.hpp"
 #include "scene/specular_transport.hpp"
 #include "solve/system.hpp"
@@ -66,6 +67,9 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   detail::ProgressGate gate(o.on_progress);
   SolveReport report;
   report.warnings = scene.warnings();
+  // Contact and interpenetration are lit correctly; only same-facing coincident surfaces are
+  // ambiguous.
+  for (std::string& w : detail::z_fighting_warnings(scene)) report.warnings.push_back(std::move(w));
 
   auto t0 = std::chrono::steady_clock::now();
   PatchHierarchy hierarchy(scene, o.mesh);
