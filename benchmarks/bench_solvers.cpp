@@ -5,6 +5,8 @@
 // Usage: bench_solvers [--ray-cast] [--rays N] [--only METHOD] [patches...]
 //          (default: 4000 with the monte_carlo estimator at 1024 rays; the second size is 16000)
 //        bench_solvers --compare PATCHES   (accuracy of monte_carlo against ray_cast on one mesh)
+//        bench_solvers --defaults [PATCHES] (default SolveOptions, only the mesh set; default 4000:
+//          the estimator automatic chose and its time, against ray_cast's in the same run)
 // Prints one line per configuration: patches, elements, method, seconds (form factors, solve),
 // iterations, residual reached, peak RSS.
 #include <sys/resource.h>
@@ -72,15 +74,24 @@ void compare(std::size_t target_patches) {
   opt.mesh.max_patch_area = static_cast<float>(scene.total_area() / static_cast<double>(target_patches));
   opt.mesh.max_element_area = opt.mesh.max_patch_area;
   opt.form_factors.method = radiosity::FormFactorMethod::ray_cast;
+  // The reference: ray_cast with 16 source samples and 16 visibility rays (4x4 its defaults),
+  // so its own noise is well below the candidates'.
+  opt.form_factors.source_samples = 16;
+  opt.form_factors.visibility_rays = 16;
   double c0 = cpu_seconds();
   const radiosity::Solution ref = radiosity::solve(scene, opt);
-  std::printf("compare: %zu elements; ray_cast reference %.1f s CPU\n", ref.report().element_count,
-              cpu_seconds() - c0);
+  std::printf("compare: %zu elements; ray_cast reference (16 x 16 samples) %.1f s CPU\n",
+              ref.report().element_count, cpu_seconds() - c0);
+  const radiosity::FormFactorOptions defaults;
   auto sum3 = [](const radiosity::Rgb& c) { return static_cast<double>(c.x) + c.y + c.z; };
-  for (std::uint32_t rays : {0u, 256u, 1024u, 4096u}) {
-    opt.form_factors.method = rays == 0 ? radiosity::FormFactorMethod::ray_cast : radiosity::FormFactorMethod::monte_carlo;
+  // 0: ray_cast at its defaults; 1: ray_cast with one source sample and one visibility ray
+  // (its cheapest); others: monte_carlo with that many rays.
+  for (std::uint32_t rays : {0u, 1u, 256u, 1024u, 4096u, 16384u}) {
+    opt.form_factors.method = rays <= 1 ? radiosity::FormFactorMethod::ray_cast : radiosity::FormFactorMethod::monte_carlo;
     opt.seed = 2;
-    opt.form_factors.hemisphere_rays = rays;
+    opt.form_factors.source_samples = rays == 1 ? 1 : defaults.source_samples;
+    opt.form_factors.visibility_rays = rays == 1 ? 1 : defaults.visibility_rays;
+    if (rays > 1) opt.form_factors.hemisphere_rays = rays;
     c0 = cpu_seconds();
     const radiosity::Solution mc = radiosity::solve(scene, opt);
     const double cpu = cpu_seconds() - c0;
@@ -114,6 +125,8 @@ void compare(std::size_t target_patches) {
     char label[64];
     if (rays == 0)
       std::snprintf(label, sizeof label, "ray_cast, seed 2");
+    else if (rays == 1)
+      std::snprintf(label, sizeof label, "ray_cast 1 x 1");
     else
       std::snprintf(label, sizeof label, "monte_carlo %u rays", rays);
     std::printf("  %-22s reflectors' RMS difference / RMS radiosity %5.2f %%, worst group mean %5.2f %%, "
@@ -121,6 +134,31 @@ void compare(std::size_t target_patches) {
                 label, 100.0 * std::sqrt(num / den), 100.0 * worst, cpu, mc.report().seconds_form_factors);
     std::fflush(stdout);
   }
+}
+
+/// `radiosity solve` with default options on the Cornell box meshed to about `target_patches`
+/// patches: the automatic estimator's total time (wall, 2 cores), against ray_cast's.
+void defaults(std::size_t target_patches) {
+  const radiosity::Scene scene = radiosity::cornell_box();
+  auto timed = [&](radiosity::FormFactorMethod method) {
+    radiosity::SolveOptions opt;  // defaults, as `radiosity solve` uses them
+    opt.mesh.max_patch_area = static_cast<float>(scene.total_area() / static_cast<double>(target_patches));
+    opt.mesh.max_element_area = opt.mesh.max_patch_area;
+    opt.form_factors.method = method;
+    const auto t0 = std::chrono::steady_clock::now();
+    const radiosity::Solution sol = radiosity::solve(scene, opt);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("  %-10s -> %-12s %6zu patches  total %6.2f s (form factors %6.2f s, solve %5.2f s)\n",
+                radiosity::to_string(method), radiosity::to_string(sol.report().form_factor_method),
+                sol.report().patch_count, seconds, sol.report().seconds_form_factors, sol.report().seconds_solving);
+    std::fflush(stdout);
+    return seconds;
+  };
+  std::printf("bench_solvers --defaults: default SolveOptions, Cornell box at about %zu patches\n", target_patches);
+  const double automatic = timed(radiosity::FormFactorMethod::automatic);
+  const double ray_cast = timed(radiosity::FormFactorMethod::ray_cast);
+  std::printf("  automatic / ray_cast time: %.3f (target: automatic under 1 s at 4000 patches on 2 cores)\n",
+              automatic / ray_cast);
 }
 
 }  // namespace
@@ -136,7 +174,8 @@ int usage(const char* bad) {
   if (bad) std::fprintf(stderr, "bench_solvers: bad argument '%s'\n", bad);
   std::fprintf(stderr,
                "usage: bench_solvers [--ray-cast] [--rays N] [--only jacobi|gauss-seidel|progressive] [PATCHES...]\n"
-               "       bench_solvers --compare PATCHES\n");
+               "       bench_solvers --compare PATCHES\n"
+               "       bench_solvers --defaults [PATCHES]\n");
   return bad ? 2 : 0;
 }
 
@@ -150,6 +189,15 @@ int main(int argc, char** argv) {
       const std::size_t n = count_arg(argv[++i]);
       if (n == 0) return usage(argv[i]);
       compare(n);
+      return 0;
+    }
+    if (arg == "--defaults") {
+      std::size_t n = 4000;
+      if (has_value && (n = count_arg(argv[i + 1])) != 0)
+        ++i;
+      else
+        n = 4000;
+      defaults(n);
       return 0;
     }
     if (arg == "--only" && has_value) {

@@ -176,7 +176,7 @@ class ProgressBar {
 struct SolveArgs {
   std::string scene;
   std::string method = "gauss-seidel";
-  std::string form_factors = "ray-cast";
+  std::string form_factors = "auto";
   unsigned hemisphere_rays = rad::FormFactorOptions{}.hemisphere_rays;
   unsigned specular_depth = 0;
   float max_patch_area = 0.0f;
@@ -195,12 +195,13 @@ inline rad::FormFactorMethod form_factor_method(const std::string& name) {
   return name == "analytic"      ? rad::FormFactorMethod::analytic
          : name == "hemicube"    ? rad::FormFactorMethod::hemicube
          : name == "monte-carlo" ? rad::FormFactorMethod::monte_carlo
+         : name == "auto"        ? rad::FormFactorMethod::automatic
                                  : rad::FormFactorMethod::ray_cast;
 }
 
 /// The names form_factor_method() accepts.
 inline const std::vector<std::string>& form_factor_names() {
-  static const std::vector<std::string> names = {"ray-cast", "hemicube", "analytic", "monte-carlo"};
+  static const std::vector<std::string> names = {"auto", "ray-cast", "hemicube", "analytic", "monte-carlo"};
   return names;
 }
 
@@ -337,6 +338,24 @@ inline void print_summary(const rad::Solution& sol) {
     std::printf("adaptive: %zu elements split in %d passes\n", r.refined_elements, r.refinement_passes);
   std::printf("time: meshing %.3f s, form factors %.3f s, solving %.3f s\n", r.seconds_meshing,
               r.seconds_form_factors, r.seconds_solving);
+}
+
+/// Says which estimator ran, and why when the choice was automatic.
+inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
+  const rad::SolveReport& r = sol.report();
+  if (options.form_factors.method != rad::FormFactorMethod::automatic) {
+    std::printf("form factors: %s\n", rad::to_string(r.form_factor_method));
+    return;
+  }
+  std::string why;
+  if (options.form_factors.specular_depth > 0)
+    why = "mirror and window form factors need it";
+  else
+    why = std::to_string(r.patch_count) + " patches: " +
+          (r.form_factor_method == rad::FormFactorMethod::ray_cast ? "a small mesh, exact unoccluded factors"
+                                                                   : "faster and as accurate on a mesh this size");
+  std::printf("form factors: %s (automatic: %s; --form-factors overrides)\n", rad::to_string(r.form_factor_method),
+              why.c_str());
 }
 
 inline glm::vec3 parse_vec3(const std::string& s, const char* name) {

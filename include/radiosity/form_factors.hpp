@@ -38,12 +38,21 @@ enum class FormFactorMethod {
   /// method for meshes of thousands of patches and more. Unbiased; a row's sum is exact in a
   /// closed enclosure, an entry's relative noise is about sqrt((1 - F) / (F hemisphere_rays)).
   monte_carlo,
+  /// The default: choose_form_factor_method() picks ray_cast for small meshes (at most
+  /// kAutomaticRayCastPairs element-patch pairs, where it takes milliseconds and its unoccluded
+  /// factors are exact) and monte_carlo above, where at the defaults it is both faster and more
+  /// accurate (docs/FORM_FACTORS.md, "Choosing an estimator"); monte_carlo whenever
+  /// specular_depth > 0. view_factors() takes it as ray_cast (small factors matter there).
+  automatic,
 };
+
+/// Element x patch pairs up to which FormFactorMethod::automatic chooses ray_cast.
+inline constexpr double kAutomaticRayCastPairs = 1e4;
 
 /// Options of the estimators; every field has a default. A count or resolution of 0 (or any
 /// value outside its range) is an Error naming the field.
 struct FormFactorOptions {
-  FormFactorMethod method = FormFactorMethod::ray_cast;
+  FormFactorMethod method = FormFactorMethod::automatic;
   /// Points per source element, in [1, 64]. Ray cast: the smallest number of
   /// stratified points from which occlusion rays leave (pairs with large factors or a penumbra
   /// get more, see visibility_rays). Hemicube: the hemicubes per element, at the nodes of a
@@ -166,10 +175,20 @@ class RADIOSITY_API FormFactorEstimator {
   std::vector<std::uint32_t> translucent_;
 };
 
-/// Makes the estimator named by options.method. The scene and hierarchy must outlive it.
-/// Throws Error{invalid_argument} naming the field for a sample count, ray count or resolution
-/// outside its range (0 selects the default) or an unknown method, and Error{invalid_scene}
-/// naming two polygons when the scene has coincident or interpenetrating ones (find_overlaps()).
+/// The estimator options.method names, with FormFactorMethod::automatic resolved for this mesh:
+/// monte_carlo when options.specular_depth > 0 or the mesh has more than
+/// kAutomaticRayCastPairs element x patch pairs, else ray_cast. Thread safety: pure function.
+RADIOSITY_API FormFactorMethod choose_form_factor_method(const PatchHierarchy& hierarchy,
+                                                         const FormFactorOptions& options);
+
+/// The method's name as the command line spells it: "ray-cast", "hemicube", "analytic",
+/// "monte-carlo", "auto".
+RADIOSITY_API const char* to_string(FormFactorMethod method);
+
+/// Makes the estimator named by options.method (automatic: choose_form_factor_method()). The
+/// scene and hierarchy must outlive it. Throws Error{invalid_argument} naming the field for a
+/// sample count, ray count or resolution outside its range (0 selects the default) or an
+/// unknown method. Coincident and interpenetrating polygons are accepted (see find_overlaps()).
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(
     const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options);
@@ -217,9 +236,9 @@ struct GroupViewFactors {
 /// more than a few thousand element rows (memory O(rows x patches + groups^2), never
 /// elements x elements). The same scene, options and seed give bit-identical results at any
 /// thread count.
-/// Throws Error{invalid_scene} for a scene without polygons or with coincident or
-/// interpenetrating ones (find_overlaps(), naming the first pair), Error{invalid_argument} for bad
-/// options (naming the field) or a group name that the scene does not have.
+/// FormFactorMethod::automatic means ray_cast here. Throws Error{invalid_scene} for a scene
+/// without polygons, Error{invalid_argument} for bad options (naming the field) or a group name
+/// that the scene does not have.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& options = {});
 

@@ -67,6 +67,9 @@ struct SolveReport {
   std::size_t refined_elements = 0;      ///< leaves split by adaptive subdivision
   int refinement_passes = 0;
   std::size_t form_factor_bytes = 0;     ///< memory held by form factors at the peak
+  /// The estimator that ran: SolveOptions' form_factors.method with automatic resolved
+  /// (choose_form_factor_method()).
+  FormFactorMethod form_factor_method = FormFactorMethod::automatic;
   /// FormFactorOptions::specular_depth of the factors: how many mirror reflections and window
   /// passages the solution carries between diffuse surfaces (0: classic radiosity). The
   /// two-pass compositor reads it so that its photon map leaves those paths out.

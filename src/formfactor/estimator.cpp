@@ -23,7 +23,7 @@ FormFactorOptions resolve(const FormFactorOptions& options) {
   if (o.specular_depth > 16)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth must be in [0, 16], got " + std::to_string(o.specular_depth));
-  if (o.specular_depth > 0 && o.method != FormFactorMethod::monte_carlo)
+  if (o.specular_depth > 0 && o.method != FormFactorMethod::monte_carlo && o.method != FormFactorMethod::automatic)
     throw Error(ErrorCode::invalid_argument,
                 "form_factors.specular_depth > 0 (mirror and window form factors) needs FormFactorMethod::monte_carlo");
   return o;
@@ -122,14 +122,34 @@ bool FormFactorEstimator::sparse() const { return false; }
 
 std::size_t FormFactorEstimator::max_row_entries() const { return target_count(); }
 
+FormFactorMethod choose_form_factor_method(const PatchHierarchy& hierarchy, const FormFactorOptions& options) {
+  if (options.method != FormFactorMethod::automatic) return options.method;
+  if (options.specular_depth > 0) return FormFactorMethod::monte_carlo;
+  const double pairs = static_cast<double>(hierarchy.leaves().size()) * static_cast<double>(hierarchy.patches().size());
+  return pairs <= kAutomaticRayCastPairs ? FormFactorMethod::ray_cast : FormFactorMethod::monte_carlo;
+}
+
+const char* to_string(FormFactorMethod method) {
+  switch (method) {
+    case FormFactorMethod::ray_cast: return "ray-cast";
+    case FormFactorMethod::hemicube: return "hemicube";
+    case FormFactorMethod::analytic: return "analytic";
+    case FormFactorMethod::monte_carlo: return "monte-carlo";
+    case FormFactorMethod::automatic: return "auto";
+  }
+  return "unknown";
+}
+
 std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                                 const FormFactorOptions& options) {
-  const FormFactorOptions o = detail::resolve(options);
+  FormFactorOptions o = detail::resolve(options);
+  o.method = choose_form_factor_method(hierarchy, o);
   switch (o.method) {
     case FormFactorMethod::ray_cast: return detail::make_ray_cast_estimator(scene, hierarchy, o);
     case FormFactorMethod::analytic: return detail::make_analytic_estimator(scene, hierarchy, o);
     case FormFactorMethod::hemicube: return detail::make_hemicube_estimator(scene, hierarchy, o);
     case FormFactorMethod::monte_carlo: return detail::make_monte_carlo_estimator(scene, hierarchy, o);
+    case FormFactorMethod::automatic: break;  // resolved above
   }
   throw Error(ErrorCode::invalid_argument,
               "form_factors.method is not one of ray_cast, hemicube, analytic, monte_carlo (got " +

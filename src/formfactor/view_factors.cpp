@@ -28,7 +28,9 @@ std::size_t chunk_rows(std::size_t elements, std::size_t patches) {
 }  // namespace
 
 GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& options) {
-  const FormFactorOptions ff = detail::resolve(options.form_factors);
+  FormFactorOptions ff = detail::resolve(options.form_factors);
+  // Thermal users read small factors: the automatic choice is the accurate one here.
+  if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factors: the scene has no polygons");
 
   // Rows and columns: the requested groups, or all of them.

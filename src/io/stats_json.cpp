@@ -56,6 +56,7 @@ const char* form_factor_name(FormFactorMethod m) {
     case FormFactorMethod::hemicube: return "hemicube";
     case FormFactorMethod::analytic: return "analytic";
     case FormFactorMethod::monte_carlo: return "monte_carlo";
+    case FormFactorMethod::automatic: return "automatic";
   }
   return "unknown";
 }
@@ -72,6 +73,7 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
     j["max_iterations"] = options->max_iterations;
     j["seed"] = options->seed;
   }
+  j["form_factor_method_used"] = form_factor_name(r.form_factor_method);
   j["status"] = status_name(solution.status());
   j["iterations"] = r.iterations;
   j["residual"] = number(r.residual);

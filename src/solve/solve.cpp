@@ -77,6 +77,8 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   report.patch_count = hierarchy.patches().size();
   report.element_count = hierarchy.leaves().size();
   report.specular_depth = o.form_factors.specular_depth;
+  o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
+  report.form_factor_method = o.form_factors.method;
   if (o.max_iterations == 0)
     o.max_iterations = o.method == SolverMethod::progressive ? static_cast<int>(100 * report.patch_count) : 1000;
 

@@ -326,6 +326,9 @@ TEST_SUITE("solve") {
     const rad::Scene s = mirror_room(0.9f);
     rad::SolveOptions o;
     o.form_factors.specular_depth = 1;
+    // The automatic estimator takes monte_carlo for it; another explicit one is an error.
+    CHECK(rad::solve(s, o).report().form_factor_method == rad::FormFactorMethod::monte_carlo);
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
     CHECK_THROWS_WITH_AS(rad::solve(s, o), doctest::Contains("needs FormFactorMethod::monte_carlo"), rad::Error);
     o.form_factors.method = rad::FormFactorMethod::monte_carlo;
     o.form_factors.specular_depth = 17;

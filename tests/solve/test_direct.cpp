@@ -45,6 +45,9 @@ TEST_SUITE("solve") {
     o.mesh.max_element_area = 10000.0f;
     o.tolerance = 1e-7;
     o.seed = 7;
+    // One discrete system for every solver: ray_cast's rows and columns are the same factors
+    // (Monte Carlo columns are shot, a different random system).
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
 
     // The discrete system with the same form factors the solvers will compute (same seed):
     // B_e = E_e + rho_e sum_j F_ej sum_{e' in j} (A_e' / A_j) B_e'.
