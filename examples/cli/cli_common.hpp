@@ -188,6 +188,7 @@ struct SolveArgs {
   bool adaptive = false;
   float adaptive_threshold = 0.3f;
   int adaptive_passes = 3;
+  bool strict = false;
 };
 
 /// The estimator a `--form-factors` / `--method` name (as the CLI spells it) selects.
@@ -244,6 +245,13 @@ struct ModeRequest {
   }
 };
 
+/// Adds `--strict` (every command that loads a scene has it).
+inline void add_strict_flag(CLI::App& cmd, bool& strict) {
+  cmd.add_flag("--strict", strict,
+               "Refuse a scene file with problems the readers would otherwise fix with a warning (degenerate or "
+               "short faces, reflectance >= 1, a missing material): exit 1 naming file and line");
+}
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
@@ -285,6 +293,7 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->check(any_number<std::uint64_t>())
       ->capture_default_str();
+  add_strict_flag(cmd, a.strict);
 }
 
 inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
@@ -313,14 +322,19 @@ constexpr const char* kSceneHelp =
     "OBJ or JSON scene file, or a built-in scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
     "block, glass short block), cornell-mirror, cornell-glass";
 
-/// A built-in scene by name, else the OBJ or JSON file at `path`.
-inline rad::Scene load(const std::string& path) {
+/// A built-in scene by name, else the OBJ or JSON file at `path`, read strictly when `strict`
+/// (LoadOptions::strict: what the readers would fix with a warning is an error; built-in scenes
+/// have nothing to fix).
+inline rad::Scene load(const std::string& path, bool strict = false) {
   if (path.empty() || path == "cornell" || path == "cornell-box") return rad::cornell_box();
   if (path == "cornell-specular") return rad::cornell_box_specular();
   if (path == "cornell-mirror") return rad::cornell_box_specular(rad::CornellSpecular::mirror);
   if (path == "cornell-glass") return rad::cornell_box_specular(rad::CornellSpecular::glass);
-  return rad::load_scene(path);
+  rad::LoadOptions options;
+  options.strict = strict;
+  return rad::load_scene(path, options);
 }
+
 
 inline void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
