@@ -340,6 +340,13 @@ inline void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
 }
 
+/// The solve's own warnings (report.warnings repeats the scene's, printed before the solve).
+inline void print_solve_warnings(const rad::Scene& scene, const rad::Solution& sol) {
+  const std::vector<std::string>& known = scene.warnings();
+  for (const std::string& w : sol.report().warnings)
+    if (std::find(known.begin(), known.end(), w) == known.end()) std::cerr << "warning: " << w << "\n";
+}
+
 inline void print_summary(const rad::Solution& sol) {
   const rad::SolveReport& r = sol.report();
   const char* status = sol.status() == rad::SolveStatus::converged       ? "converged"
@@ -351,6 +358,11 @@ inline void print_summary(const rad::Solution& sol) {
     std::printf("adaptive: %zu elements split in %d passes\n", r.refined_elements, r.refinement_passes);
   std::printf("time: meshing %.3f s, form factors %.3f s, solving %.3f s\n", r.seconds_meshing,
               r.seconds_form_factors, r.seconds_solving);
+  // Power over the three channels; what escaped as a share of what was emitted.
+  const double emitted = double(r.emitted_power.x) + double(r.emitted_power.y) + double(r.emitted_power.z);
+  const double escaped = double(r.escaped_power.x) + double(r.escaped_power.y) + double(r.escaped_power.z);
+  if (emitted > 0.0)
+    std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
 }
 
 inline glm::vec3 parse_vec3(const std::string& s, const char* name) {

@@ -165,6 +165,7 @@ int main(int argc, char** argv) {
         rad::Solution sol = rad::solve(scene, solve_options);
         bar.finish();
         print_summary(sol);
+        print_solve_warnings(scene, sol);
         rad::TwoPassOptions to;
         image_options(to, 16);
         to.ambient = ambient;
@@ -181,6 +182,7 @@ int main(int argc, char** argv) {
         rad::Solution sol = rad::solve(scene, solve_options);
         bar.finish();
         print_summary(sol);
+        print_solve_warnings(scene, sol);
         rad::RenderOptions ro;
         image_options(ro, 4);
         ro.wireframe = wireframe;
@@ -207,6 +209,7 @@ int main(int argc, char** argv) {
       rad::Solution sol = rad::solve(scene, options);
       bar.finish();
       print_summary(sol);
+      print_solve_warnings(scene, sol);
       for (const std::string& g : sol.groups()) {
         rad::Rgb b = sol.group_radiosity(g);
         std::printf("  %-16s B = (%.5g, %.5g, %.5g)  area %.6g\n", g.c_str(), b.x, b.y, b.z, sol.group_area(g));

@@ -73,6 +73,7 @@ struct SolveReport {
   std::uint32_t specular_depth = 0;
   Rgb emitted_power{0.0f};               ///< sum A E, W per channel
   Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance
+  Rgb escaped_power{0.0f};  ///< power that left the scene: emitted minus absorbed, W per channel (>= 0 up to solver tolerance)
   double seconds_meshing = 0.0;
   double seconds_form_factors = 0.0;
   double seconds_solving = 0.0;
@@ -149,6 +150,11 @@ RADIOSITY_API void validate(const SolveOptions& options);
 /// polygons for coincident or interpenetrating surfaces (find_overlaps(); checked when the form
 /// factors are set up, so a scene that emits nothing returns B = 0 without the check). A cancelled solve returns the last
 /// consistent estimate with status cancelled.
+/// Light that leaves the scene is diagnosed in SolveReport::warnings: emitters that face away
+/// from every surface (find_emitters_facing_away()), and, for a converged solve, a scene that
+/// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses
+/// more than half its emitted power (SolveReport::escaped_power): light that arrives at the
+/// back of a one-sided polygon is lost, so its polygons probably face outwards.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});
 

@@ -7,6 +7,7 @@
 
 #include "formfactor/estimators.hpp"
 #include "radiosity/solver.hpp"
+#include "scene/emitter_check.hpp"
 #include "scene/specular_transport.hpp"
 #include "solve/system.hpp"
 
@@ -237,6 +238,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   }
   report.emitted_power = Rgb(emitted);
   report.absorbed_power = Rgb(absorbed);
+  report.escaped_power = Rgb(emitted - absorbed);
   // Inner nodes (split elements) hold the mean of their children from here on.
   hierarchy.aggregate(B_elements);
   if (translucency) hierarchy.aggregate(B_back);
@@ -249,6 +251,9 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
       ambient_elements[system->leaves[i]] = (system->reflectance[i] + system->transmittance[i]) * r.ambient;
     hierarchy.aggregate(ambient_elements);
   }
+  for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
+                                                       status == SolveStatus::converged, o.threads))
+    report.warnings.push_back(std::move(w));
   return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements), std::move(B_back));
 }
