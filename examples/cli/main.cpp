@@ -1,4 +1,4 @@
-// The `radiosity` command-line tool: render, solve and factors.
+// The `radiosity` command-line tool: render, solve, factors and check.
 // Output formats are a contract that scripts parse: see docs/CLI.md.
 #include <cstdio>
 #include <filesystem>
@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "check.hpp"
 #include "factors.hpp"
 
 using namespace cli;
@@ -78,9 +79,11 @@ int main(int argc, char** argv) {
   add_solve_options(*solve, solve_args);
 
   Command factors = add_factors_command(app);
+  Command check = add_check_command(app);
 
   if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
   if (*factors.app) return factors.run();
+  if (*check.app) return check.run();
 
   // What the user asked of the render pipeline; contradictions are argument errors.
   ModeRequest requested;
