@@ -34,8 +34,9 @@ struct Estimate {
   float max_patch_area = 0.0f, max_element_area = 0.0f;
   /// elements x patches x 4 bytes: the matrix of the matrix solvers with a dense estimator.
   std::size_t dense_matrix_bytes = 0;
-  /// The Monte Carlo estimator's rows (FormFactorEstimator::max_row_entries(): hemisphere_rays
-  /// plus the emitting patches, at most the targets), an index and a float per entry.
+  /// The Monte Carlo estimator's rows at most (FormFactorEstimator::max_row_entries():
+  /// hemisphere_rays plus the emitting patches, at most the targets; an index and a float per
+  /// entry): the bound the solvers check against the memory budget; rows hold only non-zeros.
   std::size_t sparse_rows_bytes = 0;
   /// What the default solve (Gauss-Seidel, ray-cast) holds: the dense matrix, or with
   /// translucent surfaces sparse rows of every target for the fronts and the backs.
@@ -72,14 +73,16 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
     translucent_patches += tau.x > 0.0f || tau.y > 0.0f || tau.z > 0.0f ? 1 : 0;
   }
   for (std::uint32_t leaf : hierarchy.leaves()) {
-    const rad::Rgb tau = scene.material(hierarchy.patches()[hierarchy.element(leaf).patch].material).diffuse_transmittance;
+    const rad::Patch& patch = hierarchy.patches()[hierarchy.element(leaf).patch];
+    const rad::Rgb tau = scene.material(patch.material).diffuse_transmittance;
     translucent_elements += tau.x > 0.0f || tau.y > 0.0f || tau.z > 0.0f ? 1 : 0;
   }
   // Translucent patches are targets twice (front and back) and their elements have two rows.
   const std::size_t targets = e.patches + translucent_patches, rows = e.elements + translucent_elements;
   const std::size_t entry = 2 * sizeof(float);
   e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
-  e.sparse_rows_bytes = rows * std::min(targets, std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches) * entry;
+  const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
+  e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
   e.default_dense = translucent_patches == 0;
   e.default_bytes = e.default_dense ? e.dense_matrix_bytes : rows * targets * entry;
   return e;
@@ -162,10 +165,10 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
     const Estimate& e = *r.estimate;
     std::printf("estimate: %zu patches, %zu elements (max patch area %.6g, max element area %.6g)\n", e.patches,
                 e.elements, e.max_patch_area, e.max_element_area);
-    std::printf("form factors: dense matrix %zu bytes (%s), sparse rows %zu bytes (%s)\n", e.dense_matrix_bytes,
+    std::printf("form factors: dense matrix %zu bytes (%s), sparse rows up to %zu bytes (%s)\n", e.dense_matrix_bytes,
                 mib(e.dense_matrix_bytes).c_str(), e.sparse_rows_bytes, mib(e.sparse_rows_bytes).c_str());
     std::printf("default solve: gauss-seidel, ray-cast form factors, %s: %zu bytes (%s)\n",
-                e.default_dense ? "dense matrix" : "sparse rows (translucent surfaces)", e.default_bytes,
+                e.default_dense ? "dense matrix" : "sparse rows (translucent surfaces) up to", e.default_bytes,
                 mib(e.default_bytes).c_str());
   }
   if (r.error.empty())

@@ -73,7 +73,9 @@ struct SolveReport {
   std::uint32_t specular_depth = 0;
   Rgb emitted_power{0.0f};               ///< sum A E, W per channel
   Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance
-  Rgb escaped_power{0.0f};  ///< power that left the scene: emitted minus absorbed, W per channel (>= 0 up to solver tolerance)
+  /// Power that left the scene: emitted minus absorbed, W per channel (>= 0 up to solver
+  /// tolerance): through openings, into the sky, or onto the backs of one-sided polygons.
+  Rgb escaped_power{0.0f};
   double seconds_meshing = 0.0;
   double seconds_form_factors = 0.0;
   double seconds_solving = 0.0;
