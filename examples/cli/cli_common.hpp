@@ -188,6 +188,8 @@ struct SolveArgs {
   bool adaptive = false;
   float adaptive_threshold = 0.3f;
   int adaptive_passes = 3;
+  bool strict = false;
+  bool two_sided = false;
 };
 
 /// The estimator a `--form-factors` / `--method` name (as the CLI spells it) selects.
@@ -245,6 +247,13 @@ struct ModeRequest {
   }
 };
 
+/// Adds `--strict` (every command that loads a scene has it).
+inline void add_strict_flag(CLI::App& cmd, bool& strict) {
+  cmd.add_flag("--strict", strict,
+               "Refuse a scene file with problems the readers would otherwise fix with a warning (degenerate or "
+               "short faces, reflectance >= 1, a missing material): exit 1 naming file and line");
+}
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
@@ -286,6 +295,10 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->check(any_number<std::uint64_t>())
       ->capture_default_str();
+  add_strict_flag(cmd, a.strict);
+  cmd.add_flag("--two-sided", a.two_sided,
+               "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
+               "models whose polygons face inconsistently or outwards");
 }
 
 inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
@@ -314,17 +327,37 @@ constexpr const char* kSceneHelp =
     "OBJ or JSON scene file, or a built-in scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
     "block, glass short block), cornell-mirror, cornell-glass";
 
-/// A built-in scene by name, else the OBJ or JSON file at `path`.
-inline rad::Scene load(const std::string& path) {
+/// A built-in scene by name, else the OBJ or JSON file at `path`, read strictly when `strict`
+/// (LoadOptions::strict: what the readers would fix with a warning is an error; built-in scenes
+/// have nothing to fix).
+inline rad::Scene load(const std::string& path, bool strict = false) {
   if (path.empty() || path == "cornell" || path == "cornell-box") return rad::cornell_box();
   if (path == "cornell-specular") return rad::cornell_box_specular();
   if (path == "cornell-mirror") return rad::cornell_box_specular(rad::CornellSpecular::mirror);
   if (path == "cornell-glass") return rad::cornell_box_specular(rad::CornellSpecular::glass);
-  return rad::load_scene(path);
+  rad::LoadOptions options;
+  options.strict = strict;
+  return rad::load_scene(path, options);
 }
+
+/// load(), then every material two-sided when `two_sided` (`--two-sided`: models with
+/// unreliable winding; Scene::make_two_sided()).
+inline rad::Scene load(const std::string& path, bool strict, bool two_sided) {
+  rad::Scene scene = load(path, strict);
+  if (two_sided) scene.make_two_sided();
+  return scene;
+}
+
 
 inline void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
+/// The solve's own warnings (report.warnings repeats the scene's, printed before the solve).
+inline void print_solve_warnings(const rad::Scene& scene, const rad::Solution& sol) {
+  const std::vector<std::string>& known = scene.warnings();
+  for (const std::string& w : sol.report().warnings)
+    if (std::find(known.begin(), known.end(), w) == known.end()) std::cerr << "warning: " << w << "\n";
 }
 
 inline void print_summary(const rad::Solution& sol) {
@@ -338,6 +371,11 @@ inline void print_summary(const rad::Solution& sol) {
     std::printf("adaptive: %zu elements split in %d passes\n", r.refined_elements, r.refinement_passes);
   std::printf("time: meshing %.3f s, form factors %.3f s, solving %.3f s\n", r.seconds_meshing,
               r.seconds_form_factors, r.seconds_solving);
+  // Power over the three channels; what escaped as a share of what was emitted.
+  const double emitted = double(r.emitted_power.x) + double(r.emitted_power.y) + double(r.emitted_power.z);
+  const double escaped = double(r.escaped_power.x) + double(r.escaped_power.y) + double(r.escaped_power.z);
+  if (emitted > 0.0)
+    std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
 }
 
 /// Says which estimator ran, and why when the choice was automatic.

@@ -26,6 +26,7 @@ struct FactorsArgs {
   std::uint64_t seed = 1;
   unsigned threads = 0;
   float max_patch_area = 0.0f, max_element_area = 0.0f;
+  bool strict = false;
 };
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -39,7 +40,7 @@ std::vector<std::string> split_list(const std::string& s) {
 
 int run_factors(const FactorsArgs& a) {
   return run_guarded([&] {
-    rad::Scene scene = load(a.scene);
+    rad::Scene scene = load(a.scene, a.strict);
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
     o.form_factors.method = form_factor_method(a.method);
@@ -110,6 +111,7 @@ Command add_factors_command(CLI::App& app) {
       ->check(non_negative<float>());
   cmd->add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
       ->check(non_negative<float>());
+  add_strict_flag(*cmd, a.strict);
   return Command{cmd, [args] { return run_factors(*args); }};
 }
 

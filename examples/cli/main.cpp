@@ -1,4 +1,4 @@
-// The `radiosity` command-line tool: render, solve and factors.
+// The `radiosity` command-line tool: render, solve, factors and check.
 // Output formats are a contract that scripts parse: see docs/CLI.md.
 #include <cstdio>
 #include <filesystem>
@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "check.hpp"
 #include "factors.hpp"
 
 using namespace cli;
@@ -78,9 +79,11 @@ int main(int argc, char** argv) {
   add_solve_options(*solve, solve_args);
 
   Command factors = add_factors_command(app);
+  Command check = add_check_command(app);
 
   if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
   if (*factors.app) return factors.run();
+  if (*check.app) return check.run();
 
   // What the user asked of the render pipeline; contradictions are argument errors.
   ModeRequest requested;
@@ -101,7 +104,7 @@ int main(int argc, char** argv) {
   return run_guarded([&] {
     ProgressBar bar;
     if (*render) {
-      rad::Scene scene = load(render_args.scene);
+      rad::Scene scene = load(render_args.scene, render_args.strict, render_args.two_sided);
       print_warnings(scene.warnings());
       std::optional<rad::Camera> camera;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
@@ -166,6 +169,7 @@ int main(int argc, char** argv) {
         bar.finish();
         print_summary(sol);
         print_estimator(sol, solve_options);
+        print_solve_warnings(scene, sol);
         rad::TwoPassOptions to;
         image_options(to, 16);
         to.ambient = ambient;
@@ -183,6 +187,7 @@ int main(int argc, char** argv) {
         bar.finish();
         print_summary(sol);
         print_estimator(sol, solve_options);
+        print_solve_warnings(scene, sol);
         rad::RenderOptions ro;
         image_options(ro, 4);
         ro.wireframe = wireframe;
@@ -203,16 +208,22 @@ int main(int argc, char** argv) {
         std::printf("wrote %s (sRGB preview, exposure %g)\n", std::filesystem::absolute(png).c_str(), exposure);
       }
     } else if (*solve) {
-      rad::Scene scene = load(solve_args.scene);
+      rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.two_sided);
       print_warnings(scene.warnings());
       const rad::SolveOptions options = to_options(solve_args, bar);
       rad::Solution sol = rad::solve(scene, options);
       bar.finish();
       print_summary(sol);
       print_estimator(sol, options);
+      print_solve_warnings(scene, sol);
       for (const std::string& g : sol.groups()) {
         rad::Rgb b = sol.group_radiosity(g);
-        std::printf("  %-16s B = (%.5g, %.5g, %.5g)  area %.6g\n", g.c_str(), b.x, b.y, b.z, sol.group_area(g));
+        std::printf("  %-16s B = (%.5g, %.5g, %.5g)  area %.6g", g.c_str(), b.x, b.y, b.z, sol.group_area(g));
+        // Two-sided and translucent groups: their back side too.
+        const rad::Rgb back = sol.group_back_radiosity(g);
+        if (!sol.back_radiosity().empty() && (back.x > 0.0f || back.y > 0.0f || back.z > 0.0f))
+          std::printf("  back B = (%.5g, %.5g, %.5g)", back.x, back.y, back.z);
+        std::printf("\n");
       }
       if (!stats.empty()) {
         rad::write_stats_json(sol, stats, options, solve_args.scene.empty() ? "cornell-box" : solve_args.scene);

@@ -156,6 +156,18 @@ struct PolygonOverlap {
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API std::vector<PolygonOverlap> find_overlaps(const Scene& scene);
 
+/// Emitting polygons (material emission > 0 in some channel) whose front sees no polygon at
+/// all, in polygon order: all of their light leaves the scene, usually because the polygon is
+/// wound the wrong way (it faces the sky instead of the room). Each emitter casts a few hundred
+/// cosine-distributed rays (256; at least 64 when the scene has thousands of emitters) from
+/// stratified points just in front of it and is reported when none hits anything, front or
+/// back of any polygon; an emitter that sees only a speck smaller than about 1/256 of its
+/// cosine-weighted view may be reported too. Deterministic: a fixed seed, the same answer at
+/// any thread count. solve() warns about such emitters (SolveReport::warnings). Cost: a BVH
+/// over the scene (Embree) and the rays. Throws Error{internal} if Embree cannot create a device.
+/// Thread safety: concurrent calls are safe.
+RADIOSITY_API std::vector<PolygonId> find_emitters_facing_away(const Scene& scene);
+
 /// Adds the parallelogram origin, origin + edge_u, origin + edge_u + edge_v, origin + edge_v,
 /// facing edge_u x edge_v (counter-clockwise seen from that side). Units are scene units.
 /// Throws Error{invalid_argument} for a non-finite value or parallel (or zero) edges, and what

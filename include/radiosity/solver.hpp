@@ -76,6 +76,9 @@ struct SolveReport {
   std::uint32_t specular_depth = 0;
   Rgb emitted_power{0.0f};               ///< sum A E, W per channel
   Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance
+  /// Power that left the scene: emitted minus absorbed, W per channel (>= 0 up to solver
+  /// tolerance): through openings, into the sky, or onto the backs of one-sided polygons.
+  Rgb escaped_power{0.0f};
   double seconds_meshing = 0.0;
   double seconds_form_factors = 0.0;
   double seconds_solving = 0.0;
@@ -129,6 +132,9 @@ class RADIOSITY_API Solution {
   /// Area-weighted mean radiosity over the patches of a group. Throws Error{invalid_argument}
   /// naming the group when the scene has no such group.
   Rgb group_radiosity(std::string_view group) const;
+  /// The same over the backs of the group's patches (back_radiosity(); 0 where a patch is
+  /// one-sided, and for every group when back_radiosity() is empty). Throws as group_radiosity().
+  Rgb group_back_radiosity(std::string_view group) const;
   double group_area(std::string_view group) const;
   const std::vector<std::string>& groups() const { return groups_; }
 
@@ -154,6 +160,11 @@ RADIOSITY_API void validate(const SolveOptions& options);
 /// polygons for coincident or interpenetrating surfaces (find_overlaps(); checked when the form
 /// factors are set up, so a scene that emits nothing returns B = 0 without the check). A cancelled solve returns the last
 /// consistent estimate with status cancelled.
+/// Light that leaves the scene is diagnosed in SolveReport::warnings: emitters that face away
+/// from every surface (find_emitters_facing_away()), and, for a converged solve, a scene that
+/// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses
+/// more than half its emitted power (SolveReport::escaped_power): light that arrives at the
+/// back of a one-sided polygon is lost, so its polygons probably face outwards.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});
 

@@ -84,6 +84,7 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
                    {"max_element_area", number(solution.hierarchy().options().max_element_area)}};
   j["emitted_power"] = rgb(r.emitted_power);
   j["absorbed_power"] = rgb(r.absorbed_power);
+  j["escaped_power"] = rgb(r.escaped_power);
 
   Json groups = Json::object();
   for (const std::string& name : solution.groups())

@@ -52,16 +52,29 @@ GroupId Solution::group_id(std::string_view group) const {
               "no group named '" + std::string(group) + "' in the scene (groups: " + known + ")");
 }
 
-Rgb Solution::group_radiosity(std::string_view group) const {
-  const GroupId g = group_id(group);
+namespace {
+
+/// Area-weighted mean of `values` (per element id) over the patches of group `g`.
+Rgb group_mean(const PatchHierarchy& hierarchy, const std::vector<Rgb>& values, GroupId g) {
   glm::dvec3 sum(0.0);
   double area = 0.0;
-  for (const Patch& p : hierarchy_.patches())
+  for (const Patch& p : hierarchy.patches())
     if (p.group == g) {
-      sum += static_cast<double>(p.area) * glm::dvec3(radiosity_[p.root]);
+      sum += static_cast<double>(p.area) * glm::dvec3(values[p.root]);
       area += p.area;
     }
   return area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
+}
+
+}  // namespace
+
+Rgb Solution::group_radiosity(std::string_view group) const {
+  return group_mean(hierarchy_, radiosity_, group_id(group));
+}
+
+Rgb Solution::group_back_radiosity(std::string_view group) const {
+  const GroupId g = group_id(group);
+  return back_radiosity_.empty() ? Rgb(0.0f) : group_mean(hierarchy_, back_radiosity_, g);
 }
 
 double Solution::group_area(std::string_view group) const {

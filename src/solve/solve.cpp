@@ -8,6 +8,7 @@
 #include "formfactor/estimators.hpp"
 #include "geometry/overlap.hpp"
 #include "radiosity/solver.hpp"
+#include "scene/emitter_check.hpp"
 #include "scene/specular_transport.hpp"
 #include "solve/system.hpp"
 
@@ -235,15 +236,27 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   report.element_count = hierarchy.leaves().size();
 
   // Power balance: a side absorbs what it neither reflects nor transmits, (1 - rho - tau) H.
+  // With extended form factors the light that a mirror, window or glass passes on is counted
+  // where it lands, so it is not absorbed at the specular surface, on either side (pass1_* are
+  // channel means).
   glm::dvec3 emitted(0.0), absorbed(0.0);
   for (std::size_t i = 0; i < system->unknowns(); ++i) {
     const double a = system->area[i];
     emitted += a * glm::dvec3(system->emission[i]);
-    absorbed += a * (glm::dvec3(1.0) - glm::dvec3(system->reflectance[i]) - glm::dvec3(system->transmittance[i])) *
+    double passed_on = 0.0;
+    if (o.form_factors.specular_depth > 0) {
+      const Material& m = scene.material(hierarchy.patches()[hierarchy.element(system->element(i)).patch].material);
+      passed_on = static_cast<double>(detail::pass1_mirror(m) + detail::pass1_window(m) + detail::pass1_glass(m));
+    }
+    absorbed += a *
+                glm::max(glm::dvec3(1.0 - passed_on) - glm::dvec3(system->reflectance[i]) -
+                             glm::dvec3(system->transmittance[i]),
+                         glm::dvec3(0.0)) *
                 glm::dvec3(H_of(i));
   }
   report.emitted_power = Rgb(emitted);
   report.absorbed_power = Rgb(absorbed);
+  report.escaped_power = Rgb(emitted - absorbed);
   // Inner nodes (split elements) hold the mean of their children from here on.
   hierarchy.aggregate(B_elements);
   if (translucency) hierarchy.aggregate(B_back);
@@ -256,6 +269,9 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
       ambient_elements[system->leaves[i]] = (system->reflectance[i] + system->transmittance[i]) * r.ambient;
     hierarchy.aggregate(ambient_elements);
   }
+  for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
+                                                       status == SolveStatus::converged, o.threads))
+    report.warnings.push_back(std::move(w));
   return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements), std::move(B_back));
 }

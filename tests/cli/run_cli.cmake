@@ -6,6 +6,7 @@
 #   -DSTDERR=<regex>          optional: stderr must match
 #   -DONE_ERROR_LINE=ON       optional: stderr has exactly one line "radiosity: error: ...",
 #                             shorter than 200 characters
+#   -DSTDOUT_JSON=ON          optional: stdout is one JSON object (parsed by string(JSON))
 cmake_minimum_required(VERSION 3.20)
 string(REPLACE "|" ";" args "${ARGS}")
 execute_process(COMMAND ${EXE} ${args} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -18,6 +19,12 @@ if(DEFINED STDOUT AND NOT out MATCHES "${STDOUT}")
 endif()
 if(DEFINED STDERR AND NOT err MATCHES "${STDERR}")
   message(FATAL_ERROR "stderr does not match '${STDERR}': ${what}")
+endif()
+if(STDOUT_JSON)
+  string(JSON type ERROR_VARIABLE json_error TYPE "${out}")
+  if(json_error OR NOT type STREQUAL "OBJECT")
+    message(FATAL_ERROR "stdout is not a JSON object (${json_error}): ${what}")
+  endif()
 endif()
 if(ONE_ERROR_LINE)
   string(REGEX MATCHALL "radiosity: error: [^\n]*" lines "${err}")

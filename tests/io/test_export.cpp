@@ -65,6 +65,7 @@ radiosity::Solution small_solution() {
   report.form_factor_bytes = 1234;
   report.emitted_power = Rgb(5.0f, 4.0f, 3.0f);
   report.absorbed_power = Rgb(4.5f, 3.5f, 2.5f);
+  report.escaped_power = Rgb(0.5f, 0.5f, 0.5f);
   report.seconds_meshing = 0.001;
   report.seconds_form_factors = 0.25;
   report.seconds_solving = 0.125;
@@ -259,6 +260,7 @@ TEST_CASE("write_stats_json records status - sizes - power - per-group radiosity
   CHECK(j.at("form_factor_bytes") == 1234);
   CHECK(j.at("emitted_power") == nlohmann::json::array({5.0, 4.0, 3.0}));
   CHECK(j.at("absorbed_power") == nlohmann::json::array({4.5, 3.5, 2.5}));
+  CHECK(j.at("escaped_power") == nlohmann::json::array({0.5, 0.5, 0.5}));
   CHECK(j.at("mesh").at("max_patch_area").get<double>() == doctest::Approx(0.25));
   for (const char* g : {"floor", "light"}) {
     const nlohmann::json& group = j.at("groups").at(g);

@@ -1,0 +1,279 @@
+// `radiosity check`: what a user needs to know before a long bake, without solving: counts,
+// warnings, overlapping polygons, emitters facing away, and the size of the default solve.
+#include "check.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+
+namespace cli {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+struct CheckArgs {
+  std::string scene;
+  std::string format = "text";
+  bool strict = false;
+  bool two_sided = false;
+  float max_patch_area = 0.0f, max_element_area = 0.0f;
+};
+
+/// The overlaps (text and JSON) and emitters facing away (text) listed one by one; the rest are counted.
+constexpr std::size_t kOverlapsShown = 5;
+constexpr std::size_t kEmittersShown = 10;
+/// solve()'s memory budget when SolveOptions::memory_budget_bytes is 0 (solver.hpp).
+constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
+
+/// What `radiosity solve` would build and hold for the scene with these mesh options.
+struct Estimate {
+  std::size_t patches = 0, elements = 0;
+  float max_patch_area = 0.0f, max_element_area = 0.0f;
+  /// elements x patches x 4 bytes: the matrix of the matrix solvers with a dense estimator.
+  std::size_t dense_matrix_bytes = 0;
+  /// The Monte Carlo estimator's rows at most (FormFactorEstimator::max_row_entries():
+  /// hemisphere_rays plus the emitting patches, at most the targets; an index and a float per
+  /// entry): the bound the solvers check against the memory budget; rows hold only non-zeros.
+  std::size_t sparse_rows_bytes = 0;
+  /// What the default solve (Gauss-Seidel, automatic estimator) holds: the dense matrix with
+  /// ray_cast and no back sides, else sparse rows (monte_carlo's bounded rows, or rows over
+  /// every target when translucent or two-sided surfaces add back sides).
+  rad::FormFactorMethod default_method = rad::FormFactorMethod::ray_cast;
+  bool default_dense = true;
+  std::size_t default_bytes = 0;
+};
+
+struct CheckResult {
+  std::string scene;
+  std::size_t polygons = 0, materials = 0, emitters = 0, groups = 0;
+  double area = 0.0;
+  std::vector<std::string> warnings;
+  std::vector<rad::PolygonOverlap> overlaps;
+  std::size_t coincident = 0, interpenetrating = 0;
+  /// Coincident pairs facing the same way: the only ones solve() warns about (the others are
+  /// contact, lit correctly).
+  std::size_t z_fighting = 0;
+  std::vector<rad::PolygonId> facing_away;
+  std::optional<Estimate> estimate;
+  std::string error;  ///< why `radiosity solve` would refuse the scene; empty when it would run
+};
+
+bool emits(const rad::Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
+
+Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions& mesh) {
+  const rad::PatchHierarchy hierarchy(scene, mesh);
+  Estimate e;
+  e.patches = hierarchy.patches().size();
+  e.elements = hierarchy.leaves().size();
+  e.max_patch_area = hierarchy.options().max_patch_area;
+  e.max_element_area = hierarchy.options().max_element_area;
+  std::size_t emitting_patches = 0, back_patches = 0, back_elements = 0;
+  // A patch has a back side when its material is translucent or two-sided (as solve() decides).
+  auto has_back = [](const rad::Material& m) {
+    const rad::Rgb tau = m.diffuse_transmittance;
+    return m.two_sided || tau.x > 0.0f || tau.y > 0.0f || tau.z > 0.0f;
+  };
+  for (const rad::Patch& p : hierarchy.patches()) {
+    const rad::Material& m = scene.material(p.material);
+    emitting_patches += emits(m) ? 1 : 0;
+    back_patches += has_back(m) ? 1 : 0;
+  }
+  for (std::uint32_t leaf : hierarchy.leaves())
+    back_elements += has_back(scene.material(hierarchy.patches()[hierarchy.element(leaf).patch].material)) ? 1 : 0;
+  // Patches with a back are targets twice (front and back) and their elements have two rows.
+  const std::size_t targets = e.patches + back_patches, rows = e.elements + back_elements;
+  const std::size_t entry = 2 * sizeof(float);
+  e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
+  const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
+  e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
+  e.default_method = rad::choose_form_factor_method(hierarchy, rad::FormFactorOptions{});
+  const bool monte_carlo = e.default_method == rad::FormFactorMethod::monte_carlo;
+  e.default_dense = !monte_carlo && back_patches == 0;
+  e.default_bytes = e.default_dense ? e.dense_matrix_bytes
+                    : monte_carlo   ? e.sparse_rows_bytes
+                                    : rows * targets * entry;
+  return e;
+}
+
+CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
+  CheckResult r;
+  r.scene = a.scene.empty() ? "cornell-box" : a.scene;
+  r.polygons = scene.polygons().size();
+  r.materials = scene.materials().size();
+  r.groups = scene.groups().size();
+  r.area = scene.total_area();
+  for (const rad::Polygon& p : scene.polygons()) r.emitters += emits(scene.material(p.material)) ? 1 : 0;
+  r.warnings = scene.warnings();
+  if (r.polygons == 0) {
+    r.error = "the scene has no polygons";
+    return r;
+  }
+  if (r.emitters == 0) r.warnings.push_back("the scene emits no light; every radiosity is 0");
+  r.overlaps = rad::find_overlaps(scene);
+  for (const rad::PolygonOverlap& o : r.overlaps) {
+    (o.kind == rad::OverlapKind::coincident ? r.coincident : r.interpenetrating) += 1;
+    if (o.kind == rad::OverlapKind::coincident &&
+        glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) > 0.0f)
+      ++r.z_fighting;
+  }
+  r.facing_away = rad::find_emitters_facing_away(scene);
+
+  rad::MeshOptions mesh;
+  mesh.max_patch_area = a.max_patch_area;
+  mesh.max_element_area = a.max_element_area;
+  try {
+    r.estimate = estimate_default_solve(scene, mesh);
+  } catch (const rad::Error& e) {
+    r.error = e.what();  // e.g. max_element_area > max_patch_area, or far too many elements
+    return r;
+  }
+  if (r.z_fighting > 0)
+    r.warnings.push_back(std::to_string(r.z_fighting) +
+                         " pair(s) of coincident polygons face the same way (z-fighting): which is in front is "
+                         "decided by rounding, remove one of each pair (listed under overlaps)");
+  if (r.estimate->default_bytes > kDefaultMemoryBudget)
+    r.error = "the default solve's form factors need " + std::to_string(r.estimate->default_bytes >> 20) +
+              " MiB, more than the memory budget of 4096 MiB: use --method progressive, --form-factors "
+              "monte-carlo or a coarser mesh";
+  return r;
+}
+
+const std::string& group_of(const rad::Scene& scene, rad::PolygonId p) {
+  return scene.groups()[scene.polygons()[p].group];
+}
+
+const char* kind_name(rad::OverlapKind k) {
+  return k == rad::OverlapKind::coincident ? "coincident" : "interpenetrating";
+}
+
+std::string mib(std::size_t bytes) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+  return s;
+}
+
+void print_text(const CheckResult& r, const rad::Scene& scene) {
+  std::printf("scene: %s\n", r.scene.c_str());
+  std::printf("polygons: %zu\nmaterials: %zu\nemitters: %zu\ngroups: %zu\narea: %.6g\n", r.polygons, r.materials,
+              r.emitters, r.groups, r.area);
+  std::printf("warnings: %zu\n", r.warnings.size());
+  for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
+  // Contact (a box on a floor, a prop sunk into it) is lit correctly; only z-fighting is a problem.
+  std::printf("overlaps: %zu (coincident %zu, interpenetrating %zu; z-fighting %zu, the rest contact)\n",
+              r.overlaps.size(), r.coincident, r.interpenetrating, r.z_fighting);
+  for (std::size_t k = 0; k < r.overlaps.size() && k < kOverlapsShown; ++k) {
+    const rad::PolygonOverlap& o = r.overlaps[k];
+    std::printf("  %s: polygon %u (group '%s') and polygon %u (group '%s') at (%.6g, %.6g, %.6g)\n",
+                kind_name(o.kind), o.first, group_of(scene, o.first).c_str(), o.second,
+                group_of(scene, o.second).c_str(), o.point.x, o.point.y, o.point.z);
+  }
+  if (r.overlaps.size() > kOverlapsShown) std::printf("  ... and %zu more\n", r.overlaps.size() - kOverlapsShown);
+  std::printf("emitters facing away: %zu\n", r.facing_away.size());
+  for (std::size_t k = 0; k < r.facing_away.size() && k < kEmittersShown; ++k)
+    std::printf("  polygon %u (group '%s'): its light leaves the scene; check its winding (vertex order)\n",
+                r.facing_away[k], group_of(scene, r.facing_away[k]).c_str());
+  if (r.facing_away.size() > kEmittersShown)
+    std::printf("  ... and %zu more\n", r.facing_away.size() - kEmittersShown);
+  if (r.estimate) {
+    const Estimate& e = *r.estimate;
+    std::printf("estimate: %zu patches, %zu elements (max patch area %.6g, max element area %.6g)\n", e.patches,
+                e.elements, e.max_patch_area, e.max_element_area);
+    std::printf("form factors: dense matrix %zu bytes (%s), sparse rows up to %zu bytes (%s)\n", e.dense_matrix_bytes,
+                mib(e.dense_matrix_bytes).c_str(), e.sparse_rows_bytes, mib(e.sparse_rows_bytes).c_str());
+    std::printf("default solve: gauss-seidel, %s form factors (automatic), %s: %zu bytes (%s)\n",
+                rad::to_string(e.default_method), e.default_dense ? "dense matrix" : "sparse rows up to",
+                e.default_bytes, mib(e.default_bytes).c_str());
+  }
+  if (r.error.empty())
+    std::printf("result: ok, the scene can be solved\n");
+  else
+    std::printf("result: cannot be solved: %s\n", r.error.c_str());
+}
+
+void print_json(const CheckResult& r, const rad::Scene& scene) {
+  Json j;
+  j["scene"] = r.scene;
+  j["polygons"] = r.polygons;
+  j["materials"] = r.materials;
+  j["emitters"] = r.emitters;
+  j["groups"] = r.groups;
+  j["area"] = r.area;
+  j["warnings"] = r.warnings;
+  Json first = Json::array();
+  for (std::size_t k = 0; k < r.overlaps.size() && k < kOverlapsShown; ++k) {
+    const rad::PolygonOverlap& o = r.overlaps[k];
+    first.push_back(Json{{"kind", kind_name(o.kind)},
+                         {"first", o.first},
+                         {"first_group", group_of(scene, o.first)},
+                         {"second", o.second},
+                         {"second_group", group_of(scene, o.second)},
+                         {"point", Json::array({o.point.x, o.point.y, o.point.z})}});
+  }
+  j["overlaps"] = Json{{"coincident", r.coincident},
+                       {"interpenetrating", r.interpenetrating},
+                       {"z_fighting", r.z_fighting},
+                       {"first", first}};
+  Json away = Json::array();
+  for (rad::PolygonId p : r.facing_away) away.push_back(Json{{"polygon", p}, {"group", group_of(scene, p)}});
+  j["emitters_facing_away"] = std::move(away);
+  if (r.estimate) {
+    const Estimate& e = *r.estimate;
+    j["estimate"] = Json{{"patches", e.patches},
+                         {"elements", e.elements},
+                         {"max_patch_area", e.max_patch_area},
+                         {"max_element_area", e.max_element_area},
+                         {"dense_matrix_bytes", e.dense_matrix_bytes},
+                         {"sparse_rows_bytes", e.sparse_rows_bytes},
+                         {"default_form_factors", rad::to_string(e.default_method)},
+                         {"default_storage", e.default_dense ? "dense" : "sparse"},
+                         {"default_bytes", e.default_bytes}};
+  } else {
+    j["estimate"] = nullptr;
+  }
+  j["solvable"] = r.error.empty();
+  j["error"] = r.error.empty() ? Json(nullptr) : Json(r.error);
+  // Group names come from scene files and may not be UTF-8: replace bad bytes rather than fail.
+  const std::string text = j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
+  std::fwrite(text.data(), 1, text.size(), stdout);
+}
+
+int run_check(const CheckArgs& a) {
+  return run_guarded([&] {
+    const rad::Scene scene = load(a.scene, a.strict, a.two_sided);
+    const CheckResult r = check_scene(a, scene);
+    if (a.format == "json")
+      print_json(r, scene);
+    else
+      print_text(r, scene);
+    std::fflush(stdout);
+    if (r.error.empty()) return 0;
+    std::fprintf(stderr, "radiosity: error: %s\n", r.error.c_str());
+    return 1;
+  });
+}
+
+}  // namespace
+
+Command add_check_command(CLI::App& app) {
+  auto args = std::make_shared<CheckArgs>();
+  CheckArgs& a = *args;
+  CLI::App* cmd = app.add_subcommand(
+      "check", "Load and validate a scene without solving: counts, warnings, overlaps, emitters facing away, and the "
+               "mesh and memory of the default solve; exit 0 when it can be solved");
+  cmd->add_option("scene", a.scene, kSceneHelp);
+  cmd->add_option("--format", a.format, "Output format")->check(CLI::IsMember({"text", "json"}))->capture_default_str();
+  add_strict_flag(*cmd, a.strict);
+  cmd->add_flag("--two-sided", a.two_sided, "Make every material two-sided, as render and solve --two-sided do");
+  cmd->add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
+      ->check(non_negative<float>());
+  cmd->add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
+      ->check(non_negative<float>());
+  return Command{cmd, [args] { return run_check(*args); }};
+}
+
+}  // namespace cli

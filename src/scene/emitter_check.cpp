@@ -1,0 +1,180 @@
+// Where the emitters' light goes: rays from the front of every emitting polygon, against every
+// polygon of the scene (either side), with Embree through RayScene.
+// Stratified sampling as in the Monte Carlo form factors (docs/FORM_FACTORS.md): points from a
+// jittered grid on the polygon, directions from a second, shuffled grid, cosine-distributed by
+// Malley's method (a uniform disk point projected up onto the hemisphere).
+#include "scene/emitter_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <utility>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+
+#include "detail/parallel.hpp"
+#include "detail/rng.hpp"
+#include "geometry/polygon_fan.hpp"
+#include "geometry/ray_scene.hpp"
+
+namespace radiosity::detail {
+
+namespace {
+
+/// Fixed: the check must give the same answer every time, whatever the solve's seed.
+constexpr std::uint64_t kSeed = 0x656d6974746572ull;  // "emitter"
+
+bool emits(const Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
+
+/// Cosine-distributed direction around +z for u in [0,1)^2 (the polar map keeps strata compact).
+glm::vec3 cosine_direction(glm::vec2 u) {
+  const float r = std::sqrt(u.x), phi = 2.0f * glm::pi<float>() * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x))};
+}
+
+/// Tangents completing a unit normal to a right-handed frame (Duff et al., JCGT 6(1), 2017).
+void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+/// "12", "12, 13" or "12, 13, 14, 15 and 9 more".
+std::string id_list(const std::vector<PolygonId>& ids) {
+  constexpr std::size_t kShown = 4;
+  std::string s;
+  for (std::size_t k = 0; k < ids.size() && k < kShown; ++k) s += (k ? ", " : "") + std::to_string(ids[k]);
+  if (ids.size() > kShown) s += " and " + std::to_string(ids.size() - kShown) + " more";
+  return s;
+}
+
+}  // namespace
+
+std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads) {
+  const std::vector<Polygon>& polygons = scene.polygons();
+  std::vector<EmitterReach> out;
+  for (PolygonId p = 0; p < polygons.size(); ++p) {
+    const Material& m = scene.material(polygons[p].material);
+    // A two-sided emitter also emits from its back (pass 1 and the path tracer): whichever way
+    // it is wound, one of its sides faces the scene.
+    if (!emits(m) || m.two_sided) continue;
+    EmitterReach r;
+    r.polygon = p;
+    r.power = static_cast<double>(polygons[p].area) *
+              (static_cast<double>(m.emission.x) + static_cast<double>(m.emission.y) +
+               static_cast<double>(m.emission.z));
+    out.push_back(r);
+  }
+  if (out.empty()) return out;
+
+  // A square number of rays per emitter, within the budget.
+  const std::size_t wanted = std::clamp(kEmitterRayBudget / out.size(), kMinEmitterRays, kEmitterRays);
+  const auto side = static_cast<std::size_t>(std::sqrt(static_cast<double>(wanted)));
+  const std::size_t rays = side * side;
+  // Ray origins are lifted off the emitter as the estimators lift theirs.
+  const float lift = 1e-5f * std::max(scene.bounds().diagonal(), std::numeric_limits<float>::min());
+  const RayScene rays_scene = RayScene::from_polygons(scene);
+
+  parallel_for(threads, out.size(), 1, [&](std::size_t begin, std::size_t end) {
+    std::vector<glm::vec3> origin(rays), dir(rays);
+    std::vector<std::uint8_t> hit(rays);
+    std::vector<std::uint32_t> order(rays);
+    for (std::size_t k = begin; k < end; ++k) {
+      const Polygon& polygon = polygons[out[k].polygon];
+      const PolygonFan fan(polygon.vertices);
+      glm::vec3 t, b;
+      tangents(polygon.normal, t, b);
+      Rng rng(kSeed, out[k].polygon);
+      std::iota(order.begin(), order.end(), 0u);
+      for (std::size_t i = rays - 1; i > 0; --i) std::swap(order[i], order[rng.next() % (i + 1)]);
+      const float cell = 1.0f / static_cast<float>(side);
+      auto stratum = [&](std::size_t s) {
+        const glm::vec2 u = rng.uniform2();
+        return glm::min((glm::vec2(static_cast<float>(s % side), static_cast<float>(s / side)) + u) * cell,
+                        glm::vec2(0x1.fffffep-1f));
+      };
+      for (std::size_t i = 0; i < rays; ++i) {
+        origin[i] = fan.sample(stratum(i)) + lift * polygon.normal;
+        const glm::vec3 d = cosine_direction(stratum(order[i]));
+        dir[i] = d.x * t + d.y * b + d.z * polygon.normal;
+      }
+      rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
+      const std::size_t hits = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), std::uint8_t{1}));
+      out[k].hit_fraction = static_cast<double>(hits) / static_cast<double>(rays);
+    }
+  });
+  return out;
+}
+
+std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& emitted, const Rgb& escaped,
+                                                bool balanced, unsigned threads) {
+  std::vector<std::string> warnings;
+  const std::vector<EmitterReach> reach = emitter_reach(scene, threads);
+  if (reach.empty()) return warnings;
+
+  // Emitters that see nothing, by group in order of first appearance.
+  std::vector<std::pair<GroupId, std::vector<PolygonId>>> away;
+  std::size_t away_polygons = 0;
+  for (const EmitterReach& r : reach) {
+    if (r.hit_fraction > 0.0) continue;
+    const GroupId g = scene.polygons()[r.polygon].group;
+    auto it = std::find_if(away.begin(), away.end(), [g](const auto& entry) { return entry.first == g; });
+    if (it == away.end()) it = away.insert(away.end(), {g, {}});
+    it->second.push_back(r.polygon);
+    ++away_polygons;
+  }
+  if (!away.empty()) {
+    constexpr std::size_t kGroupsShown = 4;
+    std::string who;
+    for (std::size_t k = 0; k < away.size() && k < kGroupsShown; ++k) {
+      if (k > 0) who += k + 1 == away.size() ? " and " : ", ";
+      who += "'" + scene.groups()[away[k].first] + "' (polygon" + (away[k].second.size() > 1 ? "s " : " ") +
+             id_list(away[k].second) + ")";
+    }
+    if (away.size() > kGroupsShown) who += " and " + std::to_string(away.size() - kGroupsShown) + " more groups";
+    const bool many = away_polygons > 1;
+    warnings.push_back(std::string(many ? "emitters " : "emitter ") + who +
+                       (many ? " face away from every surface: their light leaves the scene; check the polygons' "
+                             : " faces away from every surface: its light leaves the scene; check the polygon's ") +
+                       "winding (vertex order) or use two-sided materials (--two-sided)");
+  }
+
+  // A closed-looking scene that loses most of its light.
+  const double total = static_cast<double>(emitted.x) + static_cast<double>(emitted.y) + static_cast<double>(emitted.z);
+  const double lost = static_cast<double>(escaped.x) + static_cast<double>(escaped.y) + static_cast<double>(escaped.z);
+  if (balanced && total > 0.0 && lost > 0.5 * total) {
+    double power = 0.0, reached = 0.0;
+    for (const EmitterReach& r : reach) {
+      power += r.power;
+      reached += r.power * r.hit_fraction;
+    }
+    if (power > 0.0 && reached > 0.95 * power) {
+      char share[32];
+      std::snprintf(share, sizeof share, "%.0f", 100.0 * lost / total);
+      warnings.push_back(std::string("the scene looks closed but ") + share +
+                         " % of the emitted light left it: polygons probably face outwards (wound the wrong way); "
+                         "reverse their winding or use two-sided materials (--two-sided)");
+    }
+  }
+  return warnings;
+}
+
+}  // namespace radiosity::detail
+
+namespace radiosity {
+inline namespace v1 {
+
+std::vector<PolygonId> find_emitters_facing_away(const Scene& scene) {
+  std::vector<PolygonId> out;
+  for (const detail::EmitterReach& r : detail::emitter_reach(scene))
+    if (r.hit_fraction <= 0.0) out.push_back(r.polygon);
+  return out;
+}
+
+}  // namespace v1
+}  // namespace radiosity

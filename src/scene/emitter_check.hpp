@@ -1,0 +1,47 @@
+// Where the light of a scene's emitters goes, by rays: the checks behind
+// radiosity::find_emitters_facing_away() (scene.hpp) and solve()'s warnings about light that
+// leaves the scene.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "radiosity/common.hpp"
+#include "radiosity/scene.hpp"
+
+namespace radiosity::detail {
+
+/// Rays per emitting polygon; fewer (down to kMinEmitterRays) when the scene has so many
+/// emitters that kEmitterRayBudget rays would be exceeded.
+inline constexpr std::size_t kEmitterRays = 256;
+inline constexpr std::size_t kMinEmitterRays = 64;
+inline constexpr std::size_t kEmitterRayBudget = std::size_t{1} << 22;
+
+/// What the front of one emitting polygon sees.
+struct EmitterReach {
+  PolygonId polygon = 0;
+  double power = 0.0;  ///< area x the sum of the emission's channels, W
+  /// Of the cosine-distributed rays leaving its front (from stratified points, so weighted as
+  /// its light is), the fraction that hit some polygon, front or back.
+  double hit_fraction = 0.0;
+};
+
+/// Every emitting polygon (emission > 0 in some channel), in polygon order. Each casts
+/// kEmitterRays rays (see above) from stratified points just in front of it, in stratified
+/// cosine-distributed directions, against every polygon of the scene; the streams have a fixed
+/// seed, so the answer is the same at any thread count. Throws Error{internal} if Embree cannot
+/// create a device. Thread safety: concurrent calls are safe.
+std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads = 0);
+
+/// The warnings of solve() about escaped light, given the power balance of a solve:
+/// - emitters whose front sees no polygon at all (named with their polygons and groups);
+/// - when `balanced` (the solve converged, so emitted - absorbed is light that left rather than
+///   light not yet propagated), more than 95 % of the emitters' light meets a surface directly
+///   (the scene looks closed) and yet more than half of the emitted power escaped: light that
+///   arrives at the backs of one-sided polygons is lost, so they probably face outwards.
+/// `emitted` and `escaped` are W per channel; nothing is cast when nothing emits.
+std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& emitted, const Rgb& escaped,
+                                                bool balanced, unsigned threads = 0);
+
+}  // namespace radiosity::detail

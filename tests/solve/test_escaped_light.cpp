@@ -1,0 +1,140 @@
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+#include <radiosity/radiosity.hpp>
+
+#include "support/scenes.hpp"
+
+namespace rad = radiosity;
+
+namespace {
+
+rad::SolveOptions coarse() {
+  rad::SolveOptions o;
+  o.mesh.max_patch_area = 1.0f;
+  o.mesh.max_element_area = 0.25f;
+  o.tolerance = 1e-5;
+  return o;
+}
+
+double share(const rad::Rgb& part, const rad::Rgb& whole) {
+  return (double(part.x) + double(part.y) + double(part.z)) / (double(whole.x) + double(whole.y) + double(whole.z));
+}
+
+bool has_warning(const rad::SolveReport& r, const std::string& text) {
+  for (const std::string& w : r.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
+rad::Material lamp() {
+  rad::Material m;
+  m.name = "lamp";
+  m.emission = rad::Rgb(10.0f);
+  m.reflectance = rad::Rgb(0.0f);
+  return m;
+}
+
+/// A unit floor facing up at y = 0 and a 0.5 x 0.5 light at y = 1, facing down or up.
+rad::Scene floor_and_light(bool light_faces_down) {
+  rad::Scene scene;
+  const rad::MaterialId white = scene.add_material(rad::Material{});
+  const rad::MaterialId light = scene.add_material(lamp());
+  rad::add_quad(scene, {0, 0, 0}, {0, 0, 1}, {1, 0, 0}, white, "floor");
+  if (light_faces_down)
+    rad::add_quad(scene, {0.25f, 1, 0.25f}, {0.5f, 0, 0}, {0, 0, 0.5f}, light, "light");
+  else
+    rad::add_quad(scene, {0.25f, 1, 0.25f}, {0, 0, 0.5f}, {0.5f, 0, 0}, light, "light");
+  return scene;
+}
+
+}  // namespace
+
+TEST_SUITE("solve") {
+  TEST_CASE("escaped power: a closed room with an inward light loses nothing and gets no warning") {
+    rad::Material white;
+    white.reflectance = rad::Rgb(0.6f);
+    rad::Scene scene = test::closed_box(white, glm::vec3(2.0f));
+    const rad::MaterialId light = scene.add_material(lamp());
+    // Small, so that little of the ceiling's light falls on its (black, one-sided) back.
+    rad::add_quad(scene, {0.9f, 1.99f, 0.9f}, {0.2f, 0, 0}, {0, 0, 0.2f}, light, "light");  // faces down
+    REQUIRE(scene.polygons().back().normal.y < 0.0f);
+    const rad::Solution sol = rad::solve(scene, coarse());
+    const rad::SolveReport& r = sol.report();
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    CHECK(std::abs(share(r.escaped_power, r.emitted_power)) < 0.005);
+    CHECK(r.warnings.empty());
+    CHECK(rad::find_emitters_facing_away(scene).empty());
+  }
+
+  TEST_CASE("escaped power: the Cornell box loses light through its open front only and gets no warning") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 20000.0f;
+    o.mesh.max_element_area = 20000.0f;
+    o.tolerance = 1e-5;
+    const rad::Solution sol = rad::solve(scene, o);
+    const rad::SolveReport& r = sol.report();
+    for (int c = 0; c < 3; ++c)
+      CHECK(r.escaped_power[c] == doctest::Approx(r.emitted_power[c] - r.absorbed_power[c]).epsilon(1e-5));
+    const double escaped = share(r.escaped_power, r.emitted_power);
+    CHECK(escaped > 0.05);  // the front is open
+    CHECK(escaped < 0.5);
+    CHECK(!has_warning(r, "faces away"));  // (the red wall's triangulation is warned about)
+    CHECK(!has_warning(r, "looks closed"));
+    CHECK(rad::find_emitters_facing_away(scene).empty());
+  }
+
+  TEST_CASE("escaped power: a room of outward-facing polygons loses its light and is said to look closed") {
+    rad::Scene scene;
+    const rad::MaterialId white = scene.add_material(rad::Material{});
+    const rad::MaterialId light = scene.add_material(lamp());
+    rad::add_box(scene, {0, 0, 0}, {2, 2, 2}, white, "room");  // faces out: the room is inside out
+    rad::add_quad(scene, {0.75f, 1.9f, 0.75f}, {0.5f, 0, 0}, {0, 0, 0.5f}, light, "light");  // faces down
+    const rad::Solution sol = rad::solve(scene, coarse());
+    const rad::SolveReport& r = sol.report();
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    CHECK(share(r.escaped_power, r.emitted_power) > 0.5);
+    CHECK(has_warning(r, "the scene looks closed but 100 % of the emitted light left it: polygons probably face "
+                         "outwards (wound the wrong way); reverse their winding or use two-sided materials"));
+    CHECK(!has_warning(r, "faces away"));
+    CHECK(rad::find_emitters_facing_away(scene).empty());
+  }
+
+  TEST_CASE("escaped power: an emitter facing away from an open floor is found and named") {
+    const rad::Scene scene = floor_and_light(false);
+    const std::vector<rad::PolygonId> away = rad::find_emitters_facing_away(scene);
+    REQUIRE(away.size() == 1);
+    CHECK(away[0] == 1);
+    const rad::Solution sol = rad::solve(scene, coarse());
+    const rad::SolveReport& r = sol.report();
+    CHECK(share(r.escaped_power, r.emitted_power) == doctest::Approx(1.0));
+    CHECK(has_warning(r, "emitter 'light' (polygon 1) faces away from every surface: its light leaves the scene; "
+                         "check the polygon's winding (vertex order) or use two-sided materials"));
+    CHECK(!has_warning(r, "looks closed"));
+  }
+
+  TEST_CASE("escaped power: a light facing down onto an open floor is not flagged though most light escapes") {
+    const rad::Scene scene = floor_and_light(true);
+    CHECK(rad::find_emitters_facing_away(scene).empty());
+    const rad::Solution sol = rad::solve(scene, coarse());
+    const rad::SolveReport& r = sol.report();
+    CHECK(share(r.escaped_power, r.emitted_power) > 0.5);  // open: the light spreads past the floor
+    CHECK(r.warnings.empty());
+  }
+
+  TEST_CASE("find_emitters_facing_away: several emitters are listed in order and the answer is repeatable") {
+    rad::Scene scene = floor_and_light(false);
+    const rad::MaterialId light = scene.polygons()[1].material;
+    rad::add_quad(scene, {0.25f, 2, 0.25f}, {0, 0, 0.5f}, {0.5f, 0, 0}, light, "light");  // up, sees nothing
+    rad::add_quad(scene, {0.25f, 0.5f, 0.25f}, {0.5f, 0, 0}, {0, 0, 0.5f}, light, "low");  // down, sees the floor
+    rad::add_quad(scene, {0.25f, 3, 0.25f}, {0, 0, 0.5f}, {0.5f, 0, 0}, light, "top");  // up, sees nothing
+    const std::vector<rad::PolygonId> away = rad::find_emitters_facing_away(scene);
+    CHECK(away == std::vector<rad::PolygonId>{4});  // 1 and 2 face up into the lights above them
+    CHECK(rad::find_emitters_facing_away(scene) == away);
+    const rad::Solution sol = rad::solve(scene, coarse());
+    CHECK(has_warning(sol.report(), "emitter 'top' (polygon 4) faces away"));
+  }
+}
