@@ -2,9 +2,11 @@
 // scene, hemicube rows per second, and the time for all factors of a ~10k-element Cornell box.
 // A plain std::chrono harness (median of a few runs for the short measurements); prints what it
 // measured, and the time of find_overlaps() on a ~100k-polygon scene. Usage: bench_form_factors
-// [--quick | --overlaps] (--quick skips the ~10k-element runs, --overlaps runs only find_overlaps).
+// [--quick | --overlaps | --emitters] (--quick skips the ~10k-element runs, --overlaps runs only
+// find_overlaps, --emitters only the many-emitters enclosure).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <functional>
@@ -261,13 +263,91 @@ void overlap_section() {
   }
 }
 
+/// An enclosure of about 4000 facets (floor and ceiling 24 x 24, walls 24 x 30; a 5 x 3 x 5
+/// room with a 1 x 1 x 1 block on the floor), one element per facet, lit either by its whole
+/// ceiling (576 emitting facets) or by one ceiling facet. Gauss-Seidel with Monte Carlo factors
+/// on one thread: the form-factor time of each, and how far limiting the exact emitter factors
+/// (FormFactorOptions::exact_emitters) moves the solution from the all-exact one.
+void emitters_section() {
+  auto room = [](bool whole_ceiling) {
+    rad::Scene scene;
+    rad::Material wall, lamp;
+    wall.name = "wall";
+    wall.reflectance = rad::Rgb(0.6f);
+    lamp.name = "lamp";
+    lamp.emission = rad::Rgb(10.0f);
+    lamp.reflectance = rad::Rgb(0.6f);
+    const rad::MaterialId w = scene.add_material(wall), l = scene.add_material(lamp);
+    const float X = 5.0f, Y = 3.0f, Z = 5.0f;
+    auto grid = [&](glm::vec3 o, glm::vec3 u, glm::vec3 v, int nu, int nv, bool ceiling, const char* group) {
+      for (int i = 0; i < nu; ++i)
+        for (int k = 0; k < nv; ++k) {
+          const glm::vec3 a = o + u * (static_cast<float>(i) / nu) + v * (static_cast<float>(k) / nv);
+          const bool emits = ceiling && (whole_ceiling || (i == nu / 2 && k == nv / 2));
+          rad::add_quad(scene, a, u / static_cast<float>(nu), v / static_cast<float>(nv), emits ? l : w, group);
+        }
+    };
+    // Inward: floor up, ceiling down, four walls.
+    grid({0, 0, 0}, {0, 0, Z}, {X, 0, 0}, 24, 24, false, "floor");
+    grid({0, Y, 0}, {X, 0, 0}, {0, 0, Z}, 24, 24, true, "ceiling");
+    grid({0, 0, 0}, {X, 0, 0}, {0, Y, 0}, 24, 30, false, "wall");
+    grid({0, 0, Z}, {0, Y, 0}, {X, 0, 0}, 30, 24, false, "wall");
+    grid({0, 0, 0}, {0, Y, 0}, {0, 0, Z}, 30, 24, false, "wall");
+    grid({X, 0, 0}, {0, 0, Z}, {0, Y, 0}, 24, 30, false, "wall");
+    rad::add_box(scene, {2, 0, 2}, {3, 1, 3}, w, "block");
+    return scene;
+  };
+  auto run = [](const rad::Scene& scene, std::uint32_t exact, rad::Solution* out, std::uint64_t seed = 1) {
+    rad::SolveOptions o;
+    o.seed = seed;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.exact_emitters = exact;
+    o.threads = 1;
+    o.mesh.max_patch_area = 5.0f * 5.0f / (24 * 24) + 1e-4f;
+    o.mesh.max_element_area = o.mesh.max_patch_area;
+    rad::Solution sol = rad::solve(scene, o);
+    const double t = sol.report().seconds_form_factors;
+    if (out) *out = std::move(sol);
+    return t;
+  };
+  std::printf("many emitters: %zu-facet enclosure, Monte Carlo factors, 1 thread\n", room(true).polygons().size());
+  const rad::Scene one = room(false), whole = room(true);
+  const double t_one = run(one, 0, nullptr);
+  rad::Solution reference;
+  const double t_all = run(whole, 0, &reference);
+  std::printf("  one emitting facet:                           form factors %6.2f s\n", t_one);
+  std::printf("  whole ceiling (576 facets), every one exact:  form factors %6.2f s (%.1f x one facet)\n", t_all,
+              t_all / t_one);
+  // k = 0 at another seed: the all-exact solution's own noise, the yardstick for the others.
+  for (std::uint32_t k : {0u, 4u, 16u, 64u}) {
+    rad::Solution sol;
+    const double t = run(whole, k, &sol, k == 0 ? 2 : 1);
+    double num = 0.0, den = 0.0, worst_group = 0.0;
+    const rad::PatchHierarchy& h = reference.hierarchy();
+    for (std::uint32_t e : h.leaves()) {
+      const rad::Patch& p = h.patches()[h.element(e).patch];
+      if (whole.material(p.material).emission.x > 0.0f) continue;  // reflectors only
+      const double a = h.element(e).area, d = sol.radiosity()[e].x - reference.radiosity()[e].x;
+      num += a * d * d;
+      den += a * static_cast<double>(reference.radiosity()[e].x) * reference.radiosity()[e].x;
+    }
+    for (const std::string& g : {std::string("floor"), std::string("wall"), std::string("block")})
+      worst_group = std::max(worst_group, std::fabs(sol.group_radiosity(g).x / reference.group_radiosity(g).x - 1.0));
+    std::printf("  whole ceiling, %s form factors %6.2f s (%.1f x one facet); "
+                "reflectors' RMS difference from all-exact %.2f %%, worst group mean %.2f %%\n",
+                k == 0 ? "every one exact, seed 2: " : ("exact_emitters " + std::to_string(k) + ":" + std::string(k < 10 ? "          " : "         ")).c_str(),
+                t, t / t_one, 100.0 * std::sqrt(num / den), 100.0 * worst_group);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 2 || (argc == 2 && std::strcmp(argv[1], "--quick") != 0 && std::strcmp(argv[1], "--overlaps") != 0)) {
+  if (argc > 2 || (argc == 2 && std::strcmp(argv[1], "--quick") != 0 && std::strcmp(argv[1], "--overlaps") != 0 &&
+                    std::strcmp(argv[1], "--emitters") != 0)) {
     const bool help = argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0);
     if (!help) std::fprintf(stderr, "bench_form_factors: bad argument '%s'\n", argv[argc - 1]);
-    std::fprintf(stderr, "usage: bench_form_factors [--quick | --overlaps]\n");
+    std::fprintf(stderr, "usage: bench_form_factors [--quick | --overlaps | --emitters]\n");
     return help ? 0 : 2;
   }
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
@@ -276,6 +356,10 @@ int main(int argc, char** argv) {
   const rad::Scene cornell = rad::cornell_box();
   if (argc > 1 && std::strcmp(argv[1], "--overlaps") == 0) {
     overlap_section();
+    return 0;
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--emitters") == 0) {
+    emitters_section();
     return 0;
   }
   ray_cast_section("Cornell box, default mesh", cornell, rad::MeshOptions{});

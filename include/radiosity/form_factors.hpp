@@ -71,6 +71,14 @@ struct FormFactorOptions {
   /// Monte Carlo: rays per element (per patch when shooting a column, times the patch's
   /// elements), in [16, 1 << 20].
   std::uint32_t hemisphere_rays = 1024;
+  /// Monte Carlo: the emitting patches that get an exact factor (unoccluded factor times shadow
+  /// rays) in each element's row, at most; the others are counted by the element's hemisphere
+  /// rays like any patch. Chosen per element by their estimated contribution (E A cos cos /
+  /// pi r^2 between centroids), so a ceiling of hundreds of emitting facets costs what a few
+  /// lamps cost. With at most this many emitting patches in the scene every one is exact (the
+  /// rows are the same as without the limit). 0 = every emitting patch exact. Accuracy and
+  /// cost: docs/FORM_FACTORS.md, "Many emitters".
+  std::uint32_t exact_emitters = 16;
   /// Monte Carlo only: extended form factors (Wallace, Cohen & Greenberg 1987) carry light
   /// between diffuse surfaces through ideal mirrors (Material::specular with specular_exponent
   /// 0; at most this many reflections on a path, weighted by the mean specular reflectance) and

@@ -146,6 +146,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     // Backs are never exact: those of two-sided emitters are counted by the rays that reach them.
     exact_.assign(target_count(), 0);
     emitter_of_.assign(patches.size(), kNone);
+    emitter_power_.assign(patches.size(), 0.0f);
     std::vector<std::uint32_t> polygon_slot(polygons.size(), kNone);
     for (std::uint32_t j = 0; j < patches.size(); ++j) {
       const PolygonId pid = patches[j].polygon;
@@ -153,6 +154,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       if (std::max(e.x, std::max(e.y, e.z)) <= 0.0f) continue;
       exact_[j] = 1;
       emitters_.push_back(j);
+      emitter_power_[j] = e.x + e.y + e.z;
       if (polygon_slot[pid] == kNone) {
         polygon_slot[pid] = static_cast<std::uint32_t>(lights_.size());
         lights_.emplace_back(pid, polygons[pid]);
@@ -279,25 +281,63 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const float per_ray = 1.0f / static_cast<float>(N);
     // One parallel loop does everything for a run of elements; the analytic estimator used
     // inside is single-threaded, so no nested parallel region is opened per emitting patch.
+    const bool limited = options_.exact_emitters > 0 && emitters_.size() > options_.exact_emitters;
     parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
       HitCounter counter(target_count());
       Scratch scratch(N);
       std::vector<std::uint32_t> index, run(elements.begin() + static_cast<std::ptrdiff_t>(begin),
                                              elements.begin() + static_cast<std::ptrdiff_t>(end));
       std::vector<float> value, column(run.size()), fraction(lights_.size());
-      // Emitting patches: unoccluded factors, column by column over the run...
       std::vector<std::vector<std::pair<std::uint32_t, float>>> exact(run.size());
-      for (std::uint32_t j : emitters_) {
-        if (back)
-          back_patch_column(*analytic_serial_, j, run, column.data());
-        else
-          analytic_serial_->patch_column(j, run, column.data());
-        for (std::size_t k = 0; k < run.size(); ++k)
-          if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
+      // Emitting patches left to the rays for the element at hand (only when some are).
+      std::vector<std::uint8_t> by_rays;
+      if (limited) by_rays.assign(target_count(), 0);
+      if (!limited) {
+        // Every emitting patch exact: unoccluded factors, column by column over the run...
+        for (std::uint32_t j : emitters_) {
+          if (back)
+            back_patch_column(*analytic_serial_, j, run, column.data());
+          else
+            analytic_serial_->patch_column(j, run, column.data());
+          for (std::size_t k = 0; k < run.size(); ++k)
+            if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
+        }
       }
+      std::vector<std::pair<float, std::uint32_t>> ranked;
       for (std::size_t k = begin; k < end; ++k) {
-        // ... times the element's visible fraction of each emitting polygon it faces.
         auto& own = exact[k - begin];
+        if (limited) {
+          // ... or the exact_emitters patches that send the element the most (a centroid
+          // estimate ranks them), the rest counted by the rays below.
+          ranked.clear();
+          const Element& el = hierarchy_.element(elements[k]);
+          const glm::vec3 n = back ? -hierarchy_.patches()[el.patch].normal : hierarchy_.patches()[el.patch].normal;
+          for (std::uint32_t j : emitters_) {
+            const Patch& p = hierarchy_.patches()[j];
+            const glm::vec3 d = p.centroid - el.centroid;
+            const float r2 = glm::dot(d, d);
+            const float c = std::max(0.0f, glm::dot(d, n)) * std::max(0.0f, -glm::dot(d, p.normal));
+            if (!(c > 0.0f) || !(r2 > 0.0f)) continue;
+            ranked.emplace_back(emitter_power_[j] * p.area * c / (r2 * r2), j);
+          }
+          const std::size_t keep = std::min<std::size_t>(ranked.size(), options_.exact_emitters);
+          std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end(),
+                            [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+          for (std::uint32_t j : emitters_) by_rays[j] = 1;
+          const std::vector<std::uint32_t> one{elements[k]};
+          for (std::size_t i = 0; i < keep; ++i) {
+            const std::uint32_t j = ranked[i].second;
+            by_rays[j] = 0;
+            float f = 0.0f;
+            if (back)
+              back_patch_column(*analytic_serial_, j, one, &f);
+            else
+              analytic_serial_->patch_column(j, one, &f);
+            if (f > 0.0f) own.emplace_back(j, f);
+          }
+          std::sort(own.begin(), own.end());
+        }
+        // ... times the element's visible fraction of each emitting polygon it faces.
         std::fill(fraction.begin(), fraction.end(), -1.0f);
         for (auto& [j, f] : own) {
           float& v = fraction[emitter_of_[j]];
@@ -311,8 +351,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
         Rng rng(options_.seed, e, back ? 0x600000000ull : 0x300000000ull);
         shoot(*rays, e, source, back, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
-          // Emitting patches reached directly are in the exact part, through glass in the photon map.
-          if (!exact_[j] || path == Path::specular) counter.add(j, w);
+          // Emitting patches reached directly are in the exact part (unless left to the rays for
+          // this element), through glass in the photon map.
+          if (!exact_[j] || (limited && by_rays[j]) || path == Path::specular) counter.add(j, w);
         });
         index.clear();
         value.clear();
@@ -651,6 +692,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   std::vector<std::uint32_t> back_target_;         ///< per patch: target of its back, or kNone (opaque)
   std::vector<std::uint32_t> emitters_;            ///< the patches with exact_ set, increasing
   std::vector<std::uint32_t> emitter_of_;          ///< per patch: index into lights_, or kNone
+  std::vector<float> emitter_power_;               ///< per patch: E summed over channels (0: not emitting)
   std::vector<Light> lights_;                      ///< the emitting polygons
   std::optional<RayScene> shadow_rays_;            ///< the scene's polygons, for shadow rays
   ShaftCuller occluders_;

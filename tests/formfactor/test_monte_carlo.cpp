@@ -192,6 +192,9 @@ TEST_SUITE("solve") {
       rad::SolveOptions o;
       o.method = method;
       o.form_factors = monte_carlo(1024);
+      // Every one of the 24 emitting patches exact, so rows are exact factor sums (with the
+      // default limit of 16 the rest would be counted by rays: see "many emitting patches").
+      o.form_factors.exact_emitters = 0;
       o.mesh = mesh(0.26f, 0.07f);
       o.tolerance = 1e-6;
       const rad::Solution sol = rad::solve(scene, o);
@@ -373,5 +376,46 @@ TEST_SUITE("solve") {
     // Classic radiosity: the pane is opaque and black.
     o.form_factors.specular_depth = 0;
     CHECK(rad::solve(room(1.0f), o).group_radiosity("tile").y == 0.0f);
+  }
+}
+
+TEST_SUITE("formfactor") {
+  TEST_CASE("many emitting patches: exact factors for the strongest few - the rest by rays - within noise") {
+    // A closed unit box whose every face is 4 x 4 emitting facets (96 emitting patches, more
+    // than exact_emitters = 16): a furnace, B = E / (1 - rho) everywhere, whichever emitters a
+    // row takes exactly.
+    rad::Material m;
+    m.emission = rad::Rgb(2.0f);
+    m.reflectance = rad::Rgb(0.5f);
+    rad::Scene scene;
+    const rad::MaterialId id = scene.add_material(m);
+    const rad::Scene box = test::closed_box(m);
+    for (const rad::Polygon& face : box.polygons()) {
+      const glm::vec3 o = face.vertices[0], u = face.vertices[1] - o, v = face.vertices[3] - o;
+      for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 4; ++k)
+          rad::add_quad(scene, o + u * (i / 4.0f) + v * (k / 4.0f), u / 4.0f, v / 4.0f, id, box.groups()[face.group]);
+    }
+    rad::SolveOptions o;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.mesh.max_patch_area = 1.0f / 16.0f + 1e-4f;
+    o.mesh.max_element_area = 1.0f / 64.0f + 1e-4f;  // 4 elements per facet
+    o.tolerance = 1e-6;
+    REQUIRE(o.form_factors.exact_emitters < 96);
+    const rad::Solution limited = rad::solve(scene, o);
+    o.form_factors.exact_emitters = 0;  // every emitting patch exact
+    const rad::Solution all = rad::solve(scene, o);
+    const double expected = 2.0 / (1.0 - 0.5);
+    double worst = 0.0, worst_all = 0.0;
+    for (std::uint32_t leaf : limited.hierarchy().leaves()) {
+      worst = std::max(worst, std::fabs(limited.radiosity()[leaf].x / expected - 1.0));
+      worst_all = std::max(worst_all, std::fabs(all.radiosity()[leaf].x / expected - 1.0));
+    }
+    MESSAGE("furnace of 96 emitting facets: worst leaf " << worst << " (every emitter exact: " << worst_all << ")");
+    // A row's exact part and its rays each estimate their share without bias; their sum is 1
+    // to the rays' noise (1024 rays), where every-exact rows sum to 1 to visibility rounding.
+    CHECK(worst < 0.02);
+    for (const std::string& g : limited.groups())
+      CHECK(limited.group_radiosity(g).x == doctest::Approx(expected).epsilon(0.005));
   }
 }
