@@ -1,0 +1,104 @@
+// Files as users bring them (tests/data/messy/, written the way exporters write them: outward
+// winding, Kd 1, a missing MTL, degenerate and two-corner faces, lines and points, CRLF and a
+// byte order mark, the PBR extension): every one loads with warnings that say what was done and
+// solves with default options; under LoadOptions::strict each untidy one is refused instead.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <radiosity/radiosity.hpp>
+
+namespace rad = radiosity;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kMessy = fs::path(RADIOSITY_TEST_DATA) / "messy";
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+rad::SolveOptions coarse() {
+  rad::SolveOptions o;
+  o.mesh.max_patch_area = 0.5f;
+  o.mesh.max_element_area = 0.25f;
+  return o;
+}
+
+}  // namespace
+
+TEST_SUITE("io") {
+  TEST_CASE("every messy exported file loads with its warnings and solves - strict refuses the untidy ones") {
+    const struct {
+      const char* file;
+      std::size_t warnings;  ///< Scene::warnings() of the load: one per kind of problem
+      const char* first;     ///< a piece of the first warning
+    } files[] = {
+        {"exported_room.obj", 3, "exported_room.mtl:5: material 'Wall': Kd (1, 1, 1)"},
+        {"missing_library.obj", 2, "missing_library.obj:3: material library 'lost_materials.mtl' not found"},
+        {"degenerate_heavy.obj", 1, "(80 in all; also at "},
+        {"lines_and_short_faces.obj", 3, "line/point element has no area; ignored (3 in all"},
+        {"pbr_dissolve.obj", 2, "pbr_dissolve.mtl:8: material 'plastic': Kd (1.2, 1, 1)"},
+        {"crlf_bom.obj", 0, ""},
+    };
+    std::size_t loaded = 0, solved = 0, refused = 0;
+    for (const auto& f : files) {
+      CAPTURE(std::string(f.file));
+      const rad::Scene scene = rad::load_scene(kMessy / f.file);
+      ++loaded;
+      CHECK(scene.warnings().size() == f.warnings);
+      if (f.warnings > 0) {
+        REQUIRE(!scene.warnings().empty());
+        CHECK(contains(scene.warnings()[0], f.first));
+      }
+      const rad::Solution sol = rad::solve(scene, coarse());
+      bool finite = true;
+      for (const rad::Rgb& b : sol.radiosity()) finite = finite && std::isfinite(b.x + b.y + b.z);
+      CHECK(finite);
+      solved += finite ? 1 : 0;
+
+      rad::LoadOptions strict;
+      strict.strict = true;
+      if (f.warnings == 0) {
+        CHECK_NOTHROW(rad::load_scene(kMessy / f.file, strict));
+      } else {
+        bool threw = false;
+        try {
+          rad::load_scene(kMessy / f.file, strict);
+        } catch (const rad::Error& e) {
+          threw = true;
+          // The error is the first warning's problem, at the same place.
+          const std::string first = scene.warnings()[0];
+          CHECK(contains(e.what(), first.substr(0, first.find(": ") + 2)));
+        }
+        CHECK(threw);
+        refused += threw ? 1 : 0;
+      }
+    }
+    MESSAGE(loaded << " of " << std::size(files) << " messy files load and " << solved << " solve; strict refuses "
+                   << refused << " of the " << std::size(files) - 1 << " untidy ones");
+    CHECK(loaded == std::size(files));
+  }
+
+  TEST_CASE("a room exported wound outwards is diagnosed - and lit inside once two-sided") {
+    rad::Scene scene = rad::load_scene(kMessy / "exported_room.obj");
+    const rad::Solution outward = rad::solve(scene, coarse());
+    const rad::SolveReport& r = outward.report();
+    CHECK(r.escaped_power.x > 0.9f * r.emitted_power.x);
+    bool diagnosed = false;
+    for (const std::string& w : r.warnings) diagnosed = diagnosed || (contains(w, "looks closed") && contains(w, "--two-sided"));
+    CHECK(diagnosed);
+
+    scene.make_two_sided();
+    const rad::Solution two_sided = rad::solve(scene, coarse());
+    const rad::SolveReport& t = two_sided.report();
+    MESSAGE("outward room: " << 100.0 * r.escaped_power.x / r.emitted_power.x << " % escaped; two-sided "
+                             << 100.0 * t.escaped_power.x / t.emitted_power.x << " %");
+    CHECK(t.escaped_power.x < 0.05f * t.emitted_power.x);
+    // The room's inside is its walls' backs: lit now.
+    CHECK(two_sided.group_back_radiosity("Room").x > 1.0f);
+    for (const std::string& w : t.warnings) CHECK(!contains(w, "looks closed"));
+  }
+}
