@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -141,6 +142,30 @@ TEST_SUITE("solve") {
         worst = std::max(worst, relative(sol.back_radiosity()[leaf].y, m.emission.y / (1.0 - m.reflectance.y)));
       MESSAGE(std::string(method) << ": worst leaf back radiosity off by " << worst);
       CHECK(worst < 2e-3);
+    }
+
+    // render() inside the box shows the backs (vertex radiosity / pi), and the PLY carries a
+    // back face for every leaf.
+    {
+      rad::SolveOptions om = options_for("ray-cast", rad::SolverMethod::gauss_seidel);
+      om.mesh.max_element_area = 0.0625f;
+      const rad::Solution sol = rad::solve(scene, om);
+      rad::RenderOptions ro;
+      ro.width = 8;
+      ro.height = 8;
+      ro.camera = rad::Camera{{0.5f, 0.5f, 0.1f}, {0.5f, 0.5f, 1.0f}, {0, 1, 0}, 90.0f};
+      const rad::Image img = rad::render(scene, sol, ro);
+      double sum = 0.0;
+      for (const rad::Rgb& px : img.pixels) sum += px.y;
+      const double L = sum / static_cast<double>(img.pixels.size());
+      CHECK(relative(L, m.emission.y / ((1.0 - m.reflectance.y) * 3.14159265358979323846)) < 1e-3);
+      const std::string ply = std::string(RADIOSITY_TEST_TMP) + "/two_sided_box.ply";
+      rad::write_ply(sol, ply);
+      std::ifstream in(ply, std::ios::binary);
+      std::string header, line;
+      while (std::getline(in, line) && line != "end_header") header += line + "\n";
+      // 96 quad leaves, 2 triangles each, front and back.
+      CHECK(header.find("element face " + std::to_string(2 * 2 * sol.hierarchy().leaves().size())) != std::string::npos);
     }
 
     // The path tracer, inside the same box: every pixel sees L = E / ((1 - rho) pi), the backs
