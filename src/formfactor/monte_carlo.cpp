@@ -45,6 +45,7 @@
 #include "radiosity/brdf.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
+#include "geometry/hemisphere.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "scene/specular_transport.hpp"
@@ -52,33 +53,6 @@
 namespace radiosity::detail {
 
 namespace {
-
-/// Cosine-distributed direction around +z from a point of [0,1)^2, by Shirley & Chiu's concentric
-/// map to the disk and Malley's projection up to the hemisphere (strata stay compact).
-glm::vec3 cosine_direction(glm::vec2 u) {
-  const float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
-  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f, 1.0f};
-  constexpr float kQuarterPi = 0.25f * glm::pi<float>();
-  float r, phi;
-  if (std::fabs(a) > std::fabs(b)) {
-    r = a;
-    phi = kQuarterPi * (b / a);
-  } else {
-    r = b;
-    phi = 2.0f * kQuarterPi - kQuarterPi * (a / b);
-  }
-  const float x = r * std::cos(phi), y = r * std::sin(phi);
-  return {x, y, std::sqrt(std::max(0.0f, 1.0f - x * x - y * y))};
-}
-
-/// Tangents completing a unit normal to a right-handed frame (Duff et al., JCGT 2017).
-void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float c = n.x * n.y * a;
-  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
-  b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
-}
 
 /// Hit weights per target, with the touched targets listed so that clearing costs O(hits).
 /// Weights are > 0 (1 for a plain hit, less after mirrors and windows).

@@ -17,6 +17,7 @@
 
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
+#include "geometry/hemisphere.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 
@@ -28,21 +29,6 @@ namespace {
 constexpr std::uint64_t kSeed = 0x656d6974746572ull;  // "emitter"
 
 bool emits(const Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
-
-/// Cosine-distributed direction around +z for u in [0,1)^2 (the polar map keeps strata compact).
-glm::vec3 cosine_direction(glm::vec2 u) {
-  const float r = std::sqrt(u.x), phi = 2.0f * glm::pi<float>() * u.y;
-  return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x))};
-}
-
-/// Tangents completing a unit normal to a right-handed frame (Duff et al., JCGT 6(1), 2017).
-void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float c = n.x * n.y * a;
-  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
-  b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
-}
 
 /// "12", "12, 13" or "12, 13, 14, 15 and 9 more".
 std::string id_list(const std::vector<PolygonId>& ids) {
