@@ -180,5 +180,15 @@ TEST_SUITE("path") {
       m.brdf = rad::make_microfacet(Rgb(0.9f, 0.6f, 0.3f), 0.16f, 0.16f);
       check_within_noise("pbr_metal", "Kd 0.9 0.6 0.3\nPm 1\nPr 0.4", m);
     }
+    {
+      // PBR plastic: a diffuse base under a GGX coat of F0 = ((n - 1)/(n + 1))^2 = 0.04 at
+      // Ni 1.5, mixed so that each part keeps its albedo (docs/SCENE_OBJ.md).
+      const float f0 = 0.04f, w = f0;
+      rad::Material m;
+      m.reflectance = rad::Rgb(0.5f, 0.4f, 0.3f);
+      m.brdf = rad::make_mix(rad::make_lambertian(m.reflectance / (1.0f - w)),
+                             rad::make_microfacet(rad::Rgb(f0 / w), 0.36f, 0.36f), w);
+      check_within_noise("pbr_plastic", "Kd 0.5 0.4 0.3\nPm 0\nPr 0.6\nNi 1.5", m);
+    }
   }
 }
