@@ -16,6 +16,7 @@
 
 #include "brdf/brdf_util.hpp"
 #include "radiosity/brdf.hpp"
+#include "core/frame.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -50,14 +51,9 @@ ShadingFrame ShadingFrame::from_normal(const glm::vec3& normal) {
     throw Error(ErrorCode::invalid_argument, "ShadingFrame::from_normal: normal is zero-length or not finite");
   }
   const glm::vec3 n = normal / len;
-  // Branchless orthonormal basis of Duff et al. (2017), listing 3: continuous except on the
-  // plane n.z = 0 where the sign flips, and right-handed (n x t = b).
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float b = n.x * n.y * a;
+  // Duff et al.'s branchless basis (core/frame.hpp), right-handed (n x t = b).
   ShadingFrame f;
-  f.tangent = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-  f.bitangent = glm::vec3(b, sign + n.y * n.y * a, -n.y);
+  detail::tangent_frame(n, f.tangent, f.bitangent);
   f.normal = n;
   return f;
 }

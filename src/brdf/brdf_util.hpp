@@ -1,11 +1,5 @@
-// Private helpers shared by the reflection models in src/brdf: constants, parameter checks and
-// sampling warps. Not installed.
-//
-// Based on:
-//   Shirley, P. & Chiu, K. (1997). A low distortion map between disk and square.
-//     Journal of Graphics Tools 2(3), 45-52. (concentric disk map for cosine sampling)
-//   Malley's method (Malley 1988, MSc thesis, Univ. of Utah): cosine-weighted directions are
-//     uniform disk points projected up onto the hemisphere.
+// Private helpers shared by the reflection models in src/brdf: parameter checks and reflection
+// directions; the constants and sampling warps come from src/core. Not installed.
 #pragma once
 
 #include <algorithm>
@@ -16,6 +10,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/constants.hpp"
+#include "core/sampling.hpp"
 #include "radiosity/brdf.hpp"
 #include "radiosity/common.hpp"
 
@@ -23,11 +19,10 @@ namespace radiosity {
 namespace detail {
 namespace brdf {
 
-constexpr float kPi = 3.14159265358979323846f;
-constexpr float kInvPi = 0.318309886183790671538f;
-constexpr float kInv2Pi = 0.159154943091895335769f;
-/// Largest float below 1, so that u in [0, 1) stays there after clamping.
-constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
+using detail::kInv2Pi;
+using detail::kInvPi;
+using detail::kOneMinusEpsilon;
+using detail::kPi;
 
 inline float clamp01(float u) { return std::min(std::max(u, 0.0f), kOneMinusEpsilon); }
 inline glm::vec2 clamp01(const glm::vec2& u) { return {clamp01(u.x), clamp01(u.y)}; }
@@ -78,32 +73,10 @@ inline glm::vec3 reflect_z(const glm::vec3& w) { return {-w.x, -w.y, w.z}; }
 /// Mirror direction of w about the unit vector h: 2 (w.h) h - w.
 inline glm::vec3 reflect_about(const glm::vec3& w, const glm::vec3& h) { return 2.0f * glm::dot(w, h) * h - w; }
 
-/// Concentric map of [0,1)^2 onto the unit disk (Shirley & Chiu 1997): area-preserving, and
-/// continuous, so stratification survives.
-inline glm::vec2 concentric_disk(const glm::vec2& u) {
-  const float a = 2.0f * u.x - 1.0f;
-  const float b = 2.0f * u.y - 1.0f;
-  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
-  float r = 0.0f;
-  float phi = 0.0f;
-  if (std::abs(a) > std::abs(b)) {
-    r = a;
-    phi = (kPi / 4.0f) * (b / a);
-  } else {
-    r = b;
-    phi = (kPi / 2.0f) - (kPi / 4.0f) * (a / b);
-  }
-  return {r * std::cos(phi), r * std::sin(phi)};
-}
-
-/// Cosine-weighted direction on the upper hemisphere (Malley's method); pdf = cos theta / pi.
-inline glm::vec3 sample_cosine_hemisphere(const glm::vec2& u) {
-  const glm::vec2 d = concentric_disk(u);
-  const float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
-  return {d.x, d.y, z};
-}
-
-inline float cosine_hemisphere_pdf(const glm::vec3& w) { return w.z > 0.0f ? w.z * kInvPi : 0.0f; }
+// The warps live in core/sampling.hpp, shared with the estimators and renderers.
+using detail::concentric_disk;
+using detail::cosine_hemisphere_pdf;
+inline glm::vec3 sample_cosine_hemisphere(const glm::vec2& u) { return detail::cosine_hemisphere(u); }
 
 /// Remaps u (in [0, 1)) that fell below `p` (or above it) back onto [0, 1) so that one uniform
 /// number both picks a lobe and drives that lobe's sampler.

@@ -7,13 +7,14 @@
 
 #include "radiosity/brdf.hpp"
 #include "radiosity/scene.hpp"
+#include "core/color.hpp"
 
 namespace radiosity {
 inline namespace v1 {
 
 namespace {
 
-float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
+using detail::max_channel;
 
 }  // namespace
 

@@ -39,13 +39,14 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include "core/frame.hpp"
+#include "core/sampling.hpp"
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
 #include "formfactor/estimators.hpp"
 #include "radiosity/brdf.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
-#include "geometry/hemisphere.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "scene/specular_transport.hpp"
@@ -532,7 +533,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     for (std::uint32_t i = count; i > 1; --i) std::swap(scratch.directions[i - 1], scratch.directions[rng.next() % i]);
     const glm::vec3 n = back ? -source.normal : source.normal;
     glm::vec3 t, b;
-    tangents(n, t, b);
+    tangent_frame(n, t, b);
     const Element& el = hierarchy_.element(from);
     std::array<glm::vec3, 4> corners{};
     for (int k = 0; k < el.corner_count(); ++k)
@@ -542,7 +543,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     // The first segments of all rays, traced as packets (they share an origin region).
     for (std::uint32_t r = 0; r < count; ++r) {
       scratch.origin[r] = sampler(scratch.points[r]) + epsilon_ * n;
-      const glm::vec3 local = cosine_direction(scratch.directions[r]);
+      const glm::vec3 local = cosine_hemisphere(scratch.directions[r]);
       scratch.dir[r] = local.x * t + local.y * b + local.z * n;
     }
     rays.scene.intersect(count, scratch.origin.data(), scratch.dir.data(), 0.0f, kInfinity, scratch.hits.data(),

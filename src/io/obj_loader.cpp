@@ -9,7 +9,6 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
-#include <cassert>
 #include <cfloat>
 #include <charconv>
 #include <cmath>
@@ -29,13 +28,15 @@
 #include "io/reader_warnings.hpp"
 #include "io/readers.hpp"
 #include "radiosity/brdf.hpp"
+#include "core/assert.hpp"
+#include "core/color.hpp"
+#include "core/constants.hpp"
 
 namespace radiosity::detail {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr float kPi = 3.14159265358979323846f;
 /// Largest diffuse + specular albedo an MTL material keeps; Ks is scaled down to fit (see below).
 constexpr float kMaxAlbedo = kMaxForgivenAlbedo;
 
@@ -253,8 +254,6 @@ Rgb clamped(const MtlInfo& info, std::string_view key, Rgb c, float upper, float
   }
   return out;
 }
-
-float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 /// f = (1 - w) first + w second with the two parts' albedos `a` and `b` kept (w = max b /
 /// (max a + max b)); `build_first(scale)` and `build_second(scale)` make the parts with their
@@ -639,7 +638,7 @@ Scene load_obj(const fs::path& path, const LoadOptions& options) {
     }
   }
   // Invariants of the scan agreeing with tinyobjloader (both read the same text).
-  assert(attrib.vertices.size() == 3 * scan.vertex_count);
+  RADIOSITY_ASSERT(attrib.vertices.size() == 3 * scan.vertex_count);
 
   Scene scene;
 
@@ -685,7 +684,7 @@ Scene load_obj(const fs::path& path, const LoadOptions& options) {
       vertices.clear();
       for (std::size_t k = 0; k < info.vertex_count; ++k) {
         const int v = shape.mesh.indices[corner + k].vertex_index;
-        assert(v >= 0 && static_cast<std::size_t>(v) < scan.vertex_count);  // check_corner() ensured it
+        RADIOSITY_ASSERT(v >= 0 && static_cast<std::size_t>(v) < scan.vertex_count);  // check_corner() ensured it
         const std::size_t o = 3 * static_cast<std::size_t>(v);
         vertices.emplace_back(attrib.vertices[o], attrib.vertices[o + 1], attrib.vertices[o + 2]);
       }

@@ -33,14 +33,16 @@
 #include "geometry/ray_scene.hpp"
 #include "radiosity/brdf.hpp"
 #include "render/camera.hpp"
+#include "core/color.hpp"
+#include "core/constants.hpp"
+#include "core/frame.hpp"
+#include "core/sampling.hpp"
 
 namespace radiosity {
 inline namespace v1 {
 
 namespace {
 
-constexpr float kPi = glm::pi<float>();
-constexpr float kInvPi = 1.0f / glm::pi<float>();
 /// Reflections a path has before Russian roulette may end it.
 constexpr int kRouletteStart = 3;
 /// Russian roulette never keeps a path with probability above this, so every path ends.
@@ -54,7 +56,9 @@ constexpr std::size_t kPathsPerBand = std::size_t{1} << 17;
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-float max_component(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
+using detail::kInvPi;
+using detail::kPi;
+float max_component(const Rgb& c) { return detail::max_channel(c); }
 
 /// Power heuristic with exponent 2 (Veach 1997, eq. 9.13) for one sample of each strategy.
 float power_heuristic(float pdf_this, float pdf_other) {
@@ -309,12 +313,10 @@ class PathTracer {
         }
 
         // Cosine-weighted bounce: f cos / pdf = (rho/pi) cos / (cos/pi) = rho.
-        const glm::vec2 u = rng.uniform2();
-        const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-        const float cz = std::sqrt(std::max(0.0f, 1.0f - u.x));
+        const glm::vec3 l = detail::cosine_hemisphere_polar(rng.uniform2());
         glm::vec3 t, b;
-        basis(n, t, b);
-        dir = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + cz * n);
+        detail::tangent_frame(n, t, b);
+        dir = glm::normalize(l.x * t + l.y * b + l.z * n);
         prev_pdf = std::max(glm::dot(n, dir), 0.0f) * kInvPi;
         prev_delta = false;
         beta *= sh.reflectance;
@@ -347,7 +349,7 @@ class PathTracer {
     // surface. Unflipped, z > 0 is the front, whose medium has index 1 (the dielectric's "above").
     ShadingFrame frame;
     frame.normal = (!front && sh.two_sided) ? -s.normal : s.normal;
-    basis(frame.normal, frame.tangent, frame.bitangent);
+    detail::tangent_frame(frame.normal, frame.tangent, frame.bitangent);
     const glm::vec3 wo = frame.to_local(-dir);
     const bool model_on = wo.z > 0.0f || !sh.model_one_sided;
     const float p_translucent = sh.translucent_share > 0.0f ? (model_on ? sh.translucent_share : 1.0f) : 0.0f;
@@ -385,10 +387,9 @@ class PathTracer {
     const bool pick_translucent =
         p_translucent >= 1.0f || (p_translucent > 0.0f && rng.uniform() < p_translucent);
     if (pick_translucent) {
-      const glm::vec2 u = rng.uniform2();
-      const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-      const float cz = std::sqrt(std::max(0.0f, 1.0f - u.x));
-      wi = glm::vec3(r * std::cos(phi), r * std::sin(phi), wo.z > 0.0f ? -cz : cz);
+      const glm::vec3 l = detail::cosine_hemisphere_polar(rng.uniform2());
+      const float cz = l.z;
+      wi = glm::vec3(l.x, l.y, wo.z > 0.0f ? -cz : cz);
       const Rgb f = sh.translucency * kInvPi + (model_on ? sh.model->eval(wo, wi) : Rgb(0.0f));
       pdf = p_translucent * cz * kInvPi + (model_on ? (1.0f - p_translucent) * sh.model->pdf(wo, wi) : 0.0f);
       if (!(pdf > 0.0f)) return false;
@@ -556,15 +557,6 @@ class PathTracer {
     const float pdf_light = light.light_pdf_area * d2 / cos_y / static_cast<float>(mirrors_.size());
     return f * m.reflectance * light.emission *
            (kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
-  }
-
-  /// Orthonormal t, b completing the unit normal n (Duff et al. 2017).
-  static void basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
-    const float sign = std::copysign(1.0f, n.z);
-    const float a = -1.0f / (sign + n.z);
-    const float c = n.x * n.y * a;
-    t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
-    b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
   }
 
   const PathTraceOptions& options_;

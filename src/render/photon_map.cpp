@@ -21,25 +21,24 @@
 
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
+#include "core/color.hpp"
+#include "core/constants.hpp"
+#include "core/sampling.hpp"
 
 namespace radiosity::detail {
 
 namespace {
 
-constexpr float kPi = glm::pi<float>();
 /// Photons traced per parallel work item; the blocks (not the threads) fix the storage order.
 constexpr std::size_t kPhotonBlock = 2048;
 /// Photons count for an estimate only on surfaces within about 25 degrees of the query's normal.
 constexpr float kMinNormalCosine = 0.9f;
 
-float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 /// Cosine-weighted direction about the unit normal n (Malley's method).
 glm::vec3 cosine_direction(const glm::vec3& n, const glm::vec2& u) {
   const ShadingFrame frame = ShadingFrame::from_normal(n);
-  const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-  const float z = std::sqrt(std::max(0.0f, 1.0f - u.x));
-  return glm::normalize(frame.to_world(glm::vec3(r * std::cos(phi), r * std::sin(phi), z)));
+  return glm::normalize(frame.to_world(cosine_hemisphere_polar(u)));
 }
 
 /// Traces photon `index` and appends its landings to `out`.

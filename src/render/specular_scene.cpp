@@ -17,12 +17,12 @@
 #include <glm/gtc/constants.hpp>
 
 #include "scene/specular_transport.hpp"
+#include "core/color.hpp"
 
 namespace radiosity::detail {
 
 namespace {
 
-float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 }  // namespace
 

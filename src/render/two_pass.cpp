@@ -31,13 +31,16 @@
 #include "render/camera.hpp"
 #include "render/photon_map.hpp"
 #include "render/specular_scene.hpp"
+#include "core/color.hpp"
+#include "core/constants.hpp"
 
 namespace radiosity {
 inline namespace v1 {
 
 namespace {
 
-constexpr float kInvPi = 1.0f / glm::pi<float>();
+using detail::kInvPi;
+using detail::max_channel;
 /// Rows per band: progress and cancel are checked between bands.
 constexpr int kBandRows = 16;
 /// Delta events with two branches (glass) are split into both for the first this many events of
@@ -52,7 +55,6 @@ const char* const kLayerNames[kLayers] = {"direct", "indirect", "specular", "cau
 }
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-float max_channel(const Rgb& c) { return std::max(c.x, std::max(c.y, c.z)); }
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

@@ -15,9 +15,10 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include "core/frame.hpp"
+#include "core/sampling.hpp"
 #include "detail/parallel.hpp"
 #include "detail/rng.hpp"
-#include "geometry/hemisphere.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 
@@ -74,7 +75,7 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads) {
       const Polygon& polygon = polygons[out[k].polygon];
       const PolygonFan fan(polygon.vertices);
       glm::vec3 t, b;
-      tangents(polygon.normal, t, b);
+      tangent_frame(polygon.normal, t, b);
       Rng rng(kSeed, out[k].polygon);
       std::iota(order.begin(), order.end(), 0u);
       for (std::size_t i = rays - 1; i > 0; --i) std::swap(order[i], order[rng.next() % (i + 1)]);
@@ -86,7 +87,7 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads) {
       };
       for (std::size_t i = 0; i < rays; ++i) {
         origin[i] = fan.sample(stratum(i)) + lift * polygon.normal;
-        const glm::vec3 d = cosine_direction(stratum(order[i]));
+        const glm::vec3 d = cosine_hemisphere(stratum(order[i]));
         dir[i] = d.x * t + d.y * b + d.z * polygon.normal;
       }
       rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());

@@ -5,10 +5,10 @@
 #pragma once
 
 #include "radiosity/scene.hpp"
+#include "core/color.hpp"
 
 namespace radiosity::detail {
 
-inline float channel_mean(const Rgb& c) { return (c.x + c.y + c.z) / 3.0f; }
 
 /// The mean reflectance with which pass 1 reflects off `m` as an ideal mirror, or 0: the
 /// material's specular part when it is ideal (specular_exponent 0). Glossy lobes are not
