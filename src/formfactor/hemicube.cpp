@@ -33,6 +33,7 @@
 #include "formfactor/estimators.hpp"
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity::detail {
 
@@ -378,7 +379,7 @@ class HemicubeEstimator final : public FormFactorEstimator {
     f.polygon = patch.polygon;
     const glm::vec3 helper = std::fabs(f.n.x) < 0.6f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
     const glm::vec3 u = glm::normalize(glm::cross(helper, f.n)), v = glm::cross(f.n, u);
-    Rng rng(options_.seed, e, (back ? 0x5e3cc0beull : 0x4e3cc0beull) + s);
+    Rng rng(options_.seed, e, stream_key(back ? Stream::hemicube_back : Stream::hemicube_front, s));
     const float phi = static_cast<float>(kTwoPi) * rng.uniform();
     f.t1 = std::cos(phi) * u + std::sin(phi) * v;
     f.t2 = glm::cross(f.n, f.t1);

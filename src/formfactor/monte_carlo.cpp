@@ -50,6 +50,7 @@
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "scene/specular_transport.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity::detail {
 
@@ -324,7 +325,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         // Everything else: the hit fractions of the rays.
         const std::uint32_t e = elements[k];
         const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
-        Rng rng(options_.seed, e, back ? 0x600000000ull : 0x300000000ull);
+        Rng rng(options_.seed, e, stream_key(back ? Stream::monte_carlo_back_row : Stream::monte_carlo_row));
         shoot(*rays, e, source, back, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
           // Emitting patches reached directly are in the exact part (unless left to the rays for
           // this element), through glass in the photon map.
@@ -418,7 +419,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         return 1.0;
     }
     const CellSampler sampler(corners.data(), el.corner_count());
-    Rng rng(options_.seed, e, (back ? 0x700000000ull : 0x500000000ull) + light);
+    Rng rng(options_.seed, e, stream_key(back ? Stream::monte_carlo_back_light : Stream::monte_carlo_light, light));
     std::array<glm::vec2, 256> from, to;
     double weight = 0.0, clear_weight = 0.0;
     std::uint32_t clear = 0, blocked = 0;
@@ -477,7 +478,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       Scratch scratch(kChunk);
       for (std::size_t c = begin; c < end; ++c) {
         const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunk, total - c * kChunk));
-        Rng rng(options_.seed, target, 0x400000000ull + c);
+        Rng rng(options_.seed, target, stream_key(Stream::monte_carlo_column, c));
         shoot(rays, root, source, back, count, rng, scratch,
               [&](std::uint32_t leaf, std::uint32_t j, float w, Path path) {
                 if (position[leaf] == kNone) return;

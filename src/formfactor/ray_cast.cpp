@@ -36,6 +36,7 @@
 #include "formfactor/sampling.hpp"
 #include "formfactor/shaft.hpp"
 #include "geometry/ray_scene.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -388,7 +389,7 @@ class SampledEstimator final : public FormFactorEstimator {
     const PatchCorners& poly = corners_[to.patch];
     const glm::vec3 nx = s.normal, ny = to.normal;
     const std::uint32_t ns = options_.source_samples, nv = options_.visibility_rays;
-    Rng rng(options_.seed, s.element, (s.back ? 0x180000000ull : 0x100000000ull) + to.target);
+    Rng rng(options_.seed, s.element, stream_key(s.back ? Stream::ray_cast_back : Stream::ray_cast_front, to.target));
     RayBatch& batch = ray_batch();
     // A pass of about `budget` rays: S = g^2 stratified source points, T = h^2 rays from each
     // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays. All rays of a pass

@@ -37,6 +37,7 @@
 #include "core/constants.hpp"
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -226,7 +227,7 @@ class PathTracer {
   /// Box-filtered mean of g x g jittered paths through the pixel, from the pixel's own stream.
   Rgb pixel(int x, int y) const {
     const std::uint64_t index = static_cast<std::uint64_t>(y) * options_.width + x;
-    detail::Rng rng(options_.seed, index, 0x9a7b'0001ull);
+    detail::Rng rng(options_.seed, index, detail::stream_key(detail::Stream::path));
     double sum[3] = {0.0, 0.0, 0.0};
     for (int j = 0; j < g_; ++j)
       for (int i = 0; i < g_; ++i) {

@@ -24,6 +24,7 @@
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/sampling.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity::detail {
 
@@ -44,7 +45,7 @@ glm::vec3 cosine_direction(const glm::vec3& n, const glm::vec2& u) {
 /// Traces photon `index` and appends its landings to `out`.
 void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth, std::uint64_t seed,
                   std::size_t index, std::vector<Photon>& out) {
-  Rng rng(seed, index, 0xca05'7100ull);
+  Rng rng(seed, index, stream_key(Stream::photon));
   const float u_emitter = rng.uniform();
   const glm::vec2 u_point = rng.uniform2();
   const EmitterSample y = scene.sample_emitter(u_emitter, u_point);

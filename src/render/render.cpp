@@ -16,6 +16,7 @@
 #include "geometry/ray_scene.hpp"
 #include "radiosity/render.hpp"
 #include "render/camera.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -82,7 +83,8 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
     detail::parallel_for(options.threads, count, 64, [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         const int x = static_cast<int>(k % options.width), y = y0 + static_cast<int>(k / options.width);
-        detail::Rng rng(options.seed, static_cast<std::uint64_t>(y) * options.width + x, 0x7e11);
+        detail::Rng rng(options.seed, static_cast<std::uint64_t>(y) * options.width + x,
+                        detail::stream_key(detail::Stream::pixel_jitter));
         Rgb sum(0.0f);
         for (int i = 0; i < g; ++i)
           for (int j = 0; j < g; ++j) {

@@ -33,6 +33,7 @@
 #include "render/specular_scene.hpp"
 #include "core/color.hpp"
 #include "core/constants.hpp"
+#include "core/streams.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -135,7 +136,7 @@ class TwoPassRenderer {
         const detail::SplitSurface& s = scene_.surface(scene_.polygon_of_element(e));
         Rgb H(0.0f);
         if (max_channel(s.diffuse) > 0.0f && scene_.has_emitters()) {
-          detail::Rng rng(options_.seed, e, 0xd1ec'7000ull);
+          detail::Rng rng(options_.seed, e, detail::stream_key(detail::Stream::two_pass_direct));
           auto uniform = [&rng] { return rng.uniform(); };
           for (int a = 0; a < n; ++a)
             for (int b = 0; b < n; ++b) {
@@ -313,8 +314,8 @@ class TwoPassRenderer {
   /// and in the same order as render(), so a scene without specular parts gives its pixels.
   Radiance pixel(int x, int y) const {
     const std::uint64_t index = static_cast<std::uint64_t>(y) * options_.width + x;
-    detail::Rng rng(options_.seed, index, 0x7e11);
-    detail::Rng path_rng(options_.seed, index, 0x2a55'0001ull);
+    detail::Rng rng(options_.seed, index, detail::stream_key(detail::Stream::pixel_jitter));
+    detail::Rng path_rng(options_.seed, index, detail::stream_key(detail::Stream::two_pass_path));
     const int count = g_ * g_;
     const int lookups = std::min(count, options_.caustics.lookups_per_pixel);
     Strata strata{0, count, path_rng.uniform(), 0.0f};
