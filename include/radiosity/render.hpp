@@ -46,6 +46,10 @@ struct RenderOptions {
   ProgressFn on_progress;
 };
 
+/// Checks options; throws Error{invalid_argument} naming the first bad field (width, height,
+/// spp, or the camera as validate(PathTraceOptions) checks it). Thread safety: pure function.
+RADIOSITY_API void validate(const RenderOptions& options);
+
 /// Ray-casts the solution: each camera ray shows the interpolated vertex radiosity / pi of the
 /// element it hits (Gouraud-style, continuous across elements). Deterministic for a seed at any
 /// thread count. Throws Error{invalid_argument} for a non-positive size or spp, or a solution

@@ -38,6 +38,7 @@
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
+#include "core/camera_check.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -55,7 +56,6 @@ constexpr std::size_t kPathsPerBand = std::size_t{1} << 17;
   throw Error(ErrorCode::invalid_argument, "PathTraceOptions::" + what);
 }
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 using detail::kInvPi;
 using detail::kPi;
@@ -582,15 +582,8 @@ void validate(const PathTraceOptions& options) {
   if (options.max_depth < 0)
     bad_option("max_depth must be >= 0 (0 = unlimited), got " + std::to_string(options.max_depth));
   if (options.camera) {
-    const Camera& c = *options.camera;
-    if (!finite(c.eye) || !finite(c.look_at) || !finite(c.up)) bad_option("camera: eye, look_at and up must be finite");
-    if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f))
-      bad_option("camera.fov_deg must be in (0, 180), got " + std::to_string(c.fov_deg));
-    const glm::vec3 forward = c.look_at - c.eye;
-    const float length = glm::length(forward);
-    if (!(length > 0.0f)) bad_option("camera.look_at must differ from camera.eye");
-    if (!(glm::length(glm::cross(forward / length, c.up)) > 1e-6f * glm::length(c.up)))
-      bad_option("camera.up must be non-zero and not parallel to the view direction");
+    const std::string problem = detail::camera_problem(*options.camera);
+    if (!problem.empty()) bad_option(problem);
   }
 }
 

@@ -16,17 +16,26 @@
 #include "geometry/ray_scene.hpp"
 #include "radiosity/render.hpp"
 #include "render/camera.hpp"
+#include "core/camera_check.hpp"
 #include "core/streams.hpp"
 
 namespace radiosity {
 inline namespace v1 {
 
-Image render(const Scene& scene, const Solution& solution, const RenderOptions& options) {
+void validate(const RenderOptions& options) {
   if (options.width <= 0 || options.height <= 0)
     throw Error(ErrorCode::invalid_argument, "render: width and height must be > 0, got " +
                                                  std::to_string(options.width) + "x" + std::to_string(options.height));
   if (options.spp <= 0)
     throw Error(ErrorCode::invalid_argument, "render: spp must be > 0, got " + std::to_string(options.spp));
+  if (options.camera) {
+    const std::string problem = detail::camera_problem(*options.camera);
+    if (!problem.empty()) throw Error(ErrorCode::invalid_argument, "render: " + problem);
+  }
+}
+
+Image render(const Scene& scene, const Solution& solution, const RenderOptions& options) {
+  validate(options);
   const PatchHierarchy& hierarchy = solution.hierarchy();
   for (const Patch& p : hierarchy.patches())
     if (p.polygon >= scene.polygons().size())

@@ -34,6 +34,7 @@
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/streams.hpp"
+#include "core/camera_check.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -55,7 +56,6 @@ const char* const kLayerNames[kLayers] = {"direct", "indirect", "specular", "cau
   throw Error(ErrorCode::invalid_argument, "TwoPassOptions::" + what);
 }
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -369,15 +369,8 @@ void validate(const TwoPassOptions& options) {
   if (!std::isfinite(c.max_radius) || c.max_radius < 0.0f)
     bad_option("caustics.max_radius must be finite and >= 0, got " + std::to_string(c.max_radius));
   if (options.camera) {
-    const Camera& cam = *options.camera;
-    if (!finite(cam.eye) || !finite(cam.look_at) || !finite(cam.up)) bad_option("camera: eye, look_at and up must be finite");
-    if (!(cam.fov_deg > 0.0f && cam.fov_deg < 180.0f))
-      bad_option("camera.fov_deg must be in (0, 180), got " + std::to_string(cam.fov_deg));
-    const glm::vec3 forward = cam.look_at - cam.eye;
-    const float length = glm::length(forward);
-    if (!(length > 0.0f)) bad_option("camera.look_at must differ from camera.eye");
-    if (!(glm::length(glm::cross(forward / length, cam.up)) > 1e-6f * glm::length(cam.up)))
-      bad_option("camera.up must be non-zero and not parallel to the view direction");
+    const std::string problem = detail::camera_problem(*options.camera);
+    if (!problem.empty()) bad_option(problem);
   }
 }
 

@@ -11,6 +11,7 @@
 
 #include "radiosity/version.hpp"
 #include "scene/polygon_math.hpp"
+#include "core/camera_check.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -133,15 +134,8 @@ PolygonRange Scene::add_polygon(const std::vector<glm::vec3>& vertices, Material
 }
 
 void Scene::set_camera(const Camera& camera) {
-  auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  if (!finite3(camera.eye) || !finite3(camera.look_at) || !finite3(camera.up))
-    throw Error(ErrorCode::invalid_argument, "camera: eye, look_at and up must be finite");
-  if (glm::length(camera.look_at - camera.eye) <= 0.0f)
-    throw Error(ErrorCode::invalid_argument, "camera: look_at must differ from eye");
-  if (glm::length(glm::cross(camera.look_at - camera.eye, camera.up)) <= 0.0f)
-    throw Error(ErrorCode::invalid_argument, "camera: up must not be parallel to the view direction");
-  if (!(camera.fov_deg > 0.0f && camera.fov_deg < 180.0f))
-    throw Error(ErrorCode::invalid_argument, "camera: fov_deg must be in (0, 180)");
+  const std::string problem = detail::camera_problem(camera);
+  if (!problem.empty()) throw Error(ErrorCode::invalid_argument, problem);
   camera_ = camera;
 }
 

@@ -74,3 +74,36 @@ TEST_SUITE("render") {
     CHECK_THROWS_AS(rad::render(scene, other, ro), rad::Error);
   }
 }
+
+TEST_SUITE("render") {
+  TEST_CASE("one camera check: Scene::set_camera and the three renderers refuse the same cameras with the same words") {
+    const radiosity::Scene scene = radiosity::cornell_box();
+    radiosity::Camera ok = scene.camera();
+    const struct {
+      radiosity::Camera camera;
+      const char* words;
+    } bad[] = {
+        {radiosity::Camera{ok.eye, ok.eye, ok.up, ok.fov_deg}, "camera.look_at must differ from camera.eye"},
+        {radiosity::Camera{ok.eye, ok.look_at, ok.look_at - ok.eye, ok.fov_deg}, "camera.up must be non-zero"},
+        {radiosity::Camera{ok.eye, ok.look_at, ok.up, 180.0f}, "camera.fov_deg must be in (0, 180)"},
+        {radiosity::Camera{glm::vec3(NAN), ok.look_at, ok.up, ok.fov_deg}, "camera: eye, look_at and up must be finite"},
+    };
+    for (const auto& b : bad) {
+      CAPTURE(std::string(b.words));
+      radiosity::Scene s = scene;
+      CHECK_THROWS_WITH_AS(s.set_camera(b.camera), doctest::Contains(b.words), radiosity::Error);
+      radiosity::RenderOptions ro;
+      ro.camera = b.camera;
+      CHECK_THROWS_WITH_AS(radiosity::validate(ro), doctest::Contains(b.words), radiosity::Error);
+      radiosity::PathTraceOptions po;
+      po.camera = b.camera;
+      CHECK_THROWS_WITH_AS(radiosity::validate(po), doctest::Contains(b.words), radiosity::Error);
+      radiosity::TwoPassOptions to;
+      to.camera = b.camera;
+      CHECK_THROWS_WITH_AS(radiosity::validate(to), doctest::Contains(b.words), radiosity::Error);
+    }
+    radiosity::RenderOptions ro;
+    ro.camera = ok;
+    CHECK_NOTHROW(radiosity::validate(ro));
+  }
+}
