@@ -46,7 +46,9 @@ struct SolveOptions {
   double tolerance = 1e-3;
   /// Sweeps (matrix) or shooting steps (progressive) at most; 0 = 1000 sweeps / 100 x patches steps.
   int max_iterations = 0;
-  unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
+  /// 0 = all hardware threads; 1 = the calling thread only. Also the estimator's, unless
+  /// form_factors.threads is set (non-zero) itself.
+  unsigned threads = 0;
   std::uint64_t seed = 1;        ///< overrides form_factors.seed
   /// Largest form-factor matrix the matrix methods may allocate, in bytes; 0 = 4 GiB.
   std::size_t memory_budget_bytes = 0;

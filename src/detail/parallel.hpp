@@ -1,5 +1,7 @@
-// Thread-count control shared by the modules: work runs in a oneTBB arena limited to the
-// requested number of threads, so concurrent calls with different settings do not interfere.
+// Thread-count control shared by the modules: with a thread count of 0 work runs in the
+// caller's oneTBB arena (all hardware threads, shared with the host's own TBB work, and no
+// arena to create per call); with an explicit count in an arena of its own limited to it, so
+// concurrent calls with different settings do not interfere.
 #pragma once
 
 #include <algorithm>
@@ -27,11 +29,16 @@ void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const 
     body(std::size_t{0}, count);
     return;
   }
-  tbb::task_arena arena(n);
-  arena.execute([&] {
+  auto run = [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, std::max<std::size_t>(grain, 1)),
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
-  });
+  };
+  if (threads == 0) {
+    run();
+    return;
+  }
+  tbb::task_arena arena(n);
+  arena.execute(run);
 }
 
 }  // namespace radiosity::detail

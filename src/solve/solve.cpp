@@ -63,7 +63,8 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
       break;
     }
   o.form_factors.seed = o.seed;
-  o.form_factors.threads = o.threads;
+  // The estimator inherits the solve's thread count unless it was given one of its own.
+  if (o.form_factors.threads == 0) o.form_factors.threads = o.threads;
 
   detail::ProgressGate gate(o.on_progress);
   SolveReport report;
