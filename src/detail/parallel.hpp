@@ -34,7 +34,9 @@ void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const 
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
   };
   if (threads == 0) {
-    run();
+    // Isolated, as an arena of its own would be: while it waits for its chunks a thread takes
+    // no unrelated outer task (which could need a lock the caller holds).
+    tbb::this_task_arena::isolate(run);
     return;
   }
   tbb::task_arena arena(n);
