@@ -72,8 +72,8 @@ RADIOSITY_API void validate(const PathTraceOptions& options);
 /// scales divided out. Pixels use counter-based random streams keyed by (seed, pixel), so the
 /// image is bit-identical at any thread count. A scene without emitters renders black.
 ///
-/// Cost: about two rays per scattering event; the 64 x 64 Cornell box at 1024 spp (4 M paths)
-/// takes about 4 s on 2 free cores (Release). Noise falls as 1/sqrt(spp): the same image has
+/// Cost: about two rays per scattering event (timings in docs/PATH_TRACER.md). Noise falls as
+/// 1/sqrt(spp): the 64 x 64 Cornell box has
 /// about 2.5 % relative RMSE at 1024 spp and 0.25 % at 65536; the mirror and glass Cornell boxes
 /// (cornell_box_specular()) have about 2.6 % and 6 % at 1024 spp (the glass box's caustics).
 ///
