@@ -12,6 +12,7 @@
 
 #include "formfactor/estimators.hpp"
 #include "radiosity/form_factors.hpp"
+#include "core/progress.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -79,15 +80,14 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   std::vector<std::uint32_t> batch;
   // Progress: at the start, at the end, and in between at most every 100 ms; a false return
   // stops after the current chunk.
-  auto last_report = std::chrono::steady_clock::now();
-  auto report = [&](double fraction) {
-    if (!options.on_progress) return true;
+  detail::ProgressGate gate(options.on_progress);
+  auto report = [&](double fraction, bool force) {
     Progress p;
     p.phase = Phase::form_factors;
     p.fraction = fraction;
-    return options.on_progress(p);
+    return gate.report(p, force);
   };
-  result.cancelled = !report(0.0);
+  result.cancelled = !report(0.0, true);
   for (std::size_t begin = 0; begin < sources.size() && !result.cancelled; begin += chunk) {
     const std::size_t end = std::min(sources.size(), begin + chunk);
     batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(begin),
@@ -101,11 +101,7 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
       for (std::size_t j = 0; j < n; ++j)
         if (column[j] != kNone) out[column[j]] += static_cast<double>(el.area) * static_cast<double>(row[j]);
     }
-    const auto now = std::chrono::steady_clock::now();
-    if (end == sources.size() || now - last_report >= std::chrono::milliseconds(100)) {
-      last_report = now;
-      result.cancelled = !report(static_cast<double>(end) / static_cast<double>(sources.size()));
-    }
+    result.cancelled = !report(static_cast<double>(end) / static_cast<double>(sources.size()), end == sources.size());
   }
 
   result.factors.assign(G * G, 0.0);

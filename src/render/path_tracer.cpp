@@ -39,6 +39,7 @@
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
 #include "core/camera_check.hpp"
+#include "core/progress.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -177,6 +178,7 @@ class PathTracer {
     const int band = static_cast<int>(std::max<std::size_t>(1, kPathsPerBand / paths_per_row));
     const std::size_t grain = std::max<std::size_t>(1, 1024 / (static_cast<std::size_t>(g_) * g_));
     // Bands of rows: parallel inside a band, progress and cancel between bands on this thread.
+    detail::ProgressGate gate(options_.on_progress);
     for (int y0 = 0; y0 < options_.height; y0 += band) {
       const int y1 = std::min(options_.height, y0 + band);
       const std::size_t count = static_cast<std::size_t>(y1 - y0) * options_.width;
@@ -186,10 +188,8 @@ class PathTracer {
           image.at(x, y) = pixel(x, y);
         }
       });
-      if (options_.on_progress) {
-        Progress progress{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
-        if (!options_.on_progress(progress)) break;
-      }
+      const Progress progress{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
+      if (!gate.report(progress, y1 == options_.height)) break;
     }
     return image;
   }

@@ -18,6 +18,7 @@
 #include "render/camera.hpp"
 #include "core/camera_check.hpp"
 #include "core/streams.hpp"
+#include "core/progress.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -86,6 +87,7 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
   // Bands of rows: parallel inside a band, progress and cancel between bands, so the callback
   // runs on this thread. Each pixel has its own random stream: thread count does not matter.
   const int band = 16;
+  detail::ProgressGate gate(options.on_progress);
   for (int y0 = 0; y0 < options.height; y0 += band) {
     const int y1 = std::min(options.height, y0 + band);
     const std::size_t count = static_cast<std::size_t>(y1 - y0) * options.width;
@@ -105,10 +107,8 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
         image.at(x, y) = sum / static_cast<float>(g * g);
       }
     });
-    if (options.on_progress) {
-      Progress p{Phase::rendering, static_cast<double>(y1) / options.height, 0, 0.0};
-      if (!options.on_progress(p)) break;
-    }
+    const Progress p{Phase::rendering, static_cast<double>(y1) / options.height, 0, 0.0};
+    if (!gate.report(p, y1 == options.height)) break;
   }
   return image;
 }

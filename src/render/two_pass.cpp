@@ -35,6 +35,7 @@
 #include "core/constants.hpp"
 #include "core/streams.hpp"
 #include "core/camera_check.hpp"
+#include "core/progress.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -99,6 +100,7 @@ class TwoPassRenderer {
     Image image(options_.width, options_.height);
     std::vector<Rgb> layers[kLayers];
     for (auto& l : layers) l.assign(image.pixels.size(), Rgb(0.0f));
+    detail::ProgressGate gate(options_.on_progress);
     for (int y0 = 0; y0 < options_.height; y0 += kBandRows) {
       const int y1 = std::min(options_.height, y0 + kBandRows);
       const std::size_t count = static_cast<std::size_t>(y1 - y0) * options_.width;
@@ -111,10 +113,8 @@ class TwoPassRenderer {
           image.pixels[at] = r.layer[kDirect] + r.layer[kIndirect] + r.layer[kSpecular] + r.layer[kCaustic];
         }
       });
-      if (options_.on_progress) {
-        Progress p{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
-        if (!options_.on_progress(p)) break;
-      }
+      const Progress p{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
+      if (!gate.report(p, y1 == options_.height)) break;
     }
     for (int l = 0; l < kLayers; ++l) image.layers.emplace_back(kLayerNames[l], std::move(layers[l]));
     return image;

@@ -55,19 +55,4 @@ void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& p
   for (std::size_t j = 0; j < sum.size(); ++j) patch_B[j] = Rgb(sum[j] / static_cast<double>(patch_area[j]));
 }
 
-bool ProgressGate::due(Phase phase, bool force) const {
-  if (!fn_) return false;
-  // Phase boundaries always get through; within a phase at most one call per 100 ms.
-  return force || first_ || phase != phase_ || std::chrono::steady_clock::now() - last_ >= std::chrono::milliseconds(100);
-}
-
-bool ProgressGate::report(const Progress& p, bool force) {
-  if (!due(p.phase, force)) return true;
-  auto now = std::chrono::steady_clock::now();
-  first_ = false;
-  phase_ = p.phase;
-  last_ = now;
-  return fn_(p);
-}
-
 }  // namespace radiosity::detail

@@ -10,6 +10,7 @@
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 #include "radiosity/solver.hpp"
+#include "core/progress.hpp"
 
 namespace radiosity::detail {
 
@@ -71,23 +72,6 @@ struct SolverResult {
   std::vector<double> residual_history, time_history;
   std::size_t form_factor_bytes = 0;
   double seconds_form_factors = 0.0;
-};
-
-/// Rate-limited progress reporting on the calling thread. report() returns false when the
-/// callback asked to cancel.
-class ProgressGate {
- public:
-  explicit ProgressGate(const ProgressFn& fn) : fn_(fn) {}
-  bool report(const Progress& p, bool force = false);
-  /// Whether report() would call the callback now: lets a caller skip building an expensive
-  /// Progress that would be dropped.
-  bool due(Phase phase, bool force = false) const;
-
- private:
-  const ProgressFn& fn_;
-  std::chrono::steady_clock::time_point last_{};
-  Phase phase_ = Phase::meshing;
-  bool first_ = true;
 };
 
 struct SolverContext {

@@ -1,6 +1,8 @@
 #include <doctest/doctest.h>
 
+#include <chrono>
 #include <cmath>
+#include <vector>
 
 #include <radiosity/radiosity.hpp>
 
@@ -105,5 +107,51 @@ TEST_SUITE("render") {
     radiosity::RenderOptions ro;
     ro.camera = ok;
     CHECK_NOTHROW(radiosity::validate(ro));
+  }
+}
+
+TEST_SUITE("render") {
+  TEST_CASE("renderers report progress as common.hpp promises: at most every 100 ms and once at the end") {
+    const radiosity::Scene scene = radiosity::cornell_box();
+    radiosity::SolveOptions so;
+    so.mesh.max_patch_area = 40000.0f;
+    const radiosity::Solution sol = radiosity::solve(scene, so);
+    std::vector<std::chrono::steady_clock::time_point> when;
+    std::vector<double> fraction;
+    const radiosity::ProgressFn record = [&](const radiosity::Progress& p) {
+      when.push_back(std::chrono::steady_clock::now());
+      fraction.push_back(p.fraction);
+      return true;
+    };
+    auto check = [&](const char* renderer) {
+      CAPTURE(std::string(renderer));
+      REQUIRE(!when.empty());
+      CHECK(fraction.back() == doctest::Approx(1.0));
+      // Between the first report and the forced last one, calls are 100 ms apart at least
+      // (the display renders its 32 bands of rows in well under that: ungated, it would call
+      // back for each).
+      for (std::size_t k = 1; k + 1 < when.size(); ++k)
+        CHECK(std::chrono::duration<double>(when[k] - when[k - 1]).count() >= 0.099);
+      when.clear();
+      fraction.clear();
+    };
+    radiosity::RenderOptions ro;  // 512 x 512: 32 bands
+    ro.on_progress = record;
+    radiosity::render(scene, sol, ro);
+    check("render");
+    radiosity::PathTraceOptions po;
+    po.width = 64;
+    po.height = 64;
+    po.spp = 16;
+    po.on_progress = record;
+    radiosity::render_path_traced(scene, po);
+    check("path");
+    radiosity::TwoPassOptions to;
+    to.width = 64;
+    to.height = 64;
+    to.spp = 1;
+    to.on_progress = record;
+    radiosity::render_two_pass(scene, sol, to);
+    check("two-pass");
   }
 }
