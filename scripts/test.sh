@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite on a fresh Debian 12 machine: install dependencies, build with warnings as
 # errors, run every test (including the installed-package consumer), then build again with
-# AddressSanitizer + UndefinedBehaviorSanitizer and run the unit tests once more.
+# AddressSanitizer + UndefinedBehaviorSanitizer and run the unit tests and the CLI tests once more
+# (the tools are built there too: about two more minutes of compiling on two cores).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"
@@ -15,7 +16,7 @@ ctest --test-dir build --output-on-failure -j"$jobs"
 
 echo "== build (ASan + UBSan) =="
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRADIOSITY_WERROR=ON -DRADIOSITY_SANITIZE=ON \
-  -DRADIOSITY_BUILD_EXAMPLES=OFF -DRADIOSITY_BUILD_BENCHMARKS=OFF
+  -DRADIOSITY_BUILD_TOOLS=ON -DRADIOSITY_BUILD_EXAMPLES=OFF -DRADIOSITY_BUILD_BENCHMARKS=OFF
 cmake --build build-sanitize -j"$jobs"
 echo "== tests under ASan + UBSan =="
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

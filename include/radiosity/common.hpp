@@ -69,10 +69,6 @@ struct Progress {
 /// boundaries and at most about every 100 ms. Return false to cancel.
 using ProgressFn = std::function<bool(const Progress&)>;
 
-/// Non-fatal diagnostics (a polygon triangulated, a value clamped).
-enum class Severity { info, warning };
-using MessageFn = std::function<void(Severity, std::string_view)>;
-
 /// Version of the library binary, e.g. "0.1.0". Compare with RADIOSITY_VERSION_STRING from
 /// <radiosity/version.hpp> to detect a header/binary mismatch.
 RADIOSITY_API const char* version() noexcept;

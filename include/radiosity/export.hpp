@@ -13,9 +13,3 @@
 #else
 #define RADIOSITY_API __attribute__((visibility("default")))
 #endif
-
-/// Marks algorithms whose interface may still change in a minor release. Consumers may define
-/// RADIOSITY_EXPERIMENTAL as [[deprecated("experimental")]] to be told where they use one.
-#ifndef RADIOSITY_EXPERIMENTAL
-#define RADIOSITY_EXPERIMENTAL
-#endif

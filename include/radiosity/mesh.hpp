@@ -89,7 +89,9 @@ class RADIOSITY_API PatchHierarchy {
   std::uint32_t subdivide(std::uint32_t element);
 
   /// Point on an element for (u, v) in [0,1]^2, uniformly distributed over its area when (u, v)
-  /// is uniform (quads are split into two triangles in proportion to their areas).
+  /// is uniform. A quad's point is its bilinear map at (s, t), with (u, v) warped through the
+  /// inverse CDFs of the map's Jacobian (the marginal in s, then the conditional in t), so
+  /// stratified (u, v) stay stratified on the quad.
   glm::vec3 sample_point(std::uint32_t element, glm::vec2 uv) const;
 
   /// Per-vertex values for smooth display from per-element values (indexed by element id; only

@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "../../examples/cli/factors_format.hpp"
+#include "../../tools/radiosity/factors_format.hpp"
 #include "formfactor/ff_support.hpp"
 #include "support/scenes.hpp"
 
