@@ -297,8 +297,11 @@ class MonteCarloEstimator final : public FormFactorEstimator {
             ranked.emplace_back(emitter_power_[j] * p.area * c / (r2 * r2), j);
           }
           const std::size_t keep = std::min<std::size_t>(ranked.size(), options_.exact_emitters);
-          std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end(),
-                            [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+          // Strongest first; ties by patch id, so the choice does not depend on the sort.
+          auto stronger = [](const auto& a, const auto& b) {
+            return a.first > b.first || (a.first == b.first && a.second < b.second);
+          };
+          std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end(), stronger);
           for (std::uint32_t j : emitters_) by_rays[j] = 1;
           const std::vector<std::uint32_t> one{elements[k]};
           for (std::size_t i = 0; i < keep; ++i) {
