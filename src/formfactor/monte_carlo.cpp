@@ -51,6 +51,7 @@
 #include "geometry/ray_scene.hpp"
 #include "scene/specular_transport.hpp"
 #include "core/streams.hpp"
+#include "core/color.hpp"
 
 namespace radiosity::detail {
 
@@ -127,7 +128,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     for (std::uint32_t j = 0; j < patches.size(); ++j) {
       const PolygonId pid = patches[j].polygon;
       const Rgb e = scene.material(polygons[pid].material).emission;
-      if (std::max(e.x, std::max(e.y, e.z)) <= 0.0f) continue;
+      if (max_channel(e) <= 0.0f) continue;
       exact_[j] = 1;
       emitters_.push_back(j);
       emitter_power_[j] = e.x + e.y + e.z;

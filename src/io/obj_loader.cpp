@@ -44,12 +44,10 @@ constexpr float kMaxAlbedo = kMaxForgivenAlbedo;
 // Text helpers
 
 /// "file:line: ", the prefix of every located message.
-std::string at(const fs::path& file, std::size_t line) {
-  return file.string() + ":" + std::to_string(line) + ": ";
-}
-
 /// "file:line", the location that ReaderWarnings takes.
 std::string loc(const fs::path& file, std::size_t line) { return file.string() + ":" + std::to_string(line); }
+
+std::string at(const fs::path& file, std::size_t line) { return loc(file, line) + ": "; }
 
 [[noreturn]] void fail(ErrorCode code, const fs::path& file, std::size_t line, const std::string& problem) {
   throw Error(code, at(file, line) + problem);

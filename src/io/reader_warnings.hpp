@@ -42,8 +42,6 @@ class ReaderWarnings {
     tallies_.push_back(Tally{std::string(kind), std::move(first), 1, {}});
   }
 
-  bool strict() const { return strict_; }
-
   /// Appends one warning per kind, in order of first occurrence, to `scene`:
   /// "<first where><problem>; <action> (N in all; also at A, B, ...)".
   void move_to(Scene& scene) {

@@ -525,6 +525,11 @@ void SceneReader::surface(const json& j, const std::string& loc, Scene& scene) c
     return g ? string(*g, key_path(loc, "group")) : std::string();
   };
   // Under strict, what Scene would only warn about (a polygon triangulated) is an error too.
+  auto refuse_new_warning = [&](std::size_t warnings_before) {
+    if (options_.strict && scene.warnings().size() > warnings_before)
+      fail(ErrorCode::invalid_scene, loc, scene.warnings()[warnings_before]);
+  };
+  // Scene's own error placed at the surface.
   auto add = [&](auto build) {
     const std::size_t warnings_before = scene.warnings().size();
     try {
@@ -532,15 +537,13 @@ void SceneReader::surface(const json& j, const std::string& loc, Scene& scene) c
     } catch (const Error& e) {
       rethrow(e, loc);
     }
-    if (options_.strict && scene.warnings().size() > warnings_before)
-      fail(ErrorCode::invalid_scene, loc, scene.warnings()[warnings_before]);
+    refuse_new_warning(warnings_before);
   };
-  // As `add`, but Scene's own error escapes unchanged, for the caller to forgive.
+  // Scene's own error escapes unchanged, for the caller to forgive.
   auto add_strict = [&](auto build) {
     const std::size_t warnings_before = scene.warnings().size();
     build();
-    if (options_.strict && scene.warnings().size() > warnings_before)
-      fail(ErrorCode::invalid_scene, loc, scene.warnings()[warnings_before]);
+    refuse_new_warning(warnings_before);
   };
 
   if (type == "polygon") {

@@ -21,6 +21,7 @@
 #include "detail/rng.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
+#include "core/color.hpp"
 
 namespace radiosity::detail {
 
@@ -29,7 +30,7 @@ namespace {
 /// Fixed: the check must give the same answer every time, whatever the solve's seed.
 constexpr std::uint64_t kSeed = 0x656d6974746572ull;  // "emitter"
 
-bool emits(const Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
+bool emits(const Material& m) { return max_channel(m.emission) > 0.0f; }
 
 /// "12", "12, 13" or "12, 13, 14, 15 and 9 more".
 std::string id_list(const std::vector<PolygonId>& ids) {
