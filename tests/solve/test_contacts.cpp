@@ -41,27 +41,6 @@ rad::Scene props_on_floor() {
   return scene;
 }
 
-/// Mean radiosity over the leaves of `group` whose centre satisfies `where`, and their area.
-template <class Where>
-double mean_where(const rad::Solution& sol, const rad::Scene& scene, const std::string& group, Where where,
-                  double* area_out = nullptr) {
-  const rad::PatchHierarchy& h = sol.hierarchy();
-  const rad::GroupId g = *scene.find_group(group);
-  double sum = 0.0, area = 0.0;
-  for (std::uint32_t leaf : h.leaves()) {
-    const rad::Element& e = h.element(leaf);
-    if (scene.polygons()[h.patches()[e.patch].polygon].group != g) continue;
-    glm::vec3 c(0.0f);
-    for (int k = 0; k < e.corner_count(); ++k) c += h.vertices()[e.corners[static_cast<std::size_t>(k)]];
-    c /= static_cast<float>(e.corner_count());
-    if (!where(c)) continue;
-    sum += static_cast<double>(sol.radiosity()[leaf].x) * e.area;
-    area += e.area;
-  }
-  if (area_out) *area_out = area;
-  return area > 0.0 ? sum / area : 0.0;
-}
-
 }  // namespace
 
 TEST_SUITE("solve") {
@@ -90,16 +69,16 @@ TEST_SUITE("solve") {
 
       // Dark where nothing can reach: the floor under the box (inset by an element), the box's
       // bottom face, the floor inside the ball and the ball below the floor.
-      const double floor_mean = mean_where(sol, scene, "y0", [](glm::vec3) { return true; });
+      const double floor_mean = test::leaf_mean(sol, scene, "y0", [](glm::vec3) { return true; });
       auto under_box = [](glm::vec3 c) { return c.x > 0.4f && c.x < 0.8f && c.z > 1.0f && c.z < 1.4f; };
       double area = 0.0;
-      const double under = mean_where(sol, scene, "y0", under_box, &area);
+      const double under = test::leaf_mean(sol, scene, "y0", under_box, false, &area);
       CHECK(area > 0.1);
-      const double bottom = mean_where(sol, scene, "box", [](glm::vec3 c) { return c.y < 1e-4f; });
-      const double in_ball = mean_where(sol, scene, "y0", [](glm::vec3 c) {
+      const double bottom = test::leaf_mean(sol, scene, "box", [](glm::vec3 c) { return c.y < 1e-4f; });
+      const double in_ball = test::leaf_mean(sol, scene, "y0", [](glm::vec3 c) {
         return glm::length(glm::vec2(c.x - 1.4f, c.z - 0.8f)) < 0.27f;  // the cut circle has radius 0.317
       });
-      const double ball_below = mean_where(sol, scene, "ball", [](glm::vec3 c) { return c.y < -0.03f; });
+      const double ball_below = test::leaf_mean(sol, scene, "ball", [](glm::vec3 c) { return c.y < -0.03f; });
       MESSAGE("floor mean " << floor_mean << "; under the box " << under << ", box bottom " << bottom
                             << ", floor inside the ball " << in_ball << ", ball below the floor " << ball_below);
       CHECK(under < 1e-3 * floor_mean);
@@ -109,7 +88,7 @@ TEST_SUITE("solve") {
 
       // No bright seam: a patch of floor 3-15 cm outside the box's -x side is no brighter than
       // the path tracer says (it is partly shadowed by the box).
-      const double strip = mean_where(sol, scene, "y0", [](glm::vec3 c) {
+      const double strip = test::leaf_mean(sol, scene, "y0", [](glm::vec3 c) {
         return c.x > 0.15f && c.x < 0.27f && c.z > 1.14f && c.z < 1.26f;
       });
       MESSAGE("strip beside the box: radiosity " << strip);

@@ -230,20 +230,9 @@ TEST_SUITE("solve") {
     };
     // The radiosity of the middle of each side, against the path tracer's pi L there.
     auto middle = [&](bool back) {
-      const rad::PatchHierarchy& h = sol.hierarchy();
-      const std::vector<rad::Rgb>& B = back ? sol.back_radiosity() : sol.radiosity();
-      double sum = 0.0, area = 0.0;
-      for (std::uint32_t leaf : h.leaves()) {
-        const rad::Element& e = h.element(leaf);
-        if (room.polygons()[h.patches()[e.patch].polygon].group != *room.find_group("table")) continue;
-        glm::vec3 c(0.0f);
-        for (int k = 0; k < e.corner_count(); ++k) c += h.vertices()[e.corners[static_cast<std::size_t>(k)]];
-        c /= static_cast<float>(e.corner_count());
-        if (std::fabs(c.x - 1.0f) > 0.12f || std::fabs(c.z - 1.0f) > 0.12f) continue;
-        sum += B[leaf].x * e.area;
-        area += e.area;
-      }
-      return sum / area;
+      return test::leaf_mean(
+          sol, room, "table", [](glm::vec3 c) { return std::fabs(c.x - 1.0f) <= 0.12f && std::fabs(c.z - 1.0f) <= 0.12f; },
+          back);
     };
     const double pi = 3.14159265358979323846;
     const double top_path = pi * mean_radiance({1.0f, 1.6f, 1.0f}, {0, 0, 1}),

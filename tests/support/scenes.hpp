@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -53,6 +54,30 @@ inline double perpendicular_rectangles(double l, double w, double h) {
   return 1.0 / (pi * W) *
          (W * std::atan(1 / W) + H * std::atan(1 / H) - S * std::atan(1 / S) +
           0.25 * (std::log(a) + W2 * std::log(b) + H2 * std::log(c)));
+}
+
+/// Area-weighted mean of the red channel of one side's radiosity (the back when `back`) over
+/// the leaves of `group` whose centre (the mean of its corners) satisfies `where`; their area
+/// in `*area_out`. 0 when no leaf qualifies.
+template <class Where>
+double leaf_mean(const rad::Solution& sol, const rad::Scene& scene, const std::string& group, Where where,
+                 bool back = false, double* area_out = nullptr) {
+  const rad::PatchHierarchy& h = sol.hierarchy();
+  const std::vector<rad::Rgb>& B = back ? sol.back_radiosity() : sol.radiosity();
+  const rad::GroupId g = *scene.find_group(group);
+  double sum = 0.0, area = 0.0;
+  for (std::uint32_t leaf : h.leaves()) {
+    const rad::Element& e = h.element(leaf);
+    if (scene.polygons()[h.patches()[e.patch].polygon].group != g) continue;
+    glm::vec3 c(0.0f);
+    for (int k = 0; k < e.corner_count(); ++k) c += h.vertices()[e.corners[static_cast<std::size_t>(k)]];
+    c /= static_cast<float>(e.corner_count());
+    if (!where(c)) continue;
+    sum += static_cast<double>(B[leaf].x) * e.area;
+    area += e.area;
+  }
+  if (area_out) *area_out = area;
+  return area > 0.0 ? sum / area : 0.0;
 }
 
 }  // namespace test
