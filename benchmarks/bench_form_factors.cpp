@@ -16,10 +16,10 @@
 
 #include <glm/geometric.hpp>
 
-#include "detail/parallel.hpp"
-#include "detail/rng.hpp"
-#include "formfactor/estimators.hpp"
-#include "formfactor/shaft.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
+#include "form_factors/estimators.hpp"
+#include "form_factors/shaft.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/radiosity.hpp"
 

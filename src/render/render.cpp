@@ -11,11 +11,11 @@
 #include <glm/trigonometric.hpp>
 #include <limits>
 
-#include "detail/parallel.hpp"
-#include "detail/rng.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/render.hpp"
-#include "render/camera.hpp"
+#include "image/camera.hpp"
 #include "core/camera_check.hpp"
 #include "core/streams.hpp"
 #include "core/progress.hpp"

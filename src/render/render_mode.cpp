@@ -9,7 +9,7 @@
 
 #include "radiosity/brdf.hpp"
 #include "radiosity/render.hpp"
-#include "scene/specular_transport.hpp"
+#include "form_factors/pass1_material.hpp"
 
 namespace radiosity {
 inline namespace v1 {

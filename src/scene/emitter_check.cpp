@@ -17,8 +17,8 @@
 
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
-#include "detail/parallel.hpp"
-#include "detail/rng.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "core/color.hpp"

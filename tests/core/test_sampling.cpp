@@ -8,7 +8,7 @@
 
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
-#include "detail/rng.hpp"
+#include "core/rng.hpp"
 
 namespace core = radiosity::detail;
 

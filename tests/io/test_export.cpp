@@ -13,7 +13,7 @@
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
 
-#include "io/srgb.hpp"
+#include "io/writers/srgb.hpp"
 #include "radiosity/io.hpp"
 #include "radiosity/radiosity.hpp"
 

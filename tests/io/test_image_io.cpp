@@ -10,7 +10,7 @@
 
 #include <doctest/doctest.h>
 
-#include "io/srgb.hpp"
+#include "io/writers/srgb.hpp"
 #include "radiosity/io.hpp"
 
 #define STB_IMAGE_STATIC

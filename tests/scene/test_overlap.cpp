@@ -1,6 +1,6 @@
 // find_overlaps(), the diagnostic: coincident and interpenetrating polygons are found and named,
 // touching ones (shared edges and corners, T-junctions, blocks standing on floors) are not.
-// Solves accept contact and interpenetration (tests/solve/test_contacts.cpp checks the light);
+// Solves accept contact and interpenetration (tests/solver/test_contacts.cpp checks the light);
 // only coincident polygons facing the same way (z-fighting) give a warning.
 #include <doctest/doctest.h>
 

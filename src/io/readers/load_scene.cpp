@@ -1,0 +1,26 @@
+// load_scene(): chooses a reader by the file's extension, so callers need not know formats.
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+#include "io/readers/readers.hpp"
+#include "radiosity/io.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+Scene load_scene(const std::filesystem::path& path, const LoadOptions& options) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".obj") return detail::load_obj(path, options);
+  if (ext == ".json") return detail::load_scene_json(path, options);
+  if (ext.empty())
+    throw Error(ErrorCode::invalid_argument,
+                "load_scene: '" + path.string() + "' has no file extension (supported: .obj, .json)");
+  throw Error(ErrorCode::invalid_argument, "load_scene: '" + path.string() + "': unsupported extension '" +
+                                               path.extension().string() + "' (supported: .obj, .json)");
+}
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,708 @@
+// Wavefront OBJ/MTL reader. tinyobjloader parses the OBJ (faces kept as polygons, not
+// triangulated); a light pre-scan of the same text maps every face to its line and checks what
+// tinyobjloader would accept silently (out-of-range indices, NaN coordinates), so that every
+// error names the file, the line and the problem. MTL files are read here (key-value lines),
+// and their materials handed to tinyobjloader by name. What a renderer would step over
+// (degenerate faces, Kd 1, a missing MTL) follows the forgiving policy of reader_warnings.hpp.
+// The MTL mapping follows the format's own description of the illumination models (Wavefront's
+// MTL specification) and the PBR extension as tinyobjloader and Blender read it.
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include "io/readers/reader_warnings.hpp"
+#include "io/readers/readers.hpp"
+#include "radiosity/brdf.hpp"
+#include "core/assert.hpp"
+#include "core/color.hpp"
+#include "core/constants.hpp"
+
+namespace radiosity::detail {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Largest diffuse + specular albedo an MTL material keeps; Ks is scaled down to fit (see below).
+constexpr float kMaxAlbedo = kMaxForgivenAlbedo;
+
+// ---------------------------------------------------------------------------------------------
+// Text helpers
+
+/// "file:line: ", the prefix of every located message.
+/// "file:line", the location that ReaderWarnings takes.
+std::string loc(const fs::path& file, std::size_t line) { return file.string() + ":" + std::to_string(line); }
+
+std::string at(const fs::path& file, std::size_t line) { return loc(file, line) + ": "; }
+
+[[noreturn]] void fail(ErrorCode code, const fs::path& file, std::size_t line, const std::string& problem) {
+  throw Error(code, at(file, line) + problem);
+}
+
+std::string read_text(const fs::path& path, const char* what) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw Error(ErrorCode::file_not_found,
+                std::string("load_scene: cannot open ") + what + " '" + path.string() +
+                    (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot open ") + what + " '" + path.string() + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot read ") + what + " '" + path.string() + "'");
+  // A UTF-8 byte order mark would hide the first statement from tinyobjloader and from us.
+  std::string s = text.str();
+  if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.erase(0, 3);
+  return s;
+}
+
+/// Splits text into lines exactly as tinyobjloader's safeGetline does ("\n", "\r\n" and a lone
+/// "\r" each end a line), so that our line numbers and its own agree.
+std::vector<std::string_view> split_lines(std::string_view text) {
+  std::vector<std::string_view> lines;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\n' && text[i] != '\r') continue;
+    lines.push_back(text.substr(start, i - start));
+    if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+    start = i + 1;
+  }
+  if (start < text.size()) lines.push_back(text.substr(start));
+  return lines;
+}
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && (is_blank(s.back()) || s.back() == '\r' || s.back() == '\n')) s.remove_suffix(1);
+  return s;
+}
+
+/// Whitespace-separated tokens (spaces and tabs, as tinyobjloader).
+std::vector<std::string_view> tokens(std::string_view line) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    std::size_t j = i;
+    while (j < line.size() && !is_blank(line[j])) ++j;
+    if (j > i) out.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return out;
+}
+
+std::optional<double> parse_real(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  double v = 0.0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+std::optional<long long> parse_int(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  long long v = 0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+/// A number that fits a float and is neither NaN nor infinite.
+std::optional<float> parse_finite_float(std::string_view s) {
+  std::optional<double> v = parse_real(s);
+  if (!v || !std::isfinite(*v) || std::fabs(*v) > static_cast<double>(FLT_MAX)) return std::nullopt;
+  return static_cast<float>(*v);
+}
+
+std::string describe(const Rgb& c) {
+  std::ostringstream s;
+  s << '(' << c.x << ", " << c.y << ", " << c.z << ')';
+  return s.str();
+}
+
+std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+// ---------------------------------------------------------------------------------------------
+// MTL reader: our own, since it is a list of "key values" lines and we need every key's line for
+// messages; tinyobjloader gets the materials' names from us (PreloadedMaterials below), so the
+// two can never disagree about which materials exist.
+
+struct MtlKey {
+  std::size_t line = 0;
+  float value[3] = {0.0f, 0.0f, 0.0f};
+};
+
+struct MtlInfo {
+  fs::path file;
+  std::size_t line = 0;  ///< of its `newmtl`
+  std::string name;
+  std::map<std::string, MtlKey, std::less<>> keys;  ///< Kd Ke Ks Tf (also from Kt) Ns Ni d Tr Pr Pm illum map_Kd
+
+  const MtlKey* key(std::string_view k) const {
+    auto it = keys.find(k);
+    return it == keys.end() ? nullptr : &it->second;
+  }
+  std::size_t line_of(std::string_view k) const {
+    const MtlKey* m = key(k);
+    return m ? m->line : line;
+  }
+  std::string where(std::string_view k) const { return loc(file, line_of(k)); }
+  std::string what() const { return "material " + in_quotes(name) + ": "; }
+};
+
+/// Appends one MtlInfo per named `newmtl` of `text`, in order. Values are checked to be numbers
+/// here (a value that is not one cannot mean anything); their ranges in to_material().
+void scan_mtl(const fs::path& file, std::string_view text, std::vector<MtlInfo>& out) {
+  std::vector<std::string_view> lines = split_lines(text);
+  MtlInfo* current = nullptr;
+  for (std::size_t n = 0; n < lines.size(); ++n) {
+    const std::size_t line_no = n + 1;
+    std::string_view line = trim(lines[n]);
+    if (line.empty() || line.front() == '#') continue;
+    std::vector<std::string_view> tok = tokens(line);
+    if (tok[0] == "newmtl") {
+      std::string_view name = trim(line.substr(6));
+      current = nullptr;
+      if (name.empty()) continue;  // a material without a name cannot be used
+      out.push_back(MtlInfo{file, line_no, std::string(name), {}});
+      current = &out.back();
+      continue;
+    }
+    std::string key(tok[0]);
+    if (key == "Kt") key = "Tf";
+    if (key == "map_Kd") {
+      if (current != nullptr) current->keys[key] = MtlKey{line_no, {}};
+      continue;
+    }
+    const bool colour = key == "Kd" || key == "Ke" || key == "Ks" || key == "Tf";
+    const bool scalar = key == "Ns" || key == "Ni" || key == "d" || key == "Tr" || key == "Pr" || key == "Pm";
+    if (!colour && !scalar && key != "illum") continue;
+    if (current == nullptr) continue;  // before the first newmtl: belongs to no material
+
+    MtlKey k;
+    k.line = line_no;
+    if (key == "illum") {
+      std::optional<long long> v = tok.size() == 2 ? parse_int(tok[1]) : std::nullopt;
+      if (!v) fail(ErrorCode::parse_error, file, line_no, current->what() + "illum needs one integer");
+      k.value[0] = static_cast<float>(*v);
+    } else {
+      if (colour && tok.size() > 1 && (tok[1] == "spectral" || tok[1] == "xyz"))
+        fail(ErrorCode::parse_error, file, line_no,
+             current->what() + key + " " + std::string(tok[1]) + " is not supported (give r g b)");
+      const std::size_t given = tok.size() - 1;
+      if (colour ? (given != 1 && given != 3) : given != 1)
+        fail(ErrorCode::parse_error, file, line_no,
+             current->what() + key + (colour ? " needs 1 or 3 numbers" : " needs 1 number") + ", got " +
+                 std::to_string(given));
+      for (std::size_t i = 0; i < given; ++i) {
+        std::optional<float> v = parse_finite_float(tok[i + 1]);
+        if (!v)
+          fail(ErrorCode::parse_error, file, line_no,
+               current->what() + key + " value " + in_quotes(tok[i + 1]) + " is not a finite number");
+        k.value[i] = *v;
+      }
+      // A single value means grey (r = g = b), as the MTL specification says.
+      if (given == 1) k.value[1] = k.value[2] = k.value[0];
+    }
+    current->keys[key] = k;
+  }
+}
+
+/// The colour of `key`, or `fallback` when the material does not set it.
+Rgb colour(const MtlInfo& info, std::string_view key, Rgb fallback) {
+  if (const MtlKey* k = info.key(key)) return Rgb(k->value[0], k->value[1], k->value[2]);
+  return fallback;
+}
+
+float scalar(const MtlInfo& info, std::string_view key, float fallback) {
+  const MtlKey* k = info.key(key);
+  return k ? k->value[0] : fallback;
+}
+
+/// `c` with every channel clamped into [0, upper]: below 0 always, above `upper` when it is
+/// at least `at_or_above` (Kd 1 is clamped to 0.99, Kd 0.995 kept). Each clamp is forgiven
+/// with a warning (an Error under strict, worded as the range check it replaces).
+Rgb clamped(const MtlInfo& info, std::string_view key, Rgb c, float upper, float at_or_above, const char* meaning,
+            const char* range, ReaderWarnings& warnings) {
+  Rgb out = c;
+  for (int i = 0; i < 3; ++i) out[i] = c[i] < 0.0f ? 0.0f : c[i] >= at_or_above ? upper : c[i];
+  if (out != c) {
+    std::ostringstream problem, action;
+    problem << info.what() << key << ' ' << describe(c) << " is " << meaning << " and must be " << range
+            << " per channel";
+    action << "clamped to " << describe(out);
+    warnings.forgive(std::string("MTL ") + std::string(key) + " out of range", ErrorCode::invalid_scene,
+                     info.where(key), problem.str(), action.str());
+  }
+  return out;
+}
+
+/// f = (1 - w) first + w second with the two parts' albedos `a` and `b` kept (w = max b /
+/// (max a + max b)); `build_first(scale)` and `build_second(scale)` make the parts with their
+/// coefficients multiplied by scale = 1 / weight. Used for the MTL models that make_brdf() has
+/// no field for (a tinted Fresnel reflection, a PBR coat).
+std::shared_ptr<const Brdf> mixture(float a, float b, const std::function<std::shared_ptr<const Brdf>(float)>& build_first,
+                                    const std::function<std::shared_ptr<const Brdf>(float)>& build_second) {
+  if (a <= 0.0f) return build_second(1.0f);
+  if (b <= 0.0f) return build_first(1.0f);
+  const float w = b / (a + b);
+  return make_mix(build_first(1.0f / (1.0f - w)), build_second(1.0f / w), w);
+}
+
+/// Converts one MTL material as the format means it (docs/SCENE_OBJ.md has the table).
+Material to_material(const MtlInfo& info, ReaderWarnings& warnings) {
+  Material m;
+  m.name = info.name;
+  // Without Kd the diffuse colour is 0, or 0.6 under a diffuse texture (tinyobjloader's rule:
+  // the texture's mean is unknown here).
+  const Rgb kd_default(info.key("map_Kd") ? 0.6f : 0.0f);
+  const Rgb kd = clamped(info, "Kd", colour(info, "Kd", kd_default), kMaxAlbedo, 1.0f,
+                         "a diffuse reflectance (1 or more would create energy)", "in [0, 1)", warnings);
+  const Rgb ke = clamped(info, "Ke", colour(info, "Ke", Rgb(0.0f)), FLT_MAX, FLT_MAX, "an emitted radiance", ">= 0", warnings);
+  m.reflectance = kd;
+  m.emission = kPi * ke;
+
+  const int illum = static_cast<int>(scalar(info, "illum", -1.0f));  // -1: not given
+  const bool refracts = illum == 4 || illum == 6 || illum == 7 || illum == 9;
+  const bool mirror = illum == 3 || illum == 5 || illum == 8;
+  const bool pbr = !refracts && (info.key("Pr") || info.key("Pm"));
+  const bool has_ks = info.key("Ks") != nullptr && illum != 0 && illum != 1;  // 0/1: no highlights
+  const Rgb ks = has_ks ? clamped(info, "Ks", colour(info, "Ks", Rgb(0.0f)), 1.0f, 1.0f + 1e-6f,
+                                  "a specular reflectance", "in [0, 1]", warnings)
+                        : Rgb(0.0f);
+
+  auto positive_ni = [&]() -> std::optional<float> {
+    const MtlKey* ni = info.key("Ni");
+    if (!ni) return std::nullopt;
+    if (ni->value[0] > 0.0f) return ni->value[0];
+    warnings.forgive("MTL Ni out of range", ErrorCode::invalid_scene, loc(info.file, ni->line),
+                     info.what() + "Ni " + std::to_string(ni->value[0]) + " must be > 0", "1.5 used");
+    return std::nullopt;
+  };
+
+  if (refracts) {
+    // A smooth dielectric: Fresnel's reflection (tinted by Ks when given) and refraction
+    // (tinted by Tf, white when absent); no Phong lobe on top, which would double the
+    // reflection and darken the glass.
+    m.transmittance = clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f, "a transmittance", "in [0, 1]", warnings);
+    m.ior = positive_ni().value_or(1.5f);
+    const Rgb tint = info.key("Ks") ? ks : Rgb(1.0f);
+    if (tint != Rgb(1.0f)) {
+      const float ior = m.ior;
+      const Rgb tf = m.transmittance;
+      m.brdf = mixture(
+          max_channel(kd), max_channel(glm::max(tf, tint)),
+          [&](float scale) { return std::shared_ptr<const Brdf>(make_lambertian(glm::min(kd * scale, Rgb(1.0f)))); },
+          [&](float scale) {
+            return std::shared_ptr<const Brdf>(
+                make_dielectric(ior, glm::min(tf * scale, Rgb(1.0f)), glm::min(tint * scale, Rgb(1.0f))));
+          });
+    }
+    return m;
+  }
+
+  if (pbr) {
+    // The PBR extension: base colour Kd, metallic Pm, roughness Pr (GGX alpha = Pr^2, the
+    // usual perceptual mapping), dielectric F0 from Ni (1.5 when absent). The view pass gets a
+    // microfacet coat mixed with the diffuse base; radiosity sees the diffuse base.
+    const float metallic = std::clamp(scalar(info, "Pm", 0.0f), 0.0f, 1.0f);
+    const float roughness = std::clamp(scalar(info, "Pr", 0.5f), 0.0f, 1.0f);
+    const float n = positive_ni().value_or(1.5f);
+    const float f0_dielectric = ((n - 1.0f) / (n + 1.0f)) * ((n - 1.0f) / (n + 1.0f));
+    const Rgb f0 = glm::mix(Rgb(f0_dielectric), kd, metallic);
+    const float w = std::clamp(max_channel(f0), 1e-3f, 0.999f);
+    const Rgb base = glm::min(kd * (1.0f - metallic), Rgb((1.0f - w) * kMaxAlbedo));
+    const float alpha = std::max(roughness * roughness, 1e-3f);
+    m.reflectance = base;
+    // A mixture keeps each part's albedo when the coat is built with f0 / w at weight w; its
+    // rise towards grazing angles is then scaled by w too (an approximation of the layered
+    // model that the library has no BRDF for). A pure metal is the microfacet model itself.
+    if (max_channel(base) <= 0.0f)
+      m.brdf = make_microfacet(f0, alpha, alpha);
+    else
+      m.brdf = make_mix(make_lambertian(base / (1.0f - w)), make_microfacet(glm::min(f0 / w, Rgb(1.0f)), alpha, alpha), w);
+    return m;
+  }
+
+  if (has_ks && max_channel(ks) > 0.0f) {
+    m.specular = ks;
+    if (mirror) {
+      m.specular_exponent = 0.0f;
+    } else {
+      float ns = scalar(info, "Ns", 1.0f);
+      if (ns < 0.0f) {
+        warnings.forgive("MTL Ns out of range", ErrorCode::invalid_scene, info.where("Ns"),
+                         info.what() + "Ns " + std::to_string(ns) + " must be >= 0", "1 used");
+        ns = 1.0f;
+      }
+      m.specular_exponent = std::max(ns, 1.0f);  // 0 would mean a mirror here
+    }
+    // Keep Kd + Ks below 1 per channel by scaling Ks (hue kept): exported files often have
+    // Kd 0.8 and Ks 0.5.
+    float scale = 1.0f;
+    for (int c = 0; c < 3; ++c)
+      if (ks[c] > 0.0f && kd[c] + ks[c] > kMaxAlbedo) scale = std::min(scale, std::max(0.0f, (kMaxAlbedo - kd[c]) / ks[c]));
+    if (scale < 1.0f) {
+      m.specular = ks * scale;
+      std::ostringstream problem, action;
+      problem << info.what() << "Kd + Ks exceeds " << kMaxAlbedo << " (1 or more would create energy)";
+      action << "Ks scaled by " << scale << " to " << describe(m.specular);
+      warnings.forgive("MTL Kd + Ks", ErrorCode::invalid_scene, info.where("Ks"), problem.str(), action.str());
+    }
+  }
+
+  // Dissolve (d, or Tr = 1 - d): a fraction 1 - d of the light passes straight through, as
+  // through a thin pane (ior 1); the surface's own parts keep the fraction d.
+  float opacity = info.key("d") ? scalar(info, "d", 1.0f) : 1.0f - scalar(info, "Tr", 0.0f);
+  if (opacity < 0.0f || opacity > 1.0f) {
+    const char* key = info.key("d") ? "d" : "Tr";
+    const float clamped_opacity = std::clamp(opacity, 0.0f, 1.0f);
+    warnings.forgive("MTL d out of range", ErrorCode::invalid_scene, info.where(key),
+                     info.what() + key + " " + std::to_string(scalar(info, key, 0.0f)) + " must be in [0, 1]",
+                     "clamped");
+    opacity = clamped_opacity;
+  }
+  if (opacity < 1.0f) {
+    m.reflectance *= opacity;
+    m.specular *= opacity;
+    m.transmittance = (1.0f - opacity) * clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f,
+                                                 "a transmittance", "in [0, 1]", warnings);
+    m.ior = 1.0f;
+  }
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// OBJ pre-scan
+
+struct FaceInfo {
+  std::size_t line = 0;
+  std::size_t vertex_count = 0;
+  std::string_view material;      ///< name given by the last usemtl ("" if none)
+  std::size_t material_line = 0;  ///< line of that usemtl
+};
+
+struct ObjScan {
+  std::vector<FaceInfo> faces;     ///< in file order, which is tinyobjloader's face order
+  std::vector<fs::path> mtl_files; ///< resolved, each once, in order of mention
+  std::size_t vertex_count = 0;
+};
+
+/// mtllib names, split like tinyobjloader does: on spaces, with "\ " escaping a space.
+std::vector<std::string> mtllib_names(std::string_view rest) {
+  std::vector<std::string> names;
+  std::string name;
+  bool escaping = false;
+  for (char ch : rest) {
+    if (escaping) {
+      escaping = false;
+    } else if (ch == '\\') {
+      escaping = true;
+      continue;
+    } else if (ch == ' ' || ch == '\t') {
+      if (!name.empty()) names.push_back(name);
+      name.clear();
+      continue;
+    }
+    name += ch;
+  }
+  if (!name.empty()) names.push_back(name);
+  return names;
+}
+
+/// Checks one index field of a face corner ("v", "v/vt", "v//vn" or "v/vt/vn"). tinyobjloader
+/// rejects 0 or a missing vt/vn index, and accepts an out-of-range vertex index silently.
+void check_corner(const fs::path& file, std::size_t line_no, std::string_view corner, std::size_t vertex_count) {
+  const std::size_t slash = corner.find('/');
+  const std::string_view v = corner.substr(0, slash);
+  const std::optional<long long> idx = parse_int(v);
+  if (!idx) fail(ErrorCode::parse_error, file, line_no, "face corner " + in_quotes(corner) + " has no valid vertex index");
+  if (*idx == 0)
+    fail(ErrorCode::parse_error, file, line_no, "face corner " + in_quotes(corner) + ": vertex index 0 is invalid (OBJ indices start at 1)");
+  const long long n = static_cast<long long>(vertex_count);
+  const long long resolved = *idx > 0 ? *idx - 1 : n + *idx;
+  if (resolved < 0 || resolved >= n)
+    fail(ErrorCode::parse_error, file, line_no,
+         "face corner " + in_quotes(corner) + ": vertex index " + std::to_string(*idx) + " is out of range (" +
+             std::to_string(vertex_count) + " vertices defined before this line)");
+  if (slash == std::string_view::npos) return;
+  const std::string_view rest = corner.substr(slash + 1);
+  const std::size_t slash2 = rest.find('/');
+  const std::string_view vt = rest.substr(0, slash2);
+  auto check_nonzero = [&](std::string_view field, const char* what) {
+    std::optional<long long> i = parse_int(field);
+    if (!i || *i == 0)
+      fail(ErrorCode::parse_error, file, line_no,
+           "face corner " + in_quotes(corner) + ": " + what + " index " + in_quotes(field) + " is not a non-zero integer");
+  };
+  if (!vt.empty() || slash2 == std::string_view::npos) check_nonzero(vt, "texture coordinate");
+  if (slash2 != std::string_view::npos) {
+    std::string_view vn = rest.substr(slash2 + 1);
+    vn = vn.substr(0, vn.find('/'));
+    check_nonzero(vn, "normal");
+  }
+}
+
+ObjScan scan_obj(const fs::path& file, std::string_view text, ReaderWarnings& warnings) {
+  ObjScan scan;
+  std::set<fs::path> seen_mtl;
+  std::string_view material;
+  std::size_t material_line = 0;
+  const std::vector<std::string_view> lines = split_lines(text);
+  for (std::size_t n = 0; n < lines.size(); ++n) {
+    const std::size_t line_no = n + 1;
+    const std::vector<std::string_view> tok = tokens(lines[n]);
+    if (tok.empty() || tok[0].front() == '#') continue;
+    const std::string_view key = tok[0];
+    if (key == "v") {
+      if (tok.size() < 4)
+        fail(ErrorCode::parse_error, file, line_no,
+             "vertex has " + std::to_string(tok.size() - 1) + " coordinates; x y z needed");
+      for (std::size_t i = 1; i <= 3; ++i)
+        if (!parse_finite_float(tok[i]))
+          fail(ErrorCode::parse_error, file, line_no, "vertex coordinate " + in_quotes(tok[i]) + " is not a finite number");
+      ++scan.vertex_count;
+    } else if (key == "f") {
+      for (std::size_t i = 1; i < tok.size(); ++i) check_corner(file, line_no, tok[i], scan.vertex_count);
+      // tinyobjloader drops such a face too, so it is left out of the face list.
+      if (tok.size() < 4)
+        warnings.forgive("short face", ErrorCode::parse_error, loc(file, line_no),
+                         "face has " + std::to_string(tok.size() - 1) + " vertices; a polygon needs at least 3",
+                         "dropped");
+      else
+        scan.faces.push_back(FaceInfo{line_no, tok.size() - 1, material, material_line});
+    } else if (key == "usemtl") {
+      material = tok.size() > 1 ? tok[1] : std::string_view();
+      material_line = line_no;
+    } else if (key == "mtllib") {
+      const std::string_view line = trim(lines[n]);
+      const std::vector<std::string> names = mtllib_names(line.substr(std::min<std::size_t>(line.size(), 7)));
+      if (names.empty())
+        warnings.forgive("empty mtllib", ErrorCode::parse_error, loc(file, line_no), "mtllib without a file name",
+                         "ignored");
+      for (const std::string& name : names) {
+        fs::path p(name);
+        if (p.is_relative()) p = file.parent_path() / p;
+        std::error_code ec;
+        if (!fs::is_regular_file(p, ec)) {
+          warnings.forgive("missing mtllib", ErrorCode::file_not_found, loc(file, line_no),
+                           "material library " + in_quotes(name) + " not found (looked for '" + p.string() + "')",
+                           "its materials are the default grey");
+          continue;
+        }
+        if (seen_mtl.insert(p.lexically_normal()).second) scan.mtl_files.push_back(p);
+      }
+    } else if (key == "l" || key == "p") {
+      warnings.forgive("line or point element", ErrorCode::parse_error, loc(file, line_no),
+                       "line/point element has no area", "ignored");
+    }
+  }
+  return scan;
+}
+
+/// Hands tinyobjloader the materials we read from every mtllib beforehand (only their names
+/// matter to it: it maps usemtl to an index). tinyobjloader would stop at the first file of a
+/// multi-file `mtllib` line, and we want all of them.
+class PreloadedMaterials : public tinyobj::MaterialReader {
+ public:
+  PreloadedMaterials(const std::vector<tinyobj::material_t>& materials, const std::map<std::string, int>& map)
+      : materials_(materials), map_(map) {}
+  bool operator()(const std::string&, std::vector<tinyobj::material_t>* materials, std::map<std::string, int>* map,
+                  std::string*, std::string*) override {
+    if (!given_) {
+      *materials = materials_;
+      *map = map_;
+      given_ = true;
+    }
+    return true;
+  }
+
+ private:
+  const std::vector<tinyobj::material_t>& materials_;
+  const std::map<std::string, int>& map_;
+  bool given_ = false;
+};
+
+/// "polygon 7 (group 'x'): problem" -> "problem": Scene numbers polygons of the scratch scene
+/// below, which mean nothing to the user; we give file:line instead.
+std::string without_polygon_prefix(const std::string& message) {
+  if (message.rfind("polygon ", 0) == 0) {
+    const std::size_t end = message.find("): ");
+    if (end != std::string::npos) return message.substr(end + 3);
+  }
+  return message;
+}
+
+/// Adds faces to the scene so that what Scene would say about them (triangulated, degenerate)
+/// carries file:line and follows the forgiving policy. Each face first goes into a scratch
+/// scene; if that records a warning, the pieces it made are added instead of the face.
+class FaceAdder {
+ public:
+  FaceAdder(Scene& scene, const fs::path& file, ReaderWarnings& warnings)
+      : scene_(scene), file_(file), warnings_(warnings) {
+    reset_scratch();
+  }
+
+  void add(const std::vector<glm::vec3>& vertices, MaterialId material, const std::string& group, std::size_t line) {
+    const std::string face = "face (group '" + (group.empty() ? std::string("default") : group) + "'): ";
+    const std::size_t warnings_before = scratch_.warnings().size();
+    PolygonRange pieces;
+    try {
+      pieces = scratch_.add_polygon(vertices, 0);
+    } catch (const Error& e) {
+      // The vertices are finite (the scan checked), so Scene refuses only degenerate faces.
+      warnings_.forgive("degenerate face", e.code(), loc(file_, line), face + without_polygon_prefix(e.what()),
+                        "dropped");
+      return;
+    }
+    if (scratch_.warnings().size() == warnings_before) {
+      scene_.add_polygon(vertices, material, group);
+    } else {
+      // A piece is a triangle Scene accepted once; one so thin that Scene's collinearity test
+      // rejects it on its own carries no area worth keeping.
+      std::size_t slivers = 0;
+      for (std::uint32_t i = 0; i < pieces.count; ++i) {
+        try {
+          scene_.add_polygon(scratch_.polygons()[pieces.first + i].vertices, material, group);
+        } catch (const Error&) {
+          ++slivers;
+        }
+      }
+      for (std::size_t w = warnings_before; w < scratch_.warnings().size(); ++w)
+        warnings_.forgive("triangulated face", ErrorCode::invalid_scene, loc(file_, line),
+                          face + without_polygon_prefix(scratch_.warnings()[w]),
+                          slivers > 0 && w + 1 == scratch_.warnings().size()
+                              ? std::to_string(slivers) + " sliver triangle(s) dropped"
+                              : std::string());
+    }
+    if (scratch_.polygons().size() > 4096) reset_scratch();
+  }
+
+ private:
+  void reset_scratch() {
+    scratch_ = Scene();
+    scratch_.add_material(Material{});
+  }
+
+  Scene& scene_;
+  const fs::path& file_;
+  ReaderWarnings& warnings_;
+  Scene scratch_;
+};
+
+}  // namespace
+
+Scene load_obj(const fs::path& path, const LoadOptions& options) {
+  const std::string text = read_text(path, "OBJ file");
+  ReaderWarnings warnings(options.strict);
+  ObjScan scan = scan_obj(path, text, warnings);
+
+  // Every MTL file, in order of mention, into one list; the first definition of a name wins.
+  std::vector<MtlInfo> infos;
+  for (const fs::path& mtl : scan.mtl_files) scan_mtl(mtl, read_text(mtl, "MTL file"), infos);
+  std::vector<tinyobj::material_t> tmaterials(infos.size());
+  std::map<std::string, int> tmaterial_map;
+  for (std::size_t i = 0; i < infos.size(); ++i) {
+    tmaterials[i].name = infos[i].name;
+    tmaterial_map.emplace(infos[i].name, static_cast<int>(i));
+  }
+
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> used_materials;
+  std::string warn, err;
+  {
+    std::istringstream in(text);
+    PreloadedMaterials reader(tmaterials, tmaterial_map);
+    if (!tinyobj::LoadObj(&attrib, &shapes, &used_materials, &warn, &err, &in, &reader, /*triangulate=*/false)) {
+      std::string first = err.substr(0, err.find('\n'));
+      throw Error(ErrorCode::parse_error, path.string() + ": " + (first.empty() ? "cannot parse" : first));
+    }
+  }
+  // Invariants of the scan agreeing with tinyobjloader (both read the same text).
+  RADIOSITY_ASSERT(attrib.vertices.size() == 3 * scan.vertex_count);
+
+  Scene scene;
+
+  // Materials: MTL material i becomes scene material ids[i]; "default" grey is added on demand.
+  std::vector<MaterialId> ids;
+  ids.reserve(infos.size());
+  for (const MtlInfo& info : infos) {
+    try {
+      ids.push_back(scene.add_material(to_material(info, warnings)));
+    } catch (const Error& e) {
+      throw Error(e.code(), at(info.file, info.line) + e.what());
+    }
+  }
+  std::optional<MaterialId> default_material;
+  auto material_of = [&](int mid, const FaceInfo& face) -> MaterialId {
+    if (mid >= 0 && static_cast<std::size_t>(mid) < ids.size()) return ids[static_cast<std::size_t>(mid)];
+    if (!face.material.empty())
+      warnings.forgive("undefined material", ErrorCode::invalid_scene, loc(path, face.material_line),
+                       "material " + in_quotes(face.material) + " is not defined by the mtllib files read",
+                       "its faces use the default grey");
+    if (!default_material) {
+      Material grey;
+      grey.name = "default";
+      default_material = scene.add_material(grey);
+    }
+    return *default_material;
+  };
+
+  // Faces, in file order: tinyobjloader's shapes are consecutive runs of the file's faces. The
+  // per-face vertex counts come from our scan (tinyobjloader stores them in an unsigned char).
+  FaceAdder adder(scene, path, warnings);
+  std::size_t face = 0;
+  std::vector<glm::vec3> vertices;
+  std::set<std::string_view> undefined_reported;
+  for (const tinyobj::shape_t& shape : shapes) {
+    const std::string group(trim(shape.name));
+    std::size_t corner = 0;
+    for (std::size_t f = 0; f < shape.mesh.material_ids.size(); ++f, ++face) {
+      if (face >= scan.faces.size() || corner + scan.faces[face].vertex_count > shape.mesh.indices.size())
+        throw Error(ErrorCode::internal, "load_scene: '" + path.string() +
+                                             "': could not match tinyobjloader's faces to the file's f lines");
+      const FaceInfo& info = scan.faces[face];
+      vertices.clear();
+      for (std::size_t k = 0; k < info.vertex_count; ++k) {
+        const int v = shape.mesh.indices[corner + k].vertex_index;
+        RADIOSITY_ASSERT(v >= 0 && static_cast<std::size_t>(v) < scan.vertex_count);  // check_corner() ensured it
+        const std::size_t o = 3 * static_cast<std::size_t>(v);
+        vertices.emplace_back(attrib.vertices[o], attrib.vertices[o + 1], attrib.vertices[o + 2]);
+      }
+      corner += info.vertex_count;
+      const int mid = shape.mesh.material_ids[f];
+      // An undefined material is reported once per name, not once per face.
+      const bool undefined = !(mid >= 0 && static_cast<std::size_t>(mid) < ids.size());
+      FaceInfo quiet = info;
+      if (undefined && !undefined_reported.insert(info.material).second) quiet.material = {};
+      adder.add(vertices, material_of(mid, quiet), group, info.line);
+    }
+  }
+  if (face != scan.faces.size())
+    throw Error(ErrorCode::internal, "load_scene: '" + path.string() + "': could not match tinyobjloader's faces to the file's " +
+                                         std::to_string(scan.faces.size()) + " f lines");
+  if (scene.polygons().empty())
+    throw Error(ErrorCode::parse_error, "load_scene: '" + path.string() + "' has no faces (f lines)" +
+                                            (scan.faces.empty() ? "" : " that are not degenerate"));
+  warnings.move_to(scene);
+  return scene;
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,136 @@
+// OpenEXR reading and writing of Image: linear float RGB in channels R, G, B and each layer NAME
+// in NAME.R, NAME.G, NAME.B (the layer naming of OpenEXR's Technical Introduction, which
+// compositors and viewers understand). FLOAT channels keep the solver's values bit-exact;
+// OpenEXR's exceptions become radiosity::Error naming the path.
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
+
+#include <cstddef>
+#include <exception>
+#include <set>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "io/writers/image_checks.hpp"
+#include "radiosity/io.hpp"
+#include "radiosity/version.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+constexpr const char* kChannels[3] = {"R", "G", "B"};
+
+/// Inserts the three FLOAT slices of an RGB buffer (glm::vec3 is three packed floats) named
+/// prefix + R/G/B.
+void insert_rgb(Imf::FrameBuffer& fb, const std::string& prefix, const Rgb* pixels, int width,
+                const Imath::Box2i& window) {
+  const std::size_t x_stride = sizeof(Rgb);
+  const std::size_t y_stride = sizeof(Rgb) * static_cast<std::size_t>(width);
+  for (int c = 0; c < 3; ++c)
+    fb.insert(prefix + kChannels[c],
+              Imf::Slice::Make(Imf::FLOAT, reinterpret_cast<const float*>(pixels) + c, window, x_stride, y_stride));
+}
+
+void check_image(const Image& image, const std::filesystem::path& path) {
+  const std::string where = "write_exr: '" + path.string() + "': ";
+  detail::check_image_size(image, where);
+  const std::size_t n = image.pixels.size();
+  std::set<std::string> names;
+  for (const auto& [name, values] : image.layers) {
+    if (name.empty()) throw Error(ErrorCode::invalid_argument, where + "a layer has an empty name");
+    if (!names.insert(name).second)
+      throw Error(ErrorCode::invalid_argument, where + "layer '" + name + "' appears twice");
+    if (values.size() != n)
+      throw Error(ErrorCode::invalid_argument, where + "layer '" + name + "' has " + std::to_string(values.size()) +
+                                                   " pixels, width x height = " + std::to_string(n));
+  }
+}
+
+}  // namespace
+
+void write_exr(const Image& image, const std::filesystem::path& path) {
+  check_image(image, path);
+  try {
+    Imf::Header header(image.width, image.height);
+    header.insert("software", Imf::StringAttribute(std::string("radiosity ") + version()));
+    for (const char* c : kChannels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    for (const auto& layer : image.layers)
+      for (const char* c : kChannels) header.channels().insert(layer.first + "." + c, Imf::Channel(Imf::FLOAT));
+
+    Imf::FrameBuffer fb;
+    const Imath::Box2i& window = header.dataWindow();
+    insert_rgb(fb, "", image.pixels.data(), image.width, window);
+    for (const auto& layer : image.layers) insert_rgb(fb, layer.first + ".", layer.second.data(), image.width, window);
+
+    Imf::OutputFile file(path.string().c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(image.height);
+  } catch (const std::exception& e) {
+    throw Error(ErrorCode::io_error, "write_exr: cannot write '" + path.string() + "': " + e.what());
+  }
+}
+
+Image read_exr(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Error(ErrorCode::file_not_found, "read_exr: cannot open '" + path.string() + "': no such file");
+  try {
+    Imf::InputFile file(path.string().c_str());
+    const Imf::Header& header = file.header();
+    const Imath::Box2i window = header.dataWindow();
+    const Imf::ChannelList& channels = header.channels();
+
+    if (!channels.findChannel("R") && !channels.findChannel("G") && !channels.findChannel("B")) {
+      std::string found;
+      for (auto it = channels.begin(); it != channels.end(); ++it) found += std::string(found.empty() ? "" : ", ") + it.name();
+      throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "' has no R, G or B channel (channels: " +
+                                              (found.empty() ? "none" : found) + ")");
+    }
+
+    const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
+    const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
+    if (w <= 0 || h <= 0 || w * h > (1ll << 31))
+      throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': unusable data window " +
+                                              std::to_string(w) + " x " + std::to_string(h));
+    Image image(static_cast<int>(w), static_cast<int>(h));
+
+    // Layers: every prefix P of a channel P.R, P.G or P.B (OpenEXR sorts them by name).
+    std::set<std::string> layer_names;
+    channels.layers(layer_names);
+    for (const std::string& name : layer_names) {
+      bool has_rgb = false;
+      for (const char* c : kChannels) has_rgb = has_rgb || channels.findChannel(name + "." + c) != nullptr;
+      if (has_rgb) image.layers.emplace_back(name, std::vector<Rgb>(image.pixels.size(), Rgb(0.0f)));
+    }
+
+    // Channels absent from the file are left out of the frame buffer, so they stay 0.
+    Imf::FrameBuffer fb;
+    auto insert_present = [&](const std::string& prefix, Rgb* pixels) {
+      for (int c = 0; c < 3; ++c) {
+        const std::string name = prefix + kChannels[c];
+        if (!channels.findChannel(name)) continue;
+        fb.insert(name, Imf::Slice::Make(Imf::FLOAT, reinterpret_cast<float*>(pixels) + c, window, sizeof(Rgb),
+                                         sizeof(Rgb) * static_cast<std::size_t>(w)));
+      }
+    };
+    insert_present("", image.pixels.data());
+    for (auto& layer : image.layers) insert_present(layer.first + ".", layer.second.data());
+    file.setFrameBuffer(fb);
+    file.readPixels(window.min.y, window.max.y);
+    return image;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error(ErrorCode::parse_error, "read_exr: cannot read '" + path.string() + "': " + e.what());
+  }
+}
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,128 @@
+// Binary little-endian PLY export of a solution's leaf elements, for viewing the radiosity on the
+// mesh in MeshLab or Blender: per-vertex position, float radiosity and 8-bit sRGB display colour;
+// faces are triangles (quads split in two), since many importers handle nothing else well.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "io/writers/srgb.hpp"
+#include "radiosity/io.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+
+// PLY's binary_little_endian, written byte by byte so the file is the same on any host.
+void put_u32(std::string& out, std::uint32_t u) {
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((u >> (8 * i)) & 0xffu));
+}
+void put_f32(std::string& out, float v) {
+  std::uint32_t u = 0;
+  std::memcpy(&u, &v, sizeof u);
+  put_u32(out, u);
+}
+
+}  // namespace
+
+void write_ply(const Solution& solution, const std::filesystem::path& path, const PngOptions& options) {
+  const std::string where = "write_ply: '" + path.string() + "': ";
+  if (!(options.exposure >= 0.0f) || !std::isfinite(options.exposure))
+    throw Error(ErrorCode::invalid_argument, where + "PngOptions::exposure must be finite and >= 0");
+
+  const PatchHierarchy& h = solution.hierarchy();
+  const std::vector<glm::vec3>& positions = h.vertices();
+  const std::vector<Rgb> B = solution.vertex_radiosity();
+  if (B.size() != positions.size())
+    throw Error(ErrorCode::invalid_argument, where + "the solution has " + std::to_string(B.size()) +
+                                                 " vertex radiosities for " + std::to_string(positions.size()) +
+                                                 " vertices");
+
+  // Vertices used by leaves, numbered in order of first use; each leaf gives corner_count - 2
+  // triangles as a fan from its first corner (elements are convex). Back faces of translucent
+  // leaves follow, over their own copies of the vertices (numbered after the fronts').
+  std::vector<std::uint32_t> remap(positions.size(), kNone), back_remap(positions.size(), kNone);
+  std::vector<std::uint32_t> used, used_back, backs;
+  const std::vector<Rgb>& back = solution.back_radiosity();
+  const std::vector<Rgb> back_B = solution.vertex_back_radiosity();
+  std::size_t triangles = 0;
+  for (std::uint32_t leaf : h.leaves()) {
+    const Element& e = h.element(leaf);
+    const bool two_faces = !back.empty() && (back[leaf].x > 0.0f || back[leaf].y > 0.0f || back[leaf].z > 0.0f);
+    if (two_faces) backs.push_back(leaf);
+    for (int c = 0; c < e.corner_count(); ++c) {
+      const std::uint32_t v = e.corners[static_cast<std::size_t>(c)];
+      if (v >= positions.size())
+        throw Error(ErrorCode::invalid_argument, where + "element " + std::to_string(leaf) + " has vertex id " +
+                                                     std::to_string(v) + " out of range");
+      if (remap[v] == kNone) {
+        remap[v] = static_cast<std::uint32_t>(used.size());
+        used.push_back(v);
+      }
+      if (two_faces && back_remap[v] == kNone) {
+        back_remap[v] = static_cast<std::uint32_t>(used_back.size());
+        used_back.push_back(v);
+      }
+    }
+    triangles += static_cast<std::size_t>(e.corner_count() - 2) * (two_faces ? 2 : 1);
+  }
+  for (std::uint32_t& v : back_remap)
+    if (v != kNone) v += static_cast<std::uint32_t>(used.size());
+  const std::size_t vertex_count = used.size() + used_back.size();
+  if (vertex_count > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw Error(ErrorCode::invalid_argument, where + "too many vertices for PLY int indices");
+
+  std::string header;
+  header += "ply\nformat binary_little_endian 1.0\n";
+  header += std::string("comment written by radiosity ") + version() + "\n";
+  header += "comment radiosity_r/g/b: radiosity B in W/m^2 per scene unit^2; red/green/blue: sRGB of B/pi x exposure\n";
+  if (!backs.empty())
+    header += "comment translucent elements have a back face over their own vertex copies (back radiosity)\n";
+  header += "element vertex " + std::to_string(vertex_count) + "\n";
+  for (const char* p : {"x", "y", "z", "radiosity_r", "radiosity_g", "radiosity_b"})
+    header += std::string("property float ") + p + "\n";
+  for (const char* p : {"red", "green", "blue"}) header += std::string("property uchar ") + p + "\n";
+  header += "element face " + std::to_string(triangles) + "\n";
+  header += "property list uchar int vertex_indices\n";
+  header += "end_header\n";
+
+  std::string body;
+  body.reserve(vertex_count * 27 + triangles * 13);
+  auto put_vertex = [&](std::uint32_t v, const Rgb& b) {
+    for (int c = 0; c < 3; ++c) put_f32(body, positions[v][c]);
+    for (int c = 0; c < 3; ++c) put_f32(body, b[c]);
+    // Displayed radiance of a diffuse surface is B / pi.
+    for (int c = 0; c < 3; ++c) body.push_back(static_cast<char>(detail::srgb8(options.exposure * b[c] / kPi)));
+  };
+  for (std::uint32_t v : used) put_vertex(v, B[v]);
+  for (std::uint32_t v : used_back) put_vertex(v, back_B[v]);
+  auto put_faces = [&](std::uint32_t leaf, const std::vector<std::uint32_t>& index, bool reversed) {
+    const Element& e = h.element(leaf);
+    for (int t = 1; t + 1 < e.corner_count(); ++t) {
+      const std::uint32_t a = index[e.corners[0]], b = index[e.corners[static_cast<std::size_t>(t)]],
+                          c = index[e.corners[static_cast<std::size_t>(t + 1)]];
+      body.push_back(3);
+      put_u32(body, a);
+      put_u32(body, reversed ? c : b);
+      put_u32(body, reversed ? b : c);
+    }
+  };
+  for (std::uint32_t leaf : h.leaves()) put_faces(leaf, remap, false);
+  for (std::uint32_t leaf : backs) put_faces(leaf, back_remap, true);
+
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(ErrorCode::io_error, "write_ply: cannot open '" + path.string() + "' for writing");
+  out.write(header.data(), static_cast<std::streamsize>(header.size()));
+  out.write(body.data(), static_cast<std::streamsize>(body.size()));
+  out.close();
+  if (!out) throw Error(ErrorCode::io_error, "write_ply: cannot write '" + path.string() + "'");
+}
+
+}  // namespace v1
+}  // namespace radiosity

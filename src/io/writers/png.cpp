@@ -1,0 +1,49 @@
+// 8-bit sRGB PNG previews of linear images via stb_image_write: exposure, clamp to [0, 1], then
+// the sRGB transfer curve. For a quick look; EXR keeps the real values.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/writers/image_checks.hpp"
+#include "io/writers/srgb.hpp"
+#include "radiosity/io.hpp"
+
+// The implementation lives here, with internal linkage so it cannot clash with another copy of
+// stb in the program.
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#include <stb_image_write.h>
+#pragma GCC diagnostic pop
+
+namespace radiosity {
+inline namespace v1 {
+
+void write_png(const Image& image, const std::filesystem::path& path, const PngOptions& options) {
+  const std::string where = "write_png: '" + path.string() + "': ";
+  detail::check_image_size(image, where);
+  const std::size_t n = image.pixels.size();
+  if (!(options.exposure >= 0.0f) || !std::isfinite(options.exposure))
+    throw Error(ErrorCode::invalid_argument, where + "PngOptions::exposure must be finite and >= 0");
+
+  std::vector<std::uint8_t> rgb(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = detail::srgb8(options.exposure * image.pixels[i][c]);
+
+  if (stbi_write_png(path.string().c_str(), image.width, image.height, 3, rgb.data(), 3 * image.width) == 0)
+    throw Error(ErrorCode::io_error, "write_png: cannot write '" + path.string() + "'");
+}
+
+}  // namespace v1
+}  // namespace radiosity

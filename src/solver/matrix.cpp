@@ -1,0 +1,193 @@
+// Matrix radiosity: all element-to-patch form factors computed once, then Jacobi or
+// Gauss-Seidel sweeps of B = E + rho F B.
+// Based on: Goral, Torrance, Greenberg & Battaile, SIGGRAPH 1984; Cohen & Greenberg, "The
+// hemi-cube", SIGGRAPH 1985 (Gauss-Seidel); Cohen, Greenberg, Immel & Brock, "An efficient
+// radiosity approach for realistic image synthesis", IEEE CG&A 1986 (element-to-patch
+// substructuring: m x n factors, never element to element).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/parallel.hpp"
+#include "solver/system.hpp"
+
+namespace radiosity::detail {
+
+namespace {
+
+double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z); }
+
+}  // namespace
+
+SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixStore& store,
+                          const std::vector<Rgb>& B0) {
+  const RadiositySystem& sys = ctx.system;
+  const std::size_t m = sys.unknowns(), n = sys.patches();
+  SolverResult result;
+  result.B = B0.empty() ? sys.emission : B0;
+  result.H.assign(m, Rgb(0.0f));
+
+  // Which sides still need a row (unknowns, fronts first), and where it goes.
+  const std::size_t elements = ctx.hierarchy.elements().size();
+  if (store.slot.size() < elements) store.slot.resize(elements, kNone);
+  if (store.back_slot.size() < elements) store.back_slot.resize(elements, kNone);
+  auto slot_of = [&](std::size_t u) -> std::uint32_t& {
+    return (u < sys.fronts() ? store.slot : store.back_slot)[sys.element(u)];
+  };
+  std::vector<std::uint32_t> missing;
+  for (std::size_t u = 0; u < m; ++u)
+    if (slot_of(u) == kNone) missing.push_back(static_cast<std::uint32_t>(u));
+  // Memory, stated before anything is computed: dense rows hold a float per patch, sparse rows
+  // an index and a float per entry, at most max_row_entries() of them.
+  // Rows with backs come from the sparse calls (the dense ones keep to fronts).
+  const bool sparse = ctx.estimator.sparse() || sys.has_backs();
+  const std::size_t row_bytes =
+      sparse ? std::min(n, ctx.estimator.max_row_entries()) * 2 * sizeof(float) : n * sizeof(float);
+  std::size_t rows_held = 0;
+  for (const FactorVector& r : store.rows) rows_held += r.empty() ? 0 : 1;
+  const std::size_t bytes = (rows_held + missing.size()) * row_bytes;
+  if (bytes > ctx.options.memory_budget_bytes) {
+    std::ostringstream s;
+    s << "the form-factor matrix of " << m << " elements x " << n << " patches needs "
+      << (sparse ? "up to " : "") << bytes / (1024.0 * 1024.0) << " MiB, more than the memory budget of "
+      << ctx.options.memory_budget_bytes / (1024.0 * 1024.0)
+      << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive"
+      << (sparse ? "" : ", FormFactorMethod::monte_carlo (sparse rows)") << " or a coarser mesh";
+    throw Error(ErrorCode::memory_budget, s.str());
+  }
+  std::vector<std::uint32_t> slots(missing.size());
+  for (std::size_t k = 0; k < missing.size(); ++k) {
+    if (!store.free_slots.empty()) {
+      slots[k] = store.free_slots.back();
+      store.free_slots.pop_back();
+    } else {
+      slots[k] = static_cast<std::uint32_t>(store.rows.size());
+      store.rows.emplace_back();
+    }
+  }
+
+  // Form factors, in chunks so that progress is reported and cancel is honoured.
+  auto t0 = std::chrono::steady_clock::now();
+  const std::size_t chunk = std::max<std::size_t>(64, missing.size() / 200);
+  std::vector<std::uint32_t> rows, backs;
+  std::vector<SparseFactors> sparse_rows, back_rows;
+  std::vector<float> buffer;
+  for (std::size_t begin = 0; begin < missing.size(); begin += chunk) {
+    std::size_t end = std::min(missing.size(), begin + chunk);
+    rows.clear();
+    backs.clear();
+    for (std::size_t k = begin; k < end; ++k)
+      (missing[k] < sys.fronts() ? rows : backs).push_back(sys.element(missing[k]));
+    if (sparse) {
+      ctx.estimator.sparse_element_rows(rows, sparse_rows);
+      if (!backs.empty()) ctx.estimator.sparse_back_rows(backs, back_rows);
+      std::size_t front = 0, back = 0;  // fronts come before backs in `missing`
+      for (std::size_t k = begin; k < end; ++k) {
+        SparseFactors& from = missing[k] < sys.fronts() ? sparse_rows[front++] : back_rows[back++];
+        FactorVector& r = store.rows[slots[k]];
+        r.index = std::move(from.index);
+        r.value = std::move(from.value);
+        r.index.shrink_to_fit();
+        r.value.shrink_to_fit();
+        slot_of(missing[k]) = slots[k];
+      }
+    } else {
+      buffer.resize(rows.size() * n);
+      ctx.estimator.element_rows(rows, buffer.data());
+      for (std::size_t k = begin; k < end; ++k) {
+        FactorVector& r = store.rows[slots[k]];
+        r.index.clear();
+        r.value.assign(buffer.data() + (k - begin) * n, buffer.data() + (k - begin + 1) * n);
+        slot_of(missing[k]) = slots[k];
+      }
+    }
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = static_cast<double>(end) / static_cast<double>(missing.size());
+    if (!ctx.progress.report(p, end == missing.size())) {
+      // Leaves without a row would be read below: forget the partial work and stop here with
+      // the starting estimate, which is consistent.
+      for (std::size_t k = 0; k < missing.size(); ++k)
+        if (slot_of(missing[k]) == kNone) store.free_slots.push_back(slots[k]);
+      result.status = SolveStatus::cancelled;
+      result.seconds_form_factors = seconds_since(t0);
+      result.form_factor_bytes = store.bytes();
+      return result;
+    }
+  }
+  result.seconds_form_factors = seconds_since(t0);
+  result.form_factor_bytes = store.bytes();
+  std::vector<const FactorVector*> row_of(m);
+  for (std::size_t u = 0; u < m; ++u) row_of[u] = &store.rows[slot_of(u)];
+  auto row = [&](std::size_t i) -> const FactorVector& { return *row_of[i]; };
+  // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp); opaque sides have no twin.
+  auto radiosity = [&](std::size_t i, const Rgb& h) {
+    Rgb b = sys.emission[i] + sys.reflectance[i] * h;
+    if (sys.twin[i] != kNone) b += sys.transmittance[i] * result.H[sys.twin[i]];
+    return b;
+  };
+
+  // Sweeps. Residual: power that the last sweep changed, over the emitted power.
+  std::vector<Rgb> patch_B, next(m);
+  const int max_iterations = ctx.options.max_iterations;
+  result.status = SolveStatus::iteration_cap;
+  for (int it = 1; it <= max_iterations; ++it) {
+    sys.patch_means(result.B, patch_B);
+    double change = 0.0;
+    if (!gauss_seidel) {
+      // Jacobi: every side from the previous sweep's patch radiosity; rows are independent.
+      // Translucent sides need the other side's irradiance, so all of H comes first.
+      parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) result.H[i] = row(i).dot(patch_B);
+      });
+      for (std::size_t i = 0; i < m; ++i) next[i] = radiosity(i, result.H[i]);
+      for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * l1(next[i] - result.B[i]);
+      result.B.swap(next);
+    } else {
+      // Gauss-Seidel: each side sees the patch means already updated by earlier sides. A new
+      // irradiance changes the twin's radiosity too (it transmits it), so that is updated at
+      // once: otherwise a sweep could change only irradiances and look converged.
+      auto set = [&](std::size_t i) {
+        const Rgb b = radiosity(i, result.H[i]);
+        const Rgb d = b - result.B[i];
+        change += sys.area[i] * l1(d);
+        patch_B[sys.patch[i]] += (sys.area[i] / sys.patch_area[sys.patch[i]]) * d;
+        result.B[i] = b;
+      };
+      for (std::size_t i = 0; i < m; ++i) {
+        result.H[i] = row(i).dot(patch_B);
+        set(i);
+        if (sys.twin[i] != kNone) set(sys.twin[i]);
+      }
+    }
+    result.iterations = it;
+    result.residual = change / sys.emitted;
+    result.residual_history.push_back(result.residual);
+    result.time_history.push_back(seconds_since(t0));  // form factors included: the first sweep waits for them
+    const bool done = result.residual < ctx.options.tolerance;
+    Progress p;
+    p.phase = Phase::solving;
+    p.iteration = it;
+    p.residual = result.residual;
+    p.fraction = done ? 1.0
+                      : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
+    if (done) result.status = SolveStatus::converged;
+    p.hierarchy = &ctx.hierarchy;
+    p.leaf_radiosity = result.B.data();
+    if (!ctx.progress.report(p, done)) {
+      result.status = SolveStatus::cancelled;
+      break;
+    }
+    if (done) break;
+  }
+
+  // Irradiance for the energy balance: H_e = sum_j F_ej B_j with the final radiosity.
+  sys.patch_means(result.B, patch_B);
+  parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) result.H[i] = row(i).dot(patch_B);
+  });
+  return result;
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,58 @@
+#include "solver/system.hpp"
+
+#include "form_factors/estimators.hpp"
+#include "form_factors/pass1_material.hpp"
+
+namespace radiosity::detail {
+
+RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission)
+    : leaves(hierarchy.leaves()) {
+  const std::size_t m = leaves.size(), n = hierarchy.patches().size();
+  // Back targets first, numbered as the estimators number them, so each back unknown knows its target.
+  const std::vector<std::uint32_t> translucent_patches =
+      diffuse_transmission ? find_back_patches(scene, hierarchy) : std::vector<std::uint32_t>{};
+  const std::vector<std::uint32_t> back_target = back_targets(n, translucent_patches);
+  patch_area.assign(n + translucent_patches.size(), 0.0f);
+  auto add = [&](std::uint32_t target, float a, const Rgb& E, const Rgb& rho, const Rgb& tau, std::uint32_t other) {
+    area.push_back(a);
+    emission.push_back(E);
+    reflectance.push_back(rho);
+    transmittance.push_back(tau);
+    patch.push_back(target);
+    twin.push_back(other);
+    // Patch areas as the sum of their leaves, so a patch mean of a constant field is exact.
+    patch_area[target] += a;
+    total_area += a;
+  };
+  std::vector<std::uint32_t> backs;  // positions in `leaves` of the leaves with a back
+  for (std::size_t i = 0; i < m; ++i) {
+    const Element& e = hierarchy.element(leaves[i]);
+    const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
+    const bool translucent = back_target[e.patch] != kNone;
+    add(e.patch, e.area, mat.emission, mat.reflectance, translucent ? mat.diffuse_transmittance : Rgb(0.0f),
+        translucent ? static_cast<std::uint32_t>(m + backs.size()) : kNone);
+    if (translucent) backs.push_back(static_cast<std::uint32_t>(i));
+    emitted += static_cast<double>(e.area) * (mat.emission.x + mat.emission.y + mat.emission.z);
+  }
+  for (std::uint32_t i : backs) {
+    const Element& e = hierarchy.element(leaves[i]);
+    const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
+    const Rgb E = pass1_back_emission(mat);
+    add(back_target[e.patch], e.area, E, pass1_back_reflectance(mat), mat.diffuse_transmittance, i);
+    emitted += static_cast<double>(e.area) * (E.x + E.y + E.z);
+  }
+  glm::dvec3 mean(0.0);
+  for (std::size_t u = 0; u < area.size(); ++u)
+    mean += static_cast<double>(area[u]) * glm::dvec3(reflectance[u] + transmittance[u]);
+  if (total_area > 0.0) mean /= total_area;
+  interreflection = Rgb(1.0 / (glm::dvec3(1.0) - mean));
+}
+
+void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const {
+  std::vector<glm::dvec3> sum(patch_area.size(), glm::dvec3(0.0));
+  for (std::size_t i = 0; i < B.size(); ++i) sum[patch[i]] += static_cast<double>(area[i]) * glm::dvec3(B[i]);
+  patch_B.resize(patch_area.size());
+  for (std::size_t j = 0; j < sum.size(); ++j) patch_B[j] = Rgb(sum[j] / static_cast<double>(patch_area[j]));
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,421 @@
+// The Monte Carlo ray-shooting estimator: closed forms within its statistical error, exact row
+// sums in closed enclosures, exact factors to emitting patches where nothing occludes, columns
+// consistent with rows through reciprocity, determinism, and the solvers on sparse rows.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "form_factors/ff_support.hpp"
+#include "support/scenes.hpp"
+
+using namespace fftest;
+
+namespace {
+
+rad::FormFactorOptions monte_carlo(std::uint32_t rays) {
+  rad::FormFactorOptions o;
+  o.method = rad::FormFactorMethod::monte_carlo;
+  o.hemisphere_rays = rays;
+  return o;
+}
+
+/// Four standard errors of a hit fraction F estimated from `rays` independent rays: a bound that
+/// stratification only makes safer.
+double four_sigma(double F, double rays) { return 4.0 * std::sqrt(F * (1.0 - F) / rays); }
+
+// The unit box around a floating block, 2 patches per wall (as in test_view_factors.cpp).
+rad::Scene room_with_block(const rad::Material& walls = rad::Material{}) {
+  rad::Scene s = test::closed_box(walls);
+  const rad::MaterialId m = 0;
+  const float a = 0.35f, b = 0.65f, lo = 0.2f, hi = 0.5f;
+  s.add_polygon({{a, lo, a}, {b, lo, a}, {b, lo, b}, {a, lo, b}}, m, "block");
+  s.add_polygon({{a, hi, a}, {a, hi, b}, {b, hi, b}, {b, hi, a}}, m, "block");
+  s.add_polygon({{a, lo, a}, {a, hi, a}, {b, hi, a}, {b, lo, a}}, m, "block");
+  s.add_polygon({{a, lo, b}, {b, lo, b}, {b, hi, b}, {a, hi, b}}, m, "block");
+  s.add_polygon({{a, lo, a}, {a, lo, b}, {a, hi, b}, {a, hi, a}}, m, "block");
+  s.add_polygon({{b, lo, a}, {b, hi, a}, {b, hi, b}, {b, lo, b}}, m, "block");
+  return s;
+}
+
+rad::MeshOptions mesh(float patch, float element) {
+  rad::MeshOptions m;
+  m.max_patch_area = patch;
+  m.max_element_area = element;
+  return m;
+}
+
+}  // namespace
+
+TEST_SUITE("formfactor") {
+  TEST_CASE("monte_carlo: unit cube faces within four standard errors of 0.1998249 and 0.2000438 and rows sum to 1") {
+    const rad::Scene s = test::closed_box(rad::Material{});
+    rad::ViewFactorOptions o;
+    o.form_factors = monte_carlo(4096);
+    o.mesh = mesh(1.0f, 1.0f / 16.0f);
+    const rad::GroupViewFactors v = rad::view_factors(s, o);
+    REQUIRE(v.groups.size() == 6);
+    const double rays_per_face = 16.0 * 4096.0;
+    for (std::size_t i = 0; i < 6; ++i) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < 6; ++k) {
+        sum += v.at(i, k);
+        const double expected = k == i ? 0.0 : (k == (i ^ 1u) ? 0.1998249 : 0.2000438);
+        INFO("F(", i, " -> ", k, ") = ", v.at(i, k), ", expected ", expected);
+        CHECK(std::fabs(v.at(i, k) - expected) <= four_sigma(expected, rays_per_face));
+      }
+      // Every ray from inside a closed box lands on the front of a face.
+      CHECK(sum == doctest::Approx(1.0).epsilon(1e-5));
+    }
+  }
+
+  TEST_CASE("monte_carlo agrees with ray_cast in an occluded room within the two estimators' errors") {
+    const rad::Scene s = room_with_block();
+    rad::ViewFactorOptions o;
+    o.mesh = mesh(0.5f, 0.125f);
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    const rad::GroupViewFactors ref = rad::view_factors(s, o);
+    o.form_factors = monte_carlo(2048);
+    const rad::GroupViewFactors mc = rad::view_factors(s, o);
+    REQUIRE(mc.groups == ref.groups);
+    for (std::size_t i = 0; i < ref.groups.size(); ++i) {
+      // Rays leaving group i: its area over the mean element area, times the rays per element.
+      const double rays = static_cast<double>(mc.element_count) * 2048.0 * ref.area[i] /
+                          std::accumulate(ref.area.begin(), ref.area.end(), 0.0);
+      for (std::size_t k = 0; k < ref.groups.size(); ++k) {
+        const double f = ref.at(i, k);
+        INFO(ref.groups[i], " -> ", ref.groups[k], ": ray_cast ", f, ", monte_carlo ", mc.at(i, k));
+        // ray_cast is within 0.5 % of the truth; monte_carlo within four standard errors.
+        CHECK(std::fabs(mc.at(i, k) - f) <= 0.005 * f + four_sigma(f, rays) + 1e-6);
+      }
+    }
+  }
+
+  TEST_CASE("monte_carlo: factors to an emitting patch that nothing occludes equal the analytic estimator's") {
+    rad::Scene s = test::closed_box(rad::Material{});
+    rad::Material light;
+    light.emission = rad::Rgb(10.0f);
+    const rad::MaterialId id = s.add_material(light);
+    // A small light just below the ceiling (y = 1), facing down, in the open box.
+    s.add_polygon({{0.4f, 0.99f, 0.4f}, {0.6f, 0.99f, 0.4f}, {0.6f, 0.99f, 0.6f}, {0.4f, 0.99f, 0.6f}}, id, "light");
+    const rad::PatchHierarchy h(s, mesh(0.26f, 0.07f));
+    const auto mc = rad::make_form_factor_estimator(s, h, monte_carlo(256));
+    rad::FormFactorOptions ao;
+    ao.method = rad::FormFactorMethod::analytic;
+    const auto exact = rad::make_form_factor_estimator(s, h, ao);
+    const std::size_t n = h.patches().size();
+    const auto& leaves = h.leaves();
+    std::vector<float> a(leaves.size() * n), b(leaves.size() * n);
+    mc->element_rows(leaves, a.data());
+    exact->element_rows(leaves, b.data());
+    const rad::GroupId light_group = *s.find_group("light");
+    int checked = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (h.patches()[j].group != light_group) continue;
+      for (std::size_t k = 0; k < leaves.size(); ++k) {
+        CHECK(a[k * n + j] == b[k * n + j]);
+        checked += b[k * n + j] > 0.0f;
+      }
+      // The column for progressive refinement carries the same numbers.
+      std::vector<float> column(leaves.size());
+      mc->patch_column(static_cast<std::uint32_t>(j), leaves, column.data());
+      for (std::size_t k = 0; k < leaves.size(); ++k) CHECK(column[k] == a[k * n + j]);
+    }
+    CHECK(checked > 20);
+  }
+
+  TEST_CASE("monte_carlo: shot columns match the rows through reciprocity and both are deterministic") {
+    const rad::Scene s = room_with_block();
+    const rad::PatchHierarchy h(s, mesh(0.5f, 0.125f));
+    const std::size_t n = h.patches().size();
+    const auto& leaves = h.leaves();
+    rad::FormFactorOptions o = monte_carlo(1024);
+    o.threads = 1;
+    const auto one = rad::make_form_factor_estimator(s, h, o);
+    o.threads = 2;
+    const auto two = rad::make_form_factor_estimator(s, h, o);
+    std::vector<float> rows(leaves.size() * n), rows2(leaves.size() * n);
+    one->element_rows(leaves, rows.data());
+    two->element_rows(leaves, rows2.data());
+    CHECK(rows == rows2);
+    std::vector<rad::SparseFactors> sparse;
+    two->sparse_element_rows(leaves, sparse);
+    REQUIRE(sparse.size() == leaves.size());
+    for (std::size_t k = 0; k < leaves.size(); ++k)
+      for (std::size_t i = 0; i < sparse[k].index.size(); ++i) {
+        CHECK(sparse[k].value[i] == rows[k * n + sparse[k].index[i]]);
+        if (i > 0) CHECK(sparse[k].index[i] > sparse[k].index[i - 1]);
+      }
+    std::vector<float> column(leaves.size()), column2(leaves.size());
+    for (std::uint32_t j = 0; j < n; ++j) {
+      one->patch_column(j, leaves, column.data());
+      two->patch_column(j, leaves, column2.data());
+      CHECK(column == column2);
+      // A_j F(j -> everything) from the rows and from the column, as fractions of the rays.
+      double from_rows = 0.0, from_column = 0.0;
+      for (std::size_t k = 0; k < leaves.size(); ++k) {
+        const double area = h.element(leaves[k]).area;
+        from_rows += area * rows[k * n + j];
+        from_column += area * column[k];
+      }
+      const double A = h.patches()[j].area, F = from_rows / A;
+      // The patch shoots 1024 rays per element it holds, and its elements receive 1024 rays each.
+      const double rays = 1024.0 * A / 0.125;
+      INFO("patch ", j, ": F(j -> all) from rows ", F, ", from its column ", from_column / A);
+      CHECK(std::fabs(from_column / A - F) <= 2.0 * four_sigma(std::min(F, 0.5), rays));
+    }
+  }
+
+  TEST_CASE("monte_carlo options: hemisphere_rays outside 16..1048576 is an error naming the field") {
+    const rad::Scene s = test::closed_box(rad::Material{});
+    const rad::PatchHierarchy h(s, mesh(1.0f, 1.0f));
+    for (std::uint32_t bad : {0u, 1u, 15u, (1u << 20) + 1u}) {
+      CAPTURE(bad);
+      CHECK_THROWS_WITH_AS(rad::make_form_factor_estimator(s, h, monte_carlo(bad)),
+                           doctest::Contains("form_factors.hemisphere_rays"), rad::Error);
+    }
+    CHECK_NOTHROW(rad::make_form_factor_estimator(s, h, monte_carlo(16)));
+  }
+}
+
+TEST_SUITE("solve") {
+  TEST_CASE("monte_carlo furnace: B = E/(1-rho) within 0.1% for the matrix methods and on average for progressive") {
+    rad::Material m;
+    m.emission = rad::Rgb(1.0f, 2.0f, 0.5f);
+    m.reflectance = rad::Rgb(0.5f, 0.8f, 0.2f);
+    const rad::Scene scene = test::closed_box(m);
+    const rad::Rgb expected = m.emission / (rad::Rgb(1.0f) - m.reflectance);
+    for (rad::SolverMethod method :
+         {rad::SolverMethod::jacobi, rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      rad::SolveOptions o;
+      o.method = method;
+      o.form_factors = monte_carlo(1024);
+      // Every one of the 24 emitting patches exact, so rows are exact factor sums (with the
+      // default limit of 16 the rest would be counted by rays: see "many emitting patches").
+      o.form_factors.exact_emitters = 0;
+      o.mesh = mesh(0.26f, 0.07f);
+      o.tolerance = 1e-6;
+      const rad::Solution sol = rad::solve(scene, o);
+      CHECK(sol.status() == rad::SolveStatus::converged);
+      const auto& h = sol.hierarchy();
+      double area = 0.0;
+      glm::dvec3 mean(0.0);
+      for (std::uint32_t e : h.leaves()) {
+        const rad::Rgb b = sol.radiosity()[e];
+        mean += static_cast<double>(h.element(e).area) * glm::dvec3(b);
+        area += h.element(e).area;
+        if (method != rad::SolverMethod::progressive) {
+          // Rows sum to 1 exactly, so the uniform field is their fixed point.
+          for (int c = 0; c < 3; ++c) CHECK(b[c] == doctest::Approx(expected[c]).epsilon(1e-3));
+        } else {
+          // Shot columns conserve power but scatter it: each element's irradiance is a sum over
+          // ~20 000 rays, and 1/(1 - 0.8) amplifies the green channel's noise 5 times.
+          for (int c = 0; c < 3; ++c) CHECK(b[c] == doctest::Approx(expected[c]).epsilon(0.08));
+        }
+      }
+      mean /= area;
+      for (int c = 0; c < 3; ++c) CHECK(mean[c] == doctest::Approx(expected[c]).epsilon(1e-3));
+      const rad::SolveReport& r = sol.report();
+      for (int c = 0; c < 3; ++c) CHECK(r.absorbed_power[c] == doctest::Approx(r.emitted_power[c]).epsilon(1e-3));
+    }
+  }
+
+  TEST_CASE("monte_carlo Cornell box: group radiosities within 1% of the ray_cast solution for every method") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 12000.0f;
+    o.mesh.max_element_area = 6000.0f;
+    o.tolerance = 1e-5;
+    const rad::Solution ref = rad::solve(scene, o);
+    for (rad::SolverMethod method :
+         {rad::SolverMethod::jacobi, rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      o.method = method;
+      o.form_factors = monte_carlo(2048);
+      const rad::Solution sol = rad::solve(scene, o);
+      for (const std::string& g : scene.groups()) {
+        const rad::Rgb a = sol.group_radiosity(g), b = ref.group_radiosity(g);
+        INFO(g, ": monte_carlo ", a.x, " ", a.y, " ", a.z, ", ray_cast ", b.x, " ", b.y, " ", b.z);
+        for (int c = 0; c < 3; ++c) CHECK(a[c] == doctest::Approx(b[c]).epsilon(0.01));
+      }
+    }
+  }
+
+  TEST_CASE("sparse rows fit a memory budget that the dense matrix would exceed") {
+    rad::Scene scene = test::closed_box(rad::Material{});
+    rad::Material light;
+    light.emission = rad::Rgb(10.0f);
+    const rad::MaterialId id = scene.add_material(light);
+    scene.add_polygon({{0.4f, 0.99f, 0.4f}, {0.6f, 0.99f, 0.4f}, {0.6f, 0.99f, 0.6f}, {0.4f, 0.99f, 0.6f}}, id, "light");
+    rad::SolveOptions o;
+    // 676 patches per face and 25 on the light, 4081 in all: a 64 MiB dense matrix.
+    o.mesh = mesh(0.0016f, 0.0016f);
+    o.memory_budget_bytes = 8u << 20;
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    CHECK_THROWS_WITH_AS(rad::solve(scene, o), doctest::Contains("FormFactorMethod::monte_carlo"), rad::Error);
+    o.form_factors = monte_carlo(64);  // at most 64 + 25 entries of 8 bytes per row: under 3 MiB
+    const rad::Solution sol = rad::solve(scene, o);
+    CHECK(sol.status() == rad::SolveStatus::converged);
+    CHECK(sol.report().form_factor_bytes <= o.memory_budget_bytes);
+  }
+}
+
+namespace {
+
+/// A mirror floor (y = 0, facing up, 8 x 8), a diffuse ceiling tile C and a light L beside it
+/// (both at y = 1, facing down, 1 x 1 each, 1.5 apart). Open: rays that miss everything escape.
+rad::Scene mirror_room(float mirror) {
+  rad::Scene s;
+  rad::Material floor;
+  floor.reflectance = rad::Rgb(0.0f);
+  floor.specular = rad::Rgb(mirror);
+  rad::Material tile;
+  tile.reflectance = rad::Rgb(0.5f);
+  rad::Material light;
+  light.reflectance = rad::Rgb(0.0f);
+  light.emission = rad::Rgb(1.0f);
+  const rad::MaterialId f = s.add_material(floor), c = s.add_material(tile), l = s.add_material(light);
+  s.add_polygon({{-3, 0, -3}, {-3, 0, 5}, {5, 0, 5}, {5, 0, -3}}, f, "floor");
+  s.add_polygon({{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, c, "tile");
+  s.add_polygon({{1.5f, 1, 0}, {2.5f, 1, 0}, {2.5f, 1, 1}, {1.5f, 1, 1}}, l, "light");
+  return s;
+}
+
+}  // namespace
+
+TEST_SUITE("solve") {
+  TEST_CASE("mirror form factors: a tile above a mirror floor gets rho r F(tile -> mirrored light) E plus its own image") {
+    // The reference: the factor to the light's mirror image, by the analytic estimator.
+    rad::Scene image;
+    const rad::MaterialId m = image.add_material(rad::Material{});
+    image.add_polygon({{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, m, "tile");
+    image.add_polygon({{1.5f, -1, 0}, {1.5f, -1, 1}, {2.5f, -1, 1}, {2.5f, -1, 0}}, m, "light_image");
+    rad::ViewFactorOptions vo;
+    vo.form_factors.method = rad::FormFactorMethod::analytic;
+    const double F = rad::view_factors(image, vo).at(0, 1);
+    REQUIRE(F > 0.01);
+
+    rad::SolveOptions o;
+    o.form_factors = monte_carlo(8192);
+    o.form_factors.specular_depth = 1;
+    o.mesh = mesh(0.0625f, 0.0625f);  // 16 elements on the tile
+    o.tolerance = 1e-6;
+    const double rays = 16.0 * 8192.0;
+    for (rad::SolverMethod method : {rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      o.method = method;
+      const double r = 0.9;
+      const rad::Solution mirror = rad::solve(mirror_room(static_cast<float>(r)), o);
+      // The tile also sees its own mirror image (1 x 1 at distance 2, Howell C-11), so
+      // B = rho r F E + rho r F_self B.
+      const double F_self = test::parallel_rectangles(1, 1, 2);
+      const double expected = 0.5 * r * F * 1.0 / (1.0 - 0.5 * r * F_self);
+      const double got = mirror.group_radiosity("tile").y;
+      INFO("F(tile -> mirrored light) = ", F, ": expected B = ", expected, ", got ", got);
+      CHECK(std::fabs(got - expected) <= 0.5 * r * four_sigma(F, rays));
+      // A black, non-reflecting floor leaves the tile dark: it sees nothing else.
+      const rad::Solution black = rad::solve(mirror_room(0.0f), o);
+      CHECK(black.group_radiosity("tile").y == 0.0f);
+      // Without extended form factors the mirror is just a black floor.
+      rad::SolveOptions classic = o;
+      classic.form_factors.specular_depth = 0;
+      CHECK(rad::solve(mirror_room(static_cast<float>(r)), classic).group_radiosity("tile").y == 0.0f);
+    }
+  }
+
+  TEST_CASE("specular_depth needs the monte_carlo estimator and at most 16 events") {
+    const rad::Scene s = mirror_room(0.9f);
+    rad::SolveOptions o;
+    o.form_factors.specular_depth = 1;
+    // The automatic estimator takes monte_carlo for it; another explicit one is an error.
+    CHECK(rad::solve(s, o).report().form_factor_method == rad::FormFactorMethod::monte_carlo);
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    CHECK_THROWS_WITH_AS(rad::solve(s, o), doctest::Contains("needs FormFactorMethod::monte_carlo"), rad::Error);
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.specular_depth = 17;
+    CHECK_THROWS_WITH_AS(rad::solve(s, o), doctest::Contains("form_factors.specular_depth"), rad::Error);
+  }
+}
+
+TEST_SUITE("solve") {
+  TEST_CASE("window form factors: light through a clear pane of transmittance T reaches a tile T times as strongly") {
+    // Howell C-11 for the tile and the light (1 x 1, 2 apart), a 4 x 4 window halfway between.
+    const double F = test::parallel_rectangles(1, 1, 2);
+    auto room = [](float T) {
+      rad::Scene s;
+      rad::Material tile;
+      tile.reflectance = rad::Rgb(0.5f);
+      rad::Material pane;
+      pane.reflectance = rad::Rgb(0.0f);
+      pane.transmittance = rad::Rgb(T);
+      pane.ior = 1.0f;  // a window: no refraction
+      rad::Material light;
+      light.reflectance = rad::Rgb(0.0f);
+      light.emission = rad::Rgb(1.0f);
+      const rad::MaterialId t = s.add_material(tile), p = s.add_material(pane), l = s.add_material(light);
+      s.add_polygon({{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, t, "tile");
+      s.add_polygon({{-1.5f, 1, -1.5f}, {-1.5f, 1, 2.5f}, {2.5f, 1, 2.5f}, {2.5f, 1, -1.5f}}, p, "window");
+      s.add_polygon({{0, 2, 0}, {1, 2, 0}, {1, 2, 1}, {0, 2, 1}}, l, "light");
+      return s;
+    };
+    rad::SolveOptions o;
+    o.form_factors = monte_carlo(8192);
+    o.form_factors.specular_depth = 1;
+    o.mesh = mesh(0.0625f, 0.0625f);
+    o.tolerance = 1e-6;
+    const double rays = 16.0 * 8192.0;
+    for (float T : {1.0f, 0.6f}) {
+      CAPTURE(T);
+      const double got = rad::solve(room(T), o).group_radiosity("tile").y;
+      const double expected = 0.5 * T * F;
+      INFO("expected ", expected, ", got ", got);
+      CHECK(std::fabs(got - expected) <= 0.5 * T * four_sigma(F, rays));
+    }
+    // Classic radiosity: the pane is opaque and black.
+    o.form_factors.specular_depth = 0;
+    CHECK(rad::solve(room(1.0f), o).group_radiosity("tile").y == 0.0f);
+  }
+}
+
+TEST_SUITE("formfactor") {
+  TEST_CASE("many emitting patches: exact factors for the strongest few - the rest by rays - within noise") {
+    // A closed unit box whose every face is 4 x 4 emitting facets (96 emitting patches, more
+    // than exact_emitters = 16): a furnace, B = E / (1 - rho) everywhere, whichever emitters a
+    // row takes exactly.
+    rad::Material m;
+    m.emission = rad::Rgb(2.0f);
+    m.reflectance = rad::Rgb(0.5f);
+    rad::Scene scene;
+    const rad::MaterialId id = scene.add_material(m);
+    const rad::Scene box = test::closed_box(m);
+    for (const rad::Polygon& face : box.polygons()) {
+      const glm::vec3 o = face.vertices[0], u = face.vertices[1] - o, v = face.vertices[3] - o;
+      for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 4; ++k)
+          rad::add_quad(scene, o + u * (i / 4.0f) + v * (k / 4.0f), u / 4.0f, v / 4.0f, id, box.groups()[face.group]);
+    }
+    rad::SolveOptions o;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.mesh.max_patch_area = 1.0f / 16.0f + 1e-4f;
+    o.mesh.max_element_area = 1.0f / 64.0f + 1e-4f;  // 4 elements per facet
+    o.tolerance = 1e-6;
+    REQUIRE(o.form_factors.exact_emitters < 96);
+    const rad::Solution limited = rad::solve(scene, o);
+    o.form_factors.exact_emitters = 0;  // every emitting patch exact
+    const rad::Solution all = rad::solve(scene, o);
+    const double expected = 2.0 / (1.0 - 0.5);
+    double worst = 0.0, worst_all = 0.0;
+    for (std::uint32_t leaf : limited.hierarchy().leaves()) {
+      worst = std::max(worst, std::fabs(limited.radiosity()[leaf].x / expected - 1.0));
+      worst_all = std::max(worst_all, std::fabs(all.radiosity()[leaf].x / expected - 1.0));
+    }
+    MESSAGE("furnace of 96 emitting facets: worst leaf " << worst << " (every emitter exact: " << worst_all << ")");
+    // A row's exact part and its rays each estimate their share without bias; their sum is 1
+    // to the rays' noise (1024 rays), where every-exact rows sum to 1 to visibility rounding.
+    CHECK(worst < 0.02);
+    for (const std::string& g : limited.groups())
+      CHECK(limited.group_radiosity(g).x == doctest::Approx(expected).epsilon(0.005));
+  }
+}
