@@ -92,9 +92,8 @@ struct FormFactorOptions {
   /// Back sides: diffuse transmission (Rushmeier & Torrance 1990) and two-sided surfaces, for
   /// every method. A patch whose material has diffuse_transmittance > 0 (a translucent thin
   /// sheet) or is two_sided (a single sheet that reflects on both sides: a partition wall, a
-  /// table top as one quad) has two sides. Its back becomes a second target, numbered patch
-  /// count + k for the k-th such patch (FormFactorEstimator::translucent_patches(), which
-  /// despite its name lists two-sided patches too), which sparse rows and columns then report,
+  /// table top as one quad) has two sides. Its back becomes a second Target{patch, Side::back}
+  /// (FormFactorEstimator::patches_with_backs(), target_index()), which sparse rows and columns then report,
   /// and its elements get a second row over the back hemisphere (sparse_back_rows(): Rushmeier's
   /// backward form factors). The dense calls (element_rows(), patch_column()) keep to the
   /// fronts of patches. solve() sets this when the scene uses a translucent or two-sided
@@ -103,6 +102,23 @@ struct FormFactorOptions {
   /// Seeds every random stream (ray-cast samples, hemicube orientations).
   std::uint64_t seed = 1;
   unsigned threads = 0;  ///< 0 = all hardware threads; 1 = the calling thread only
+};
+
+/// Which side of a patch light leaves from or arrives at: the front faces the polygon's normal
+/// (counter-clockwise corners seen from it), the back faces away. Only a translucent or a
+/// two-sided patch has a back of its own in the form factors (FormFactorOptions::
+/// diffuse_transmission); the back of a one-sided opaque patch absorbs and sees nothing.
+enum class Side : std::uint8_t { front, back };
+
+/// A receiver of light: one side of one patch (an index into PatchHierarchy::patches()). Sparse
+/// rows index their entries by target: FormFactorEstimator::target_index() and target() convert
+/// between the two, so no caller needs to know how the backs are numbered.
+struct Target {
+  std::uint32_t patch = kNone;
+  Side side = Side::front;
+
+  friend bool operator==(const Target& a, const Target& b) { return a.patch == b.patch && a.side == b.side; }
+  friend bool operator!=(const Target& a, const Target& b) { return !(a == b); }
 };
 
 /// The non-zero entries of one row (or column) of the form-factor matrix, indices increasing.
@@ -134,16 +150,16 @@ class RADIOSITY_API FormFactorEstimator {
                             float* out) const = 0;
 
   /// element_rows() with only the non-zero entries: out[k] (resized to elements.size()) is the
-  /// row of elements[k], indexed by patch id (and, with diffuse transmission, by target: the
-  /// backs of translucent patches follow the patches). The default compresses dense rows
+  /// row of elements[k], indexed by patch id (and, with diffuse transmission, by target_index():
+  /// the backs of patches_with_backs() come after the fronts of all patches). The default compresses dense rows
   /// computed a few hundred at a time.
   virtual void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const;
 
   /// patch_column() with only the non-zero entries, indexed by position in `elements`. The
   /// default compresses the dense column. With diffuse transmission `patch` may be any target
-  /// (>= the patch count: the back of a translucent patch), and arrivals at the backs of
-  /// translucent elements are reported too: index k < elements.size() is the front of
-  /// elements[k], elements.size() + k its back.
+  /// (target_index(Target{p, Side::back}) shoots from the back of patch p), and arrivals at the
+  /// backs of elements are reported too: index k < elements.size() is the Side::front of
+  /// elements[k], elements.size() + k its Side::back.
   virtual void sparse_patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements,
                                    SparseFactors& out) const;
 
@@ -159,11 +175,18 @@ class RADIOSITY_API FormFactorEstimator {
   /// An upper bound of the non-zero entries of any row; target_count() for dense estimators.
   virtual std::size_t max_row_entries() const;
 
-  /// With FormFactorOptions::diffuse_transmission: the translucent patches, increasing; the
-  /// back of translucent_patches()[k] is target patch count + k. Empty otherwise.
+  /// With FormFactorOptions::diffuse_transmission: the patches that have a back side
+  /// (translucent or two-sided materials), increasing. Empty otherwise.
+  const std::vector<std::uint32_t>& patches_with_backs() const { return translucent_; }
+  /// The same list under its first name, which predates two-sided materials.
   const std::vector<std::uint32_t>& translucent_patches() const { return translucent_; }
-  /// Patches plus the backs of translucent patches: the index range of a sparse row.
+  /// Fronts of all patches plus the backs of patches_with_backs(): the index range of a sparse row.
   std::size_t target_count() const { return patch_count_ + translucent_.size(); }
+  /// The index of `target` in sparse rows and in sparse_patch_column()'s `patch` argument, or
+  /// kNone when the patch is out of range or `target` is the back of a patch without one.
+  std::uint32_t target_index(Target target) const;
+  /// The target at `index` of a sparse row; Target{} (patch kNone) when index >= target_count().
+  Target target(std::uint32_t index) const;
 
   /// F(back of element -> target) for elements of translucent patches: the fraction of the
   /// energy leaving the element's back side (a Lambertian emitter facing -normal) that

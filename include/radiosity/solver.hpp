@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -156,6 +157,61 @@ class RADIOSITY_API Solution {
 /// Checks options; throws Error{invalid_argument} naming the first bad field.
 RADIOSITY_API void validate(const SolveOptions& options);
 
+/// A scene set up for solving, kept across solves: its patch hierarchy (refined in place by
+/// adaptive subdivision), its form-factor estimator (with whatever it builds and caches: BVHs,
+/// visibility) and the form factors the matrix methods have computed. Solving it again, with the
+/// materials' emission or with other emission per polygon (relighting, light groups, a lamp
+/// switched off), reuses all of that: a matrix method's second solve costs its sweeps only. The
+/// estimator is made on the first solve that has something to emit; progressive refinement
+/// keeps no matrix, so each of its solves computes the columns it shoots anew.
+///
+///   Problem problem(scene, options);
+///   Solution lit = problem.solve();                    // meshes were made in the constructor
+///   std::vector<Rgb> E(scene.polygons().size(), Rgb(0.0f));
+///   E[lamp] = Rgb(10.0f);
+///   Solution relit = problem.solve(E);                 // same form factors, new emission
+///
+/// `scene` must outlive the Problem and must not change while it lives. Move-only.
+/// Thread safety: solve() needs exclusive access (it may refine the hierarchy and adds factors);
+/// const member functions may be called concurrently with each other.
+class RADIOSITY_API Problem {
+ public:
+  /// Validates `options` (validate()) and meshes the scene (PatchHierarchy(scene, options.mesh)).
+  /// Throws as solve(scene, options) does for bad options and a scene without polygons.
+  explicit Problem(const Scene& scene, const SolveOptions& options = {});
+  ~Problem();
+  Problem(Problem&&) noexcept;
+  Problem& operator=(Problem&&) noexcept;
+  Problem(const Problem&) = delete;
+  Problem& operator=(const Problem&) = delete;
+
+  const Scene& scene() const;
+  /// The options as they are applied: form_factors.method resolved (choose_form_factor_method()),
+  /// seed, threads and diffuse_transmission filled in, iteration cap and memory budget defaulted.
+  const SolveOptions& options() const;
+  /// The hierarchy the next solve works on (after adaptive subdivision, the refined one).
+  const PatchHierarchy& hierarchy() const;
+  /// Bytes of form factors kept between solves (the matrix methods' rows; 0 for progressive).
+  std::size_t form_factor_bytes() const;
+
+  /// Solves with the emission of the scene's materials; the result is that of
+  /// solve(scene, options) for a fresh Problem, and what solve(scene, options) documents holds
+  /// here too. SolveReport::seconds_meshing counts the meshing once, in the first solve.
+  Solution solve();
+  /// Solves with `polygon_emission[p]` (W/m^2, per index of Scene::polygons(); leaving the
+  /// front, and the back too for a two-sided material) in place of each material's emission.
+  /// Throws Error{invalid_argument} unless there is one finite, non-negative value per polygon.
+  /// The Monte Carlo estimator gives its exact emitter factors (FormFactorOptions::
+  /// exact_emitters) to the patches that emit in the scene's materials; newly emitting patches
+  /// are counted by its hemisphere rays: unbiased, but their direct light is noisier.
+  Solution solve(const std::vector<Rgb>& polygon_emission);
+
+ private:
+  struct Impl;
+  friend Solution solve(const Scene& scene, const SolveOptions& options);
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Meshes the scene, computes form factors and solves for radiosity. Throws Error for bad
 /// options or when the matrix methods would exceed memory_budget_bytes (the message gives the
 /// size and suggests progressive or a coarser mesh), and Error{invalid_scene} naming two
@@ -167,6 +223,7 @@ RADIOSITY_API void validate(const SolveOptions& options);
 /// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses
 /// more than half its emitted power (SolveReport::escaped_power): light that arrives at the
 /// back of a one-sided polygon is lost, so its polygons probably face outwards.
+/// The same as Problem(scene, options).solve(), without keeping the Problem.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});
 

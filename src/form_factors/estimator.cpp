@@ -122,6 +122,21 @@ bool FormFactorEstimator::sparse() const { return false; }
 
 std::size_t FormFactorEstimator::max_row_entries() const { return target_count(); }
 
+std::uint32_t FormFactorEstimator::target_index(Target target) const {
+  if (target.patch >= patch_count_) return kNone;
+  if (target.side == Side::front) return target.patch;
+  // Backs follow the fronts, in the order of patches_with_backs() (increasing).
+  const auto it = std::lower_bound(translucent_.begin(), translucent_.end(), target.patch);
+  if (it == translucent_.end() || *it != target.patch) return kNone;
+  return static_cast<std::uint32_t>(patch_count_ + static_cast<std::size_t>(it - translucent_.begin()));
+}
+
+Target FormFactorEstimator::target(std::uint32_t index) const {
+  if (index < patch_count_) return Target{index, Side::front};
+  if (index < target_count()) return Target{translucent_[index - patch_count_], Side::back};
+  return Target{};
+}
+
 FormFactorMethod choose_form_factor_method(const PatchHierarchy& hierarchy, const FormFactorOptions& options) {
   if (options.method != FormFactorMethod::automatic) return options.method;
   if (options.specular_depth > 0) return FormFactorMethod::monte_carlo;

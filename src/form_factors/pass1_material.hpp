@@ -40,6 +40,8 @@ inline bool pass1_has_back(const Material& m) { return pass1_translucent(m) || m
 /// emissive surface does in Blender and glTF, and in the path tracer), a one-sided one only
 /// on its front.
 inline Rgb pass1_back_emission(const Material& m) { return m.two_sided ? m.emission : Rgb(0.0f); }
+/// The same when the front emits `front` instead of the material's emission (a relit solve).
+inline Rgb pass1_back_emission(const Material& m, const Rgb& front) { return m.two_sided ? front : Rgb(0.0f); }
 
 /// What the back of a translucent sheet of `m` reflects: like the front for a two-sided
 /// material, nothing for a one-sided one (its back transmits only, as in the path tracer).

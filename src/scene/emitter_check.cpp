@@ -4,6 +4,7 @@
 // jittered grid on the polygon, directions from a second, shuffled grid, cosine-distributed by
 // Malley's method (a uniform disk point projected up onto the hemisphere).
 #include "scene/emitter_check.hpp"
+#include "scene/emission.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,8 +31,6 @@ namespace {
 /// Fixed: the check must give the same answer every time, whatever the solve's seed.
 constexpr std::uint64_t kSeed = 0x656d6974746572ull;  // "emitter"
 
-bool emits(const Material& m) { return max_channel(m.emission) > 0.0f; }
-
 /// "12", "12, 13" or "12, 13, 14, 15 and 9 more".
 std::string id_list(const std::vector<PolygonId>& ids) {
   constexpr std::size_t kShown = 4;
@@ -43,19 +42,18 @@ std::string id_list(const std::vector<PolygonId>& ids) {
 
 }  // namespace
 
-std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads) {
+std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads, const std::vector<Rgb>* emission) {
   const std::vector<Polygon>& polygons = scene.polygons();
   std::vector<EmitterReach> out;
   for (PolygonId p = 0; p < polygons.size(); ++p) {
-    const Material& m = scene.material(polygons[p].material);
+    const Rgb& e = polygon_emission(scene, p, emission);
     // A two-sided emitter also emits from its back (pass 1 and the path tracer): whichever way
     // it is wound, one of its sides faces the scene.
-    if (!emits(m) || m.two_sided) continue;
+    if (!(max_channel(e) > 0.0f) || scene.material(polygons[p].material).two_sided) continue;
     EmitterReach r;
     r.polygon = p;
     r.power = static_cast<double>(polygons[p].area) *
-              (static_cast<double>(m.emission.x) + static_cast<double>(m.emission.y) +
-               static_cast<double>(m.emission.z));
+              (static_cast<double>(e.x) + static_cast<double>(e.y) + static_cast<double>(e.z));
     out.push_back(r);
   }
   if (out.empty()) return out;
@@ -100,9 +98,10 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads) {
 }
 
 std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& emitted, const Rgb& escaped,
-                                                bool balanced, unsigned threads) {
+                                                bool balanced, unsigned threads,
+                                                const std::vector<Rgb>* emission) {
   std::vector<std::string> warnings;
-  const std::vector<EmitterReach> reach = emitter_reach(scene, threads);
+  const std::vector<EmitterReach> reach = emitter_reach(scene, threads, emission);
   if (reach.empty()) return warnings;
 
   // Emitters that see nothing, by group in order of first appearance.

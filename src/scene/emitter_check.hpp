@@ -30,9 +30,11 @@ struct EmitterReach {
 /// Every emitting polygon (emission > 0 in some channel), in polygon order. Each casts
 /// kEmitterRays rays (see above) from stratified points just in front of it, in stratified
 /// cosine-distributed directions, against every polygon of the scene; the streams have a fixed
-/// seed, so the answer is the same at any thread count. Throws Error{internal} if Embree cannot
-/// create a device. Thread safety: concurrent calls are safe.
-std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads = 0);
+/// seed, so the answer is the same at any thread count. `emission`: one value per polygon in
+/// place of the materials' (polygon_emission()), or null. Throws Error{internal} if Embree
+/// cannot create a device. Thread safety: concurrent calls are safe.
+std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads = 0,
+                                        const std::vector<Rgb>* emission = nullptr);
 
 /// The warnings of solve() about escaped light, given the power balance of a solve:
 /// - emitters whose front sees no polygon at all (named with their polygons and groups);
@@ -40,8 +42,10 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads = 0
 ///   light not yet propagated), more than 95 % of the emitters' light meets a surface directly
 ///   (the scene looks closed) and yet more than half of the emitted power escaped: light that
 ///   arrives at the backs of one-sided polygons is lost, so they probably face outwards.
-/// `emitted` and `escaped` are W per channel; nothing is cast when nothing emits.
+/// `emitted` and `escaped` are W per channel; nothing is cast when nothing emits. `emission` as
+/// for emitter_reach().
 std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& emitted, const Rgb& escaped,
-                                                bool balanced, unsigned threads = 0);
+                                                bool balanced, unsigned threads = 0,
+                                                const std::vector<Rgb>* emission = nullptr);
 
 }  // namespace radiosity::detail

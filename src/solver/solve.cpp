@@ -1,4 +1,5 @@
-// The solve() facade: mesh, form factors, solver, Solution.
+// The solve() facade and the Problem it is made of: mesh once, make the estimator once, keep
+// the form factors, and solve for the materials' emission or any other.
 #include <chrono>
 #include <algorithm>
 #include <cmath>
@@ -6,11 +7,13 @@
 #include <string>
 
 #include "form_factors/estimators.hpp"
+#include "scene/emission.hpp"
 #include "scene/overlap.hpp"
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
 #include "form_factors/pass1_material.hpp"
 #include "solver/system.hpp"
+#include "core/assert.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -50,11 +53,30 @@ void validate(const SolveOptions& o) {
   detail::resolve(o.form_factors);
 }
 
-Solution solve(const Scene& scene, const SolveOptions& options) {
-  validate(options);
+struct Problem::Impl {
+  const Scene& scene;
+  SolveOptions options;  ///< resolved (see Problem::options())
+  PatchHierarchy hierarchy;
+  std::vector<std::string> warnings;  ///< the scene's and the z-fighting check's, for every report
+  double seconds_meshing = 0.0;       ///< reported by the first solve only
+  bool meshed_reported = false;
+  /// Adaptive subdivision's limits stay those of the initial mesh however often it refines.
+  std::uint8_t initial_depth = 0;
+  std::size_t initial_leaves = 0;
+  std::unique_ptr<FormFactorEstimator> estimator;  ///< made by the first solve with emission
+  detail::MatrixStore store;                       ///< the matrix methods' rows, kept
+
+  Impl(const Scene& s, const SolveOptions& options);
+  /// One solve; `emission` per polygon or null (the materials'). With `last` the hierarchy is
+  /// moved into the Solution (the facade's single solve: no copy).
+  Solution solve(const std::vector<Rgb>* emission, bool last);
+};
+
+Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), options(given) {
+  validate(given);
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "solve: the scene has no polygons");
 
-  SolveOptions o = options;
+  SolveOptions& o = options;
   if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
   // Translucent and two-sided materials in use switch the back sides on.
   for (const Polygon& polygon : scene.polygons())
@@ -66,46 +88,60 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   // The estimator inherits the solve's thread count unless it was given one of its own.
   if (o.form_factors.threads == 0) o.form_factors.threads = o.threads;
 
-  detail::ProgressGate gate(o.on_progress);
-  SolveReport report;
-  report.warnings = scene.warnings();
+  warnings = scene.warnings();
   // Contact and interpenetration are lit correctly; only same-facing coincident surfaces are
   // ambiguous.
-  for (std::string& w : detail::z_fighting_warnings(scene)) report.warnings.push_back(std::move(w));
+  for (std::string& w : detail::z_fighting_warnings(scene)) warnings.push_back(std::move(w));
 
   auto t0 = std::chrono::steady_clock::now();
-  PatchHierarchy hierarchy(scene, o.mesh);
-  report.seconds_meshing = seconds_since(t0);
+  hierarchy = PatchHierarchy(scene, o.mesh);
+  seconds_meshing = seconds_since(t0);
+  o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
+  if (o.max_iterations == 0)
+    o.max_iterations =
+        o.method == SolverMethod::progressive ? static_cast<int>(100 * hierarchy.patches().size()) : 1000;
+  for (std::uint32_t e : hierarchy.leaves()) initial_depth = std::max(initial_depth, hierarchy.element(e).depth);
+  initial_leaves = hierarchy.leaves().size();
+}
+
+Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
+  const SolveOptions& o = options;
+  detail::ProgressGate gate(o.on_progress);
+  SolveReport report;
+  report.warnings = warnings;
+  report.seconds_meshing = meshed_reported ? 0.0 : seconds_meshing;
   report.patch_count = hierarchy.patches().size();
   report.element_count = hierarchy.leaves().size();
   report.specular_depth = o.form_factors.specular_depth;
-  o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
   report.form_factor_method = o.form_factors.method;
-  if (o.max_iterations == 0)
-    o.max_iterations = o.method == SolverMethod::progressive ? static_cast<int>(100 * report.patch_count) : 1000;
+  // The Solution owns its hierarchy: the facade's only solve hands over this one, a kept
+  // Problem a copy.
+  auto result_hierarchy = [&] { return last ? std::move(hierarchy) : PatchHierarchy(hierarchy); };
 
   const bool translucency = o.form_factors.diffuse_transmission;
-  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy, translucency);
+  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy, translucency, emission);
   std::vector<Rgb> B_elements(hierarchy.elements().size(), Rgb(0.0f));
   // Per element id, with diffuse transmission: the backs' radiosity (empty without).
   std::vector<Rgb> B_back(translucency ? hierarchy.elements().size() : 0, Rgb(0.0f));
   std::vector<std::string> groups = scene.groups();
 
-  if (!gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true))
-    return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
+  // The meshing phase ends (in the constructor) before the first solve reports it.
+  const bool meshing_reported = meshed_reported;
+  meshed_reported = true;
+  if (!meshing_reported && !gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true))
+    return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
                     std::move(report), Rgb(0.0f), {}, std::move(B_back));
 
   if (system->emitted <= 0.0) {
     // Nothing emits: B = 0 is the exact answer.
     report.warnings.push_back("the scene emits no light; every radiosity is 0");
-    return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), SolveStatus::converged,
+    return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::converged,
                     std::move(report), Rgb(0.0f), {}, std::move(B_back));
   }
 
-  auto estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
-  if (estimator->target_count() != system->patches())
-    throw Error(ErrorCode::internal, "solve: the estimator and the system number the translucent patches differently");
-  detail::MatrixStore store;
+  if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
+  // Both number the backs with find_back_patches().
+  RADIOSITY_ASSERT(estimator->target_count() == system->patches());
   const bool progressive = o.method == SolverMethod::progressive;
   auto t1 = std::chrono::steady_clock::now();
 
@@ -149,11 +185,9 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
   SolveStatus status = r.status;
 
   if (o.adaptive.enabled && status != SolveStatus::cancelled) {
-    std::uint8_t initial_depth = 0;
-    for (std::uint32_t e : hierarchy.leaves()) initial_depth = std::max(initial_depth, hierarchy.element(e).depth);
     const auto max_depth = static_cast<std::uint8_t>(std::min(250, initial_depth + o.adaptive.max_depth));
     const std::size_t budget =
-        o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * hierarchy.leaves().size();
+        o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * initial_leaves;
     for (int pass = 1; pass <= o.adaptive.max_passes; ++pass) {
       const std::vector<std::uint32_t> split =
           detail::leaves_to_refine(hierarchy, B_elements, o.adaptive, max_depth, budget);
@@ -177,7 +211,7 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
       }
       report.refined_elements += split.size();
       report.refinement_passes = pass;
-      system.emplace(scene, hierarchy, translucency);
+      system.emplace(scene, hierarchy, translucency, emission);
       Progress p{Phase::refining, static_cast<double>(pass) / o.adaptive.max_passes, pass, report.residual};
       if (!gate.report(p, true)) {
         status = SolveStatus::cancelled;
@@ -218,16 +252,19 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
         };
         for (std::size_t k = 0; k < created.size(); ++k) H_elements[created[k]] = gather(rows[k]);
         for (std::size_t k = 0; k < backs.size(); ++k) H_back[backs[k]] = gather(back_rows[k]);
+        auto front_emission = [&](std::uint32_t c) -> const Rgb& {
+          return detail::polygon_emission(scene, hierarchy.patches()[hierarchy.element(c).patch].polygon, emission);
+        };
         for (std::uint32_t c : created) {
           const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
-          B_elements[c] = mat.emission + mat.reflectance * H_elements[c];
+          B_elements[c] = front_emission(c) + mat.reflectance * H_elements[c];
         }
         for (std::uint32_t c : backs) {
           const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
           const Rgb tau = mat.diffuse_transmittance;
           B_elements[c] += tau * H_back[c];
-          B_back[c] =
-              detail::pass1_back_emission(mat) + detail::pass1_back_reflectance(mat) * H_back[c] + tau * H_elements[c];
+          B_back[c] = detail::pass1_back_emission(mat, front_emission(c)) + detail::pass1_back_reflectance(mat) * H_back[c] +
+                      tau * H_elements[c];
         }
       }
     }
@@ -271,10 +308,44 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
     hierarchy.aggregate(ambient_elements);
   }
   for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
-                                                       status == SolveStatus::converged, o.threads))
+                                                       status == SolveStatus::converged, o.threads, emission))
     report.warnings.push_back(std::move(w));
-  return Solution(std::move(hierarchy), std::move(B_elements), std::move(groups), status, std::move(report),
+  return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements), std::move(B_back));
+}
+
+Problem::Problem(const Scene& scene, const SolveOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {}
+Problem::~Problem() = default;
+Problem::Problem(Problem&&) noexcept = default;
+Problem& Problem::operator=(Problem&&) noexcept = default;
+
+const Scene& Problem::scene() const { return impl_->scene; }
+const SolveOptions& Problem::options() const { return impl_->options; }
+const PatchHierarchy& Problem::hierarchy() const { return impl_->hierarchy; }
+std::size_t Problem::form_factor_bytes() const { return impl_->store.bytes(); }
+
+Solution Problem::solve() { return impl_->solve(nullptr, false); }
+
+Solution Problem::solve(const std::vector<Rgb>& polygon_emission) {
+  const std::size_t n = impl_->scene.polygons().size();
+  if (polygon_emission.size() != n)
+    throw Error(ErrorCode::invalid_argument, "Problem::solve: polygon_emission has " +
+                                                 std::to_string(polygon_emission.size()) +
+                                                 " values; the scene has " + std::to_string(n) + " polygons");
+  for (std::size_t p = 0; p < n; ++p) {
+    const Rgb& e = polygon_emission[p];
+    for (int c = 0; c < 3; ++c)
+      if (!(e[c] >= 0.0f) || !std::isfinite(e[c]))
+        throw Error(ErrorCode::invalid_argument, "Problem::solve: polygon_emission[" + std::to_string(p) +
+                                                     "] must be finite and >= 0, got (" + std::to_string(e.x) + ", " +
+                                                     std::to_string(e.y) + ", " + std::to_string(e.z) + ")");
+  }
+  return impl_->solve(&polygon_emission, false);
+}
+
+Solution solve(const Scene& scene, const SolveOptions& options) {
+  Problem::Impl problem(scene, options);
+  return problem.solve(nullptr, true);
 }
 
 }  // namespace v1

@@ -2,10 +2,12 @@
 
 #include "form_factors/estimators.hpp"
 #include "form_factors/pass1_material.hpp"
+#include "scene/emission.hpp"
 
 namespace radiosity::detail {
 
-RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission)
+RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission,
+                                 const std::vector<Rgb>* polygon_emission)
     : leaves(hierarchy.leaves()) {
   const std::size_t m = leaves.size(), n = hierarchy.patches().size();
   // Back targets first, numbered as the estimators number them, so each back unknown knows its target.
@@ -28,16 +30,18 @@ RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hiera
   for (std::size_t i = 0; i < m; ++i) {
     const Element& e = hierarchy.element(leaves[i]);
     const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
+    const Rgb& E = detail::polygon_emission(scene, hierarchy.patches()[e.patch].polygon, polygon_emission);
     const bool translucent = back_target[e.patch] != kNone;
-    add(e.patch, e.area, mat.emission, mat.reflectance, translucent ? mat.diffuse_transmittance : Rgb(0.0f),
+    add(e.patch, e.area, E, mat.reflectance, translucent ? mat.diffuse_transmittance : Rgb(0.0f),
         translucent ? static_cast<std::uint32_t>(m + backs.size()) : kNone);
     if (translucent) backs.push_back(static_cast<std::uint32_t>(i));
-    emitted += static_cast<double>(e.area) * (mat.emission.x + mat.emission.y + mat.emission.z);
+    emitted += static_cast<double>(e.area) * (E.x + E.y + E.z);
   }
   for (std::uint32_t i : backs) {
     const Element& e = hierarchy.element(leaves[i]);
     const Material& mat = scene.material(hierarchy.patches()[e.patch].material);
-    const Rgb E = pass1_back_emission(mat);
+    const Rgb E = pass1_back_emission(mat, detail::polygon_emission(scene, hierarchy.patches()[e.patch].polygon,
+                                                                    polygon_emission));
     add(back_target[e.patch], e.area, E, pass1_back_reflectance(mat), mat.diffuse_transmittance, i);
     emitted += static_cast<double>(e.area) * (E.x + E.y + E.z);
   }

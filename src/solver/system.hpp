@@ -45,7 +45,9 @@ struct RadiositySystem {
   double total_area = 0.0;            ///< of all sides
 
   /// `diffuse_transmission`: give translucent and two-sided patches (pass1_has_back()) their backs.
-  RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission);
+  /// `polygon_emission`: one value per polygon in place of the materials' emission, or null.
+  RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission,
+                  const std::vector<Rgb>* polygon_emission = nullptr);
   std::size_t unknowns() const { return area.size(); }
   std::size_t fronts() const { return leaves.size(); }
   std::size_t patches() const { return patch_area.size(); }  ///< targets, backs included
