@@ -5,7 +5,7 @@
 
 #include <array>
 #include <cstdint>
-#include <unordered_map>
+#include <memory>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -62,7 +62,12 @@ struct Patch {
 /// Thread safety: const member functions may be called concurrently; subdivide() needs exclusive access.
 class RADIOSITY_API PatchHierarchy {
  public:
-  PatchHierarchy() = default;
+  PatchHierarchy();
+  ~PatchHierarchy();
+  PatchHierarchy(const PatchHierarchy& other);
+  PatchHierarchy& operator=(const PatchHierarchy& other);
+  PatchHierarchy(PatchHierarchy&&) noexcept;
+  PatchHierarchy& operator=(PatchHierarchy&&) noexcept;
   /// Meshes every polygon of `scene`. Throws Error{invalid_argument} if an area option is
   /// negative or NaN, or if max_element_area > max_patch_area.
   PatchHierarchy(const Scene& scene, const MeshOptions& options);
@@ -118,10 +123,11 @@ class RADIOSITY_API PatchHierarchy {
   std::vector<std::uint32_t> leaves_;
   std::vector<std::uint32_t> leaf_slot_;  ///< element id -> index in leaves_ (kNone if inner)
   std::vector<glm::vec3> vertices_;
-  /// Edge (min vertex, max vertex) -> its midpoint vertex, for sharing and T-vertex handling.
-  std::unordered_map<std::uint64_t, std::uint32_t> midpoints_;
-  /// For a midpoint vertex, the edge it splits (kNone for lattice and centre vertices).
-  std::vector<std::array<std::uint32_t, 2>> vertex_edge_;
+  /// Which edge each midpoint vertex splits and the midpoint of each split edge: subdivision's
+  /// bookkeeping, private to patch_hierarchy.cpp (so its containers are no part of the ABI).
+  /// Null only in a moved-from hierarchy.
+  struct Edges;
+  std::unique_ptr<Edges> edges_;
 };
 
 }  // namespace v1

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -95,7 +96,33 @@ float sample_linear(float u, float f0, float f1) {
 
 }  // namespace
 
-PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) {
+struct PatchHierarchy::Edges {
+  /// Edge (min vertex, max vertex) -> its midpoint vertex, for sharing and T-vertex handling.
+  std::unordered_map<std::uint64_t, std::uint32_t> midpoints;
+  /// For a midpoint vertex, the edge it splits (kNone for lattice and centre vertices).
+  std::vector<std::array<std::uint32_t, 2>> vertex_edge;
+};
+
+PatchHierarchy::PatchHierarchy() : edges_(std::make_unique<Edges>()) {}
+PatchHierarchy::~PatchHierarchy() = default;
+PatchHierarchy::PatchHierarchy(PatchHierarchy&&) noexcept = default;
+PatchHierarchy& PatchHierarchy::operator=(PatchHierarchy&&) noexcept = default;
+
+PatchHierarchy::PatchHierarchy(const PatchHierarchy& other)
+    : options_(other.options_),
+      patches_(other.patches_),
+      elements_(other.elements_),
+      leaves_(other.leaves_),
+      leaf_slot_(other.leaf_slot_),
+      vertices_(other.vertices_),
+      edges_(std::make_unique<Edges>(*other.edges_)) {}
+
+PatchHierarchy& PatchHierarchy::operator=(const PatchHierarchy& other) {
+  if (this != &other) *this = PatchHierarchy(other);
+  return *this;
+}
+
+PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) : PatchHierarchy() {
   check_area_option(options.max_patch_area, "max_patch_area");
   check_area_option(options.max_element_area, "max_element_area");
   const double total_area = scene.total_area();
@@ -160,7 +187,7 @@ std::uint32_t PatchHierarchy::add_vertex(const glm::vec3& position, std::uint32_
   if (vertices_.size() >= kNone - 1)
     throw Error(ErrorCode::memory_budget, "PatchHierarchy: more vertices than 32-bit ids can index");
   vertices_.push_back(position);
-  vertex_edge_.push_back({edge_a, edge_b});
+  edges_->vertex_edge.push_back({edge_a, edge_b});
   return static_cast<std::uint32_t>(vertices_.size() - 1);
 }
 
@@ -177,10 +204,10 @@ std::uint32_t PatchHierarchy::midpoint(std::uint32_t a, std::uint32_t b) {
   // vertex, which keeps the mesh conforming where both sides are split and lets vertex_values()
   // recognise it as a T-vertex where only one side is.
   const std::uint64_t key = edge_key(a, b);
-  const auto found = midpoints_.find(key);
-  if (found != midpoints_.end()) return found->second;
+  const auto found = edges_->midpoints.find(key);
+  if (found != edges_->midpoints.end()) return found->second;
   const std::uint32_t m = add_vertex(0.5f * (vertices_[a] + vertices_[b]), std::min(a, b), std::max(a, b));
-  midpoints_.emplace(key, m);
+  edges_->midpoints.emplace(key, m);
   return m;
 }
 
@@ -402,8 +429,8 @@ std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_v
       while (!edges.empty()) {
         const std::array<std::uint32_t, 2> ab = edges.back();
         edges.pop_back();
-        const auto found = midpoints_.find(edge_key(ab[0], ab[1]));
-        if (found == midpoints_.end() || hanging[found->second]) continue;
+        const auto found = edges_->midpoints.find(edge_key(ab[0], ab[1]));
+        if (found == edges_->midpoints.end() || hanging[found->second]) continue;
         const std::uint32_t m = found->second;
         hanging[m] = true;
         edges.push_back({ab[0], m});
@@ -415,7 +442,7 @@ std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_v
   // endpoints of every hanging vertex, hanging or not, already hold their final values.
   for (std::size_t m = 0; m < vertices_.size(); ++m) {
     if (!hanging[m]) continue;
-    const std::array<std::uint32_t, 2>& ab = vertex_edge_[m];
+    const std::array<std::uint32_t, 2>& ab = edges_->vertex_edge[m];
     out[m] = 0.5f * (out[ab[0]] + out[ab[1]]);
   }
   return out;

@@ -383,6 +383,18 @@ TEST_SUITE("solve") {
       const auto estimator = rad::make_form_factor_estimator(s.scene, h, f);
       REQUIRE(estimator->translucent_patches() == std::vector<std::uint32_t>{1});
       CHECK(estimator->target_count() == h.patches().size() + 1);
+      CHECK(estimator->patches_with_backs() == estimator->translucent_patches());
+      // Targets by name: every index round-trips; the back of patch 1 follows the fronts, and
+      // an opaque patch's back is no target.
+      const auto n = static_cast<std::uint32_t>(h.patches().size());
+      for (std::uint32_t t = 0; t < estimator->target_count(); ++t)
+        CHECK(estimator->target_index(estimator->target(t)) == t);
+      CHECK(estimator->target(n) == rad::Target{1, rad::Side::back});
+      CHECK(estimator->target_index(rad::Target{1, rad::Side::back}) == n);
+      CHECK(estimator->target_index(rad::Target{0, rad::Side::front}) == 0);
+      CHECK(estimator->target_index(rad::Target{0, rad::Side::back}) == rad::kNone);
+      CHECK(estimator->target_index(rad::Target{n, rad::Side::front}) == rad::kNone);
+      CHECK(estimator->target(n + 1).patch == rad::kNone);
       CHECK_NOTHROW(estimator->sparse_back_rows({h.patches()[1].root}, rows));
       CHECK_THROWS_WITH_AS(estimator->sparse_back_rows({h.patches()[0].root}, rows),
                            "sparse_back_rows: element 0 is not an element of a translucent patch", rad::Error);
