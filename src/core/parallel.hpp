@@ -1,11 +1,14 @@
 // Thread-count control shared by the modules: with a thread count of 0 work runs in the
-// caller's oneTBB arena (all hardware threads, shared with the host's own TBB work, and no
-// arena to create per call); with an explicit count in an arena of its own limited to it, so
-// concurrent calls with different settings do not interfere.
+// caller's oneTBB arena (all hardware threads, shared with the host's own TBB work); with an
+// explicit count in a long-lived arena limited to it, made on first use and kept for the
+// process, so a loop of many small parallel calls (rows, columns, sweeps) pays for no arena
+// creation and concurrent calls with different settings do not interfere.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <map>
+#include <mutex>
 #include <thread>
 
 #include <tbb/blocked_range.h>
@@ -17,6 +20,17 @@ namespace radiosity::detail {
 inline int thread_count(unsigned requested) {
   if (requested > 0) return static_cast<int>(requested);
   return std::max(1, static_cast<int>(tbb::this_task_arena::max_concurrency()));
+}
+
+/// The process's arena of `n` threads. Arenas are never destroyed: a static destructor could
+/// run after oneTBB's own shutdown. Thread safety: may be called concurrently.
+inline tbb::task_arena& arena_of(int n) {
+  static std::mutex mutex;
+  static std::map<int, tbb::task_arena*> arenas;
+  const std::lock_guard<std::mutex> lock(mutex);
+  tbb::task_arena*& arena = arenas[n];
+  if (arena == nullptr) arena = new tbb::task_arena(n);
+  return *arena;
 }
 
 /// Runs body(begin, end) over [0, count) in chunks of `grain`, on at most `threads` threads.
@@ -33,14 +47,13 @@ void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const 
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, std::max<std::size_t>(grain, 1)),
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
   };
+  // Isolated: while it waits for its chunks a thread takes no unrelated task of the same arena
+  // (another call's, or an outer loop's, which could need a lock the caller holds).
   if (threads == 0) {
-    // Isolated, as an arena of its own would be: while it waits for its chunks a thread takes
-    // no unrelated outer task (which could need a lock the caller holds).
     tbb::this_task_arena::isolate(run);
     return;
   }
-  tbb::task_arena arena(n);
-  arena.execute(run);
+  arena_of(n).execute([&] { tbb::this_task_arena::isolate(run); });
 }
 
 }  // namespace radiosity::detail
