@@ -162,8 +162,9 @@ RADIOSITY_API void validate(const SolveOptions& options);
 /// visibility) and the form factors the matrix methods have computed. Solving it again, with the
 /// materials' emission or with other emission per polygon (relighting, light groups, a lamp
 /// switched off), reuses all of that: a matrix method's second solve costs its sweeps only. The
-/// estimator is made on the first solve that has something to emit; progressive refinement
-/// keeps no matrix, so each of its solves computes the columns it shoots anew.
+/// estimator is made on the first solve that has something to emit. Progressive refinement
+/// keeps the columns it shot (within SolveOptions::memory_budget_bytes), so a relit solve
+/// computes only the columns of patches not shot before.
 ///
 ///   Problem problem(scene, options);
 ///   Solution lit = problem.solve();                    // meshes were made in the constructor
@@ -191,10 +192,11 @@ class RADIOSITY_API Problem {
   const SolveOptions& options() const;
   /// The hierarchy the next solve works on (after adaptive subdivision, the refined one).
   const PatchHierarchy& hierarchy() const;
-  /// Bytes of form factors kept between solves (the matrix methods' rows; 0 for progressive).
+  /// Bytes of form factors kept between solves (the matrix methods' rows, progressive
+  /// refinement's columns).
   std::size_t form_factor_bytes() const;
 
-  /// Solves with the emission of the scene's materials; the result is that of
+  /// Solves with the emission of the scene's materials. The result is that of
   /// solve(scene, options) for a fresh Problem, and what solve(scene, options) documents holds
   /// here too. SolveReport::seconds_meshing counts the meshing once, in the first solve.
   Solution solve();

@@ -27,7 +27,7 @@ double sum3(const Rgb& c) { return static_cast<double>(c.x) + c.y + c.z; }
 
 }  // namespace
 
-SolverResult solve_progressive(const SolverContext& ctx) {
+SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   const RadiositySystem& sys = ctx.system;
   const std::size_t m = sys.unknowns(), n = sys.patches();
   SolverResult result;
@@ -42,10 +42,19 @@ SolverResult solve_progressive(const SolverContext& ctx) {
   // several times, and recomputing its column is the whole cost of a step.
   // Sparse estimators (monte_carlo) give sparse columns, so a step costs O(entries).
   // Columns with backs come from the sparse calls (the dense ones keep to fronts).
+  // They are kept in `store` for the next solve of the same Problem (relighting), unless the
+  // leaves changed since they were computed.
   const bool sparse = ctx.estimator.sparse() || sys.has_backs();
-  std::vector<FactorVector> cache(n);
-  std::vector<std::uint8_t> cached(n, 0);  // a column may be cached and empty (a patch that sees nothing)
-  std::size_t cached_bytes = 0, peak_scratch = 0;
+  if (store.leaf_count != sys.fronts() || store.columns.size() != n) {
+    store = ColumnStore{};
+    store.columns.resize(n);
+    store.cached.assign(n, 0);
+    store.leaf_count = sys.fronts();
+  }
+  std::vector<FactorVector>& cache = store.columns;
+  std::vector<std::uint8_t>& cached = store.cached;  // a column may be cached and empty (a patch that sees nothing)
+  std::size_t& cached_bytes = store.bytes;
+  std::size_t peak_scratch = 0;
   FactorVector scratch;
   std::vector<std::uint32_t> batch, candidates;
   std::vector<SparseFactors> fetched;

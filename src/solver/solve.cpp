@@ -65,6 +65,7 @@ struct Problem::Impl {
   std::size_t initial_leaves = 0;
   std::unique_ptr<FormFactorEstimator> estimator;  ///< made by the first solve with emission
   detail::MatrixStore store;                       ///< the matrix methods' rows, kept
+  detail::ColumnStore columns;                     ///< progressive refinement's columns, kept
 
   Impl(const Scene& s, const SolveOptions& options);
   /// One solve; `emission` per polygon or null (the materials'). With `last` the hierarchy is
@@ -178,7 +179,7 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
   detail::SolverResult r;
   {
     detail::SolverContext context{scene, hierarchy, *system, *estimator, o, gate};
-    r = progressive ? detail::solve_progressive(context)
+    r = progressive ? detail::solve_progressive(context, columns)
                     : detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, {});
   }
   keep(r);
@@ -322,7 +323,7 @@ Problem& Problem::operator=(Problem&&) noexcept = default;
 const Scene& Problem::scene() const { return impl_->scene; }
 const SolveOptions& Problem::options() const { return impl_->options; }
 const PatchHierarchy& Problem::hierarchy() const { return impl_->hierarchy; }
-std::size_t Problem::form_factor_bytes() const { return impl_->store.bytes(); }
+std::size_t Problem::form_factor_bytes() const { return impl_->store.bytes() + impl_->columns.bytes; }
 
 Solution Problem::solve() { return impl_->solve(nullptr, false); }
 

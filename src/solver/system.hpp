@@ -135,11 +135,23 @@ struct MatrixStore {
   }
 };
 
+/// Columns F(every side -> target) that progressive refinement computed, by target, kept across
+/// the solves of one Problem while they fit the memory budget. They are positions over the
+/// leaves they were computed for; subdivision changes the leaf count (a split adds three), so a
+/// different count means other leaves and the columns are dropped.
+struct ColumnStore {
+  std::vector<FactorVector> columns;
+  std::vector<std::uint8_t> cached;  ///< per target: 1 when columns[t] holds its column (maybe empty)
+  std::size_t bytes = 0;
+  std::size_t leaf_count = 0;
+};
+
 /// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
 /// of them on the first call), then iterates from `B0` (per unknown; empty = start from E).
 SolverResult solve_matrix(const SolverContext& context, bool gauss_seidel, MatrixStore& store,
                           const std::vector<Rgb>& B0);
-SolverResult solve_progressive(const SolverContext& context);
+/// Progressive refinement, reusing and adding to the columns in `store`.
+SolverResult solve_progressive(const SolverContext& context, ColumnStore& store);
 
 /// Adaptive subdivision (Cohen, Greenberg, Immel & Brock 1986): the leaves whose radiosity
 /// differs from the interpolated values at their corners (i.e. from their neighbours) by more
