@@ -435,11 +435,11 @@ struct ObjFace {
 
 /// What an OBJ file says, read in one pass.
 struct ObjFile {
-  std::vector<glm::vec3> corners;        ///< every face's corner positions, face after face
-  std::vector<ObjFace> faces;            ///< in file order; those of fewer than 3 corners left out
-  std::vector<std::string> groups;       ///< [0] "" (before any g or o), then one per g or o
-  std::vector<UseMaterial> materials;    ///< [0] before any usemtl, then one per usemtl
-  std::vector<fs::path> mtl_files;       ///< resolved, each once, in order of mention
+  std::vector<glm::vec3> corners;      ///< every face's corner positions, face after face
+  std::vector<ObjFace> faces;          ///< in file order; those of fewer than 3 corners left out
+  std::vector<std::string> groups;     ///< [0] "" (before any g or o), then one per g or o
+  std::vector<UseMaterial> materials;  ///< [0] before any usemtl, then one per usemtl
+  std::vector<fs::path> mtl_files;     ///< resolved, each once, in order of mention
 };
 
 /// mtllib names: split on spaces, with "\ " escaping a space (as tinyobjloader read them, so that
