@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake
   libglm-dev doctest-dev libopenexr-dev libembree-dev libtbb-dev
-  libtinyobjloader-dev libstb-dev nlohmann-json3-dev libcli11-dev
+  libstb-dev nlohmann-json3-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev
 )
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <doctest/doctest.h>
@@ -166,19 +167,118 @@ TEST_CASE("a UTF-8 byte order mark does not hide the first vertex") {
 }
 
 TEST_CASE("a face with more than 255 vertices stays one polygon") {
-  // tinyobjloader counts face vertices in an unsigned char; the loader must not rely on it.
-  std::string obj = "# a 300-gon\n";
+  // tinyobjloader, which read OBJ files before, counted face vertices in an unsigned char.
+  std::string obj = "# a 300-gon, by absolute and by relative indices\n";
   const int n = 300;
   for (int i = 0; i < n; ++i) {
     const double a = 2.0 * 3.14159265358979323846 * i / n;
     obj += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
   }
+  std::string relative = "f";
   obj += "f";
-  for (int i = 1; i <= n; ++i) obj += " " + std::to_string(i);
-  obj += "\n";
+  for (int i = 1; i <= n; ++i) {
+    obj += " " + std::to_string(i);
+    relative += " " + std::to_string(i - n - 1);
+  }
+  obj += "\n" + relative + "\n";
   radiosity::Scene s = radiosity::load_scene(write_tmp("polygon300.obj", obj));
+  REQUIRE(s.polygons().size() == 2);
+  CHECK(s.warnings().empty());
+  for (const radiosity::Polygon& p : s.polygons()) {
+    CHECK(p.vertices.size() == 300);
+    CHECK(p.area == doctest::Approx(3.14159).epsilon(1e-3));
+  }
+  CHECK(s.polygons()[0].vertices == s.polygons()[1].vertices);
+}
+
+TEST_CASE("g and o name groups as before - faces before any name are in group default") {
+  // Each statement is followed by one face; the comment says the group that face is in.
+  const char* statements[][2] = {
+      {"", "default"},                        // faces before any g or o
+      {"g a b", "a b"},                       // several names: one group, joined by a space
+      {"g  a\t b  ", "a b"},                  // ... by one space whatever the blanks
+      {"g ", "default"},                      // g with no name: the unnamed group
+      {"g a", "a"},
+      {"g", "a"},                             // a bare g, not even a blank after it: no change
+      {"o name with  spaces ", "name with  spaces"},  // o takes its whole line, inner blanks kept
+      {"o", "name with  spaces"},             // a bare o: no change
+      {"o ", "default"},
+      {"g a # c", "a # c"},                   // '#' starts a comment only at the start of a line
+      {"o\tx", "x"},
+  };
+  std::string obj;
+  int v = 0;
+  for (const auto& st : statements) {
+    if (*st[0] != '\0') obj += std::string(st[0]) + "\n";
+    obj += "v 0 0 " + std::to_string(v) + "\nv 1 0 " + std::to_string(v) + "\nv 0 1 " + std::to_string(v) + "\n";
+    obj += "f -3 -2 -1\n";
+    ++v;
+  }
+  radiosity::Scene s = radiosity::load_scene(write_tmp("group_names.obj", obj));
+  REQUIRE(s.polygons().size() == std::size(statements));
+  for (std::size_t i = 0; i < std::size(statements); ++i) {
+    INFO("statement '" << statements[i][0] << "'");
+    CHECK(s.groups()[s.polygons()[i].group] == statements[i][1]);
+  }
+  CHECK(s.groups().size() == 6);  // default, "a b", "a", "name with  spaces", "a # c", "x"
+}
+
+TEST_CASE("a usemtl before any mtllib line names no material - as tinyobjloader read it") {
+  write_tmp("late_library.mtl", "newmtl red\nKd 0.6 0.1 0.1\n");
+  radiosity::Scene s = radiosity::load_scene(write_tmp(
+      "late_library.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nmtllib late_library.mtl\nf 1 2 3\nusemtl red\nf 1 2 3\n"));
+  REQUIRE(s.polygons().size() == 3);
+  CHECK(s.material(s.polygons()[0].material).name == "default");
+  CHECK(s.material(s.polygons()[1].material).name == "default");
+  CHECK(s.material(s.polygons()[2].material).name == "red");
+  REQUIRE(s.warnings().size() == 1);
+  CHECK(contains(s.warnings()[0], "late_library.obj:4: material 'red' is not defined"));
+}
+
+TEST_CASE("CRLF and CR line ends give the same scene - with the same line numbers - as LF") {
+  // Groups, materials, a short face, a triangulated and a degenerate face, lines: every kind
+  // of statement whose line a message names.
+  write_tmp("line_ends.mtl", "newmtl white\nKd 1 1 1\n");
+  const std::string lf =
+      "mtllib line_ends.mtl\n# a comment\n\nv 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0\nv 2 0 0\n"
+      "g floor\nusemtl white\nf 1 2 3 4\nf 1 2\n\no second one\nf 1 2 5\nl 1 2\nusemtl none\nf 1 2 3\n";
+  std::string crlf, cr;
+  for (char c : lf) {
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    cr += c == '\n' ? '\r' : c;
+  }
+  const radiosity::Scene a = radiosity::load_scene(write_tmp("line_ends.obj", lf));
+  REQUIRE(a.polygons().size() == 3);  // the non-planar quad as two triangles, and the triangle
+  REQUIRE(a.warnings().size() == 6);
+  CHECK(contains(a.warnings()[0], "line_ends.obj:12: face has 2 vertices"));
+  CHECK(contains(a.warnings()[1], "line_ends.obj:16: line/point element"));
+  CHECK(contains(a.warnings()[2], "line_ends.mtl:2: material 'white': Kd"));
+  CHECK(contains(a.warnings()[3], "line_ends.obj:11: face (group 'floor'): non-planar"));
+  CHECK(contains(a.warnings()[4], "line_ends.obj:15: face (group 'second one'): degenerate"));
+  CHECK(contains(a.warnings()[5], "line_ends.obj:17: material 'none'"));
+  for (const std::string& text : {crlf, cr}) {
+    const radiosity::Scene b = radiosity::load_scene(write_tmp("line_ends.obj", text));
+    CHECK(b.groups() == a.groups());
+    CHECK(b.warnings() == a.warnings());
+    REQUIRE(b.polygons().size() == a.polygons().size());
+    for (std::size_t i = 0; i < a.polygons().size(); ++i) {
+      CHECK(b.polygons()[i].vertices == a.polygons()[i].vertices);
+      CHECK(b.polygons()[i].group == a.polygons()[i].group);
+      CHECK(b.material(b.polygons()[i].material).name == a.material(a.polygons()[i].material).name);
+    }
+  }
+}
+
+TEST_CASE("a backslash at the end of a line does not continue it") {
+  // OBJ allows "\" as a line continuation; this reader (as tinyobjloader before it) does not,
+  // so the backslash is one more word of its line.
+  check_error(write_tmp("continued_face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n3\n"), ErrorCode::parse_error,
+              "continued_face.obj", 4, "face corner '\\' has no valid vertex index");
+  radiosity::Scene s = radiosity::load_scene(
+      write_tmp("continued_lines.obj", "v 0 0 0 \\\n9 9\nv 1 0 0\nv 0 1 0\ng a \\\nb\nf 1 2 3\n"));
   REQUIRE(s.polygons().size() == 1);
-  CHECK(s.polygons()[0].area == doctest::Approx(3.14159).epsilon(1e-3));
+  CHECK(s.polygons()[0].vertices[0] == glm::vec3(0.0f));
+  CHECK(s.groups()[s.polygons()[0].group] == "a \\");
 }
 
 TEST_CASE("a missing OBJ file or an unsupported extension is an error naming the path") {
@@ -205,6 +305,13 @@ TEST_CASE("an out-of-range vertex index is an error naming file and line") {
   check_error(kData / "bad_index.obj", ErrorCode::parse_error, "bad_index.obj", 8, "out of range");
   check_error(write_tmp("negative_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n"), ErrorCode::parse_error,
               "negative_index.obj", 4, "out of range");
+}
+
+TEST_CASE("a face corner of more than 3 indices is an error naming file and line") {
+  check_error(write_tmp("four_indices.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1/1/1/1 2 3\n"),
+              ErrorCode::parse_error, "four_indices.obj", 6, "face corner '1/1/1/1' has more than 3 indices");
+  check_error(write_tmp("trailing_slash.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1 2/1/1/ 3\n"),
+              ErrorCode::parse_error, "trailing_slash.obj", 6, "face corner '2/1/1/'");
 }
 
 TEST_CASE("a zero vertex index is an error naming file and line") {

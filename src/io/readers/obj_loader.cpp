@@ -1,13 +1,13 @@
-// Wavefront OBJ/MTL reader. tinyobjloader parses the OBJ (faces kept as polygons, not
-// triangulated); a light pre-scan of the same text maps every face to its line and checks what
-// tinyobjloader would accept silently (out-of-range indices, NaN coordinates), so that every
-// error names the file, the line and the problem. MTL files are read here (key-value lines),
-// and their materials handed to tinyobjloader by name. What a renderer would step over
-// (degenerate faces, Kd 1, a missing MTL) follows the forgiving policy of reader_warnings.hpp.
-// The MTL mapping follows the format's own description of the illumination models (Wavefront's
-// MTL specification) and the PBR extension as tinyobjloader and Blender read it.
-#include <tiny_obj_loader.h>
-
+// Wavefront OBJ/MTL reader. Both parsers are our own: every message names the file and the
+// line, and the forgiving policy of reader_warnings.hpp (what a renderer would step over, such as
+// degenerate faces, Kd 1 or a missing MTL, is fixed with one warning per kind) needs the parser
+// to know the line of each element. tinyobjloader, which parsed the OBJ before (the MTL reader
+// was always ours), reports no lines, so the file had to be tokenised a second time to find them.
+// The OBJ is read in one pass: vertices as they come, each face corner resolved at once to its
+// vertex's position, with the group (`g`, `o`) and material (`usemtl`) current at the face; faces
+// stay polygons, of any size. The MTL mapping follows the format's own description of the
+// illumination models (Wavefront's MTL specification) and the PBR extension as tinyobjloader
+// and Blender read it.
 #include <algorithm>
 #include <cfloat>
 #include <charconv>
@@ -64,26 +64,38 @@ std::string read_text(const fs::path& path, const char* what) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot read ") + what + " '" + path.string() + "'");
-  // A UTF-8 byte order mark would hide the first statement from tinyobjloader and from us.
+  // A UTF-8 byte order mark would hide the first statement.
   std::string s = text.str();
   if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.erase(0, 3);
   return s;
 }
 
-/// Splits text into lines exactly as tinyobjloader's safeGetline does ("\n", "\r\n" and a lone
-/// "\r" each end a line), so that our line numbers and its own agree.
-std::vector<std::string_view> split_lines(std::string_view text) {
-  std::vector<std::string_view> lines;
-  std::size_t start = 0;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if (text[i] != '\n' && text[i] != '\r') continue;
-    lines.push_back(text.substr(start, i - start));
-    if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
-    start = i + 1;
+/// The lines of a text, one at a time: "\n", "\r\n" and a lone "\r" each end a line, so that
+/// files from any platform count lines alike. A backslash at the end of a line is an ordinary
+/// character (OBJ's line continuation is not read).
+class Lines {
+ public:
+  explicit Lines(std::string_view text) : text_(text) {}
+
+  /// The next line without its end, or false after the last one.
+  bool next(std::string_view& line) {
+    if (pos_ >= text_.size()) return false;
+    std::size_t end = pos_;
+    while (end < text_.size() && text_[end] != '\n' && text_[end] != '\r') ++end;
+    line = text_.substr(pos_, end - pos_);
+    pos_ = end + 1;
+    if (end < text_.size() && text_[end] == '\r' && pos_ < text_.size() && text_[pos_] == '\n') ++pos_;
+    ++number_;
+    return true;
   }
-  if (start < text.size()) lines.push_back(text.substr(start));
-  return lines;
-}
+  /// 1-based number of the line next() returned last.
+  std::size_t number() const { return number_; }
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  std::size_t number_ = 0;
+};
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
@@ -93,17 +105,31 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-/// Whitespace-separated tokens (spaces and tabs, as tinyobjloader).
+/// The words of a line (separated by spaces and tabs), one at a time, so that reading a line
+/// allocates nothing.
+class Words {
+ public:
+  explicit Words(std::string_view line) : line_(line) {}
+
+  /// The next word, or "" at the end of the line.
+  std::string_view next() {
+    while (pos_ < line_.size() && is_blank(line_[pos_])) ++pos_;
+    const std::size_t start = pos_;
+    while (pos_ < line_.size() && !is_blank(line_[pos_])) ++pos_;
+    return line_.substr(start, pos_ - start);
+  }
+  /// What follows the last word read, blanks included.
+  std::string_view rest() const { return line_.substr(pos_); }
+
+ private:
+  std::string_view line_;
+  std::size_t pos_ = 0;
+};
+
 std::vector<std::string_view> tokens(std::string_view line) {
   std::vector<std::string_view> out;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && is_blank(line[i])) ++i;
-    std::size_t j = i;
-    while (j < line.size() && !is_blank(line[j])) ++j;
-    if (j > i) out.push_back(line.substr(i, j - i));
-    i = j;
-  }
+  Words words(line);
+  for (std::string_view w = words.next(); !w.empty(); w = words.next()) out.push_back(w);
   return out;
 }
 
@@ -139,9 +165,7 @@ std::string describe(const Rgb& c) {
 std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
 // ---------------------------------------------------------------------------------------------
-// MTL reader: our own, since it is a list of "key values" lines and we need every key's line for
-// messages; tinyobjloader gets the materials' names from us (PreloadedMaterials below), so the
-// two can never disagree about which materials exist.
+// MTL reader: a list of "key values" lines, each key's line kept for messages.
 
 struct MtlKey {
   std::size_t line = 0;
@@ -169,11 +193,11 @@ struct MtlInfo {
 /// Appends one MtlInfo per named `newmtl` of `text`, in order. Values are checked to be numbers
 /// here (a value that is not one cannot mean anything); their ranges in to_material().
 void scan_mtl(const fs::path& file, std::string_view text, std::vector<MtlInfo>& out) {
-  std::vector<std::string_view> lines = split_lines(text);
+  Lines lines(text);
   MtlInfo* current = nullptr;
-  for (std::size_t n = 0; n < lines.size(); ++n) {
-    const std::size_t line_no = n + 1;
-    std::string_view line = trim(lines[n]);
+  for (std::string_view raw; lines.next(raw);) {
+    const std::size_t line_no = lines.number();
+    std::string_view line = trim(raw);
     if (line.empty() || line.front() == '#') continue;
     std::vector<std::string_view> tok = tokens(line);
     if (tok[0] == "newmtl") {
@@ -389,22 +413,37 @@ Material to_material(const MtlInfo& info, ReaderWarnings& warnings) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// OBJ pre-scan
+// OBJ reader
 
-struct FaceInfo {
+/// A `usemtl` statement; each face uses the last one before it.
+struct UseMaterial {
+  std::string_view name;  ///< "" before any usemtl, or for a usemtl without a name
   std::size_t line = 0;
-  std::size_t vertex_count = 0;
-  std::string_view material;      ///< name given by the last usemtl ("" if none)
-  std::size_t material_line = 0;  ///< line of that usemtl
+  /// Whether an mtllib line came before. A material named before any mtllib line is taken as
+  /// undefined: tinyobjloader (which read these files before) knew no material there, and the
+  /// files keep the materials they had.
+  bool after_mtllib = false;
 };
 
-struct ObjScan {
-  std::vector<FaceInfo> faces;     ///< in file order, which is tinyobjloader's face order
-  std::vector<fs::path> mtl_files; ///< resolved, each once, in order of mention
-  std::size_t vertex_count = 0;
+struct ObjFace {
+  std::size_t line = 0;
+  std::size_t first = 0;     ///< its first corner in ObjFile::corners
+  std::size_t count = 0;     ///< corners, 3 or more
+  std::size_t group = 0;     ///< into ObjFile::groups
+  std::size_t material = 0;  ///< into ObjFile::materials
 };
 
-/// mtllib names, split like tinyobjloader does: on spaces, with "\ " escaping a space.
+/// What an OBJ file says, read in one pass.
+struct ObjFile {
+  std::vector<glm::vec3> corners;      ///< every face's corner positions, face after face
+  std::vector<ObjFace> faces;          ///< in file order; those of fewer than 3 corners left out
+  std::vector<std::string> groups;     ///< [0] "" (before any g or o), then one per g or o
+  std::vector<UseMaterial> materials;  ///< [0] before any usemtl, then one per usemtl
+  std::vector<fs::path> mtl_files;     ///< resolved, each once, in order of mention
+};
+
+/// mtllib names: split on spaces, with "\ " escaping a space (as tinyobjloader read them, so that
+/// such files still find their libraries).
 std::vector<std::string> mtllib_names(std::string_view rest) {
   std::vector<std::string> names;
   std::string name;
@@ -426,22 +465,24 @@ std::vector<std::string> mtllib_names(std::string_view rest) {
   return names;
 }
 
-/// Checks one index field of a face corner ("v", "v/vt", "v//vn" or "v/vt/vn"). tinyobjloader
-/// rejects 0 or a missing vt/vn index, and accepts an out-of-range vertex index silently.
-void check_corner(const fs::path& file, std::size_t line_no, std::string_view corner, std::size_t vertex_count) {
+/// The vertex of one face corner ("v", "v/vt", "v//vn" or "v/vt/vn"), as an index into the
+/// `vertex_count` vertices defined before the face. The vt and vn indices are not used, but must
+/// be non-zero integers.
+std::size_t corner_vertex(const fs::path& file, std::size_t line_no, std::string_view corner, std::size_t vertex_count) {
   const std::size_t slash = corner.find('/');
   const std::string_view v = corner.substr(0, slash);
   const std::optional<long long> idx = parse_int(v);
   if (!idx) fail(ErrorCode::parse_error, file, line_no, "face corner " + in_quotes(corner) + " has no valid vertex index");
   if (*idx == 0)
     fail(ErrorCode::parse_error, file, line_no, "face corner " + in_quotes(corner) + ": vertex index 0 is invalid (OBJ indices start at 1)");
+  // OBJ counts from 1; a negative index counts back from the last vertex defined so far.
   const long long n = static_cast<long long>(vertex_count);
   const long long resolved = *idx > 0 ? *idx - 1 : n + *idx;
   if (resolved < 0 || resolved >= n)
     fail(ErrorCode::parse_error, file, line_no,
          "face corner " + in_quotes(corner) + ": vertex index " + std::to_string(*idx) + " is out of range (" +
              std::to_string(vertex_count) + " vertices defined before this line)");
-  if (slash == std::string_view::npos) return;
+  if (slash == std::string_view::npos) return static_cast<std::size_t>(resolved);
   const std::string_view rest = corner.substr(slash + 1);
   const std::size_t slash2 = rest.find('/');
   const std::string_view vt = rest.substr(0, slash2);
@@ -453,46 +494,79 @@ void check_corner(const fs::path& file, std::size_t line_no, std::string_view co
   };
   if (!vt.empty() || slash2 == std::string_view::npos) check_nonzero(vt, "texture coordinate");
   if (slash2 != std::string_view::npos) {
-    std::string_view vn = rest.substr(slash2 + 1);
-    vn = vn.substr(0, vn.find('/'));
-    check_nonzero(vn, "normal");
+    const std::string_view vn = rest.substr(slash2 + 1);
+    const std::size_t slash3 = vn.find('/');
+    check_nonzero(vn.substr(0, slash3), "normal");
+    if (slash3 != std::string_view::npos)
+      fail(ErrorCode::parse_error, file, line_no,
+           "face corner " + in_quotes(corner) + " has more than 3 indices (v, v/vt, v//vn or v/vt/vn expected)");
   }
+  return static_cast<std::size_t>(resolved);
 }
 
-ObjScan scan_obj(const fs::path& file, std::string_view text, ReaderWarnings& warnings) {
-  ObjScan scan;
+/// A group's name from what follows `g` or `o`. `g a b` names the group "a b" (its words joined
+/// by one space); `o` takes the rest of its line as one name, inner blanks kept. Both as
+/// tinyobjloader named them, so that groups keep their names.
+std::string group_name(std::string_view key, Words& words) {
+  if (key == "o") return std::string(trim(words.rest()));
+  std::string name;
+  for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+    if (!name.empty()) name += ' ';
+    name += w;
+  }
+  return name;
+}
+
+/// Reads the OBJ statements that make a scene (v, f, g, o, usemtl, mtllib) and warns about l and
+/// p; every other statement (vt, vn, s, ...) is ignored. Fails at the first line that cannot
+/// mean anything.
+ObjFile read_obj(const fs::path& file, std::string_view text, ReaderWarnings& warnings) {
+  ObjFile obj;
+  obj.groups.emplace_back();
+  obj.materials.emplace_back();
+  std::vector<glm::vec3> positions;
   std::set<fs::path> seen_mtl;
-  std::string_view material;
-  std::size_t material_line = 0;
-  const std::vector<std::string_view> lines = split_lines(text);
-  for (std::size_t n = 0; n < lines.size(); ++n) {
-    const std::size_t line_no = n + 1;
-    const std::vector<std::string_view> tok = tokens(lines[n]);
-    if (tok.empty() || tok[0].front() == '#') continue;
-    const std::string_view key = tok[0];
+  bool after_mtllib = false;
+  Lines lines(text);
+  for (std::string_view line; lines.next(line);) {
+    const std::size_t line_no = lines.number();
+    Words words(line);
+    const std::string_view key = words.next();
+    if (key.empty() || key.front() == '#') continue;
     if (key == "v") {
-      if (tok.size() < 4)
+      const std::string_view xyz[3] = {words.next(), words.next(), words.next()};
+      if (xyz[2].empty())
         fail(ErrorCode::parse_error, file, line_no,
-             "vertex has " + std::to_string(tok.size() - 1) + " coordinates; x y z needed");
-      for (std::size_t i = 1; i <= 3; ++i)
-        if (!parse_finite_float(tok[i]))
-          fail(ErrorCode::parse_error, file, line_no, "vertex coordinate " + in_quotes(tok[i]) + " is not a finite number");
-      ++scan.vertex_count;
+             "vertex has " + std::to_string(xyz[0].empty() ? 0 : xyz[1].empty() ? 1 : 2) + " coordinates; x y z needed");
+      glm::vec3 p;
+      for (int i = 0; i < 3; ++i) {
+        const std::optional<float> c = parse_finite_float(xyz[i]);
+        if (!c) fail(ErrorCode::parse_error, file, line_no, "vertex coordinate " + in_quotes(xyz[i]) + " is not a finite number");
+        p[i] = *c;
+      }
+      positions.push_back(p);
     } else if (key == "f") {
-      for (std::size_t i = 1; i < tok.size(); ++i) check_corner(file, line_no, tok[i], scan.vertex_count);
-      // tinyobjloader drops such a face too, so it is left out of the face list.
-      if (tok.size() < 4)
+      const std::size_t first = obj.corners.size();
+      for (std::string_view corner = words.next(); !corner.empty(); corner = words.next())
+        obj.corners.push_back(positions[corner_vertex(file, line_no, corner, positions.size())]);
+      const std::size_t count = obj.corners.size() - first;
+      if (count < 3) {
+        obj.corners.resize(first);
         warnings.forgive("short face", ErrorCode::parse_error, loc(file, line_no),
-                         "face has " + std::to_string(tok.size() - 1) + " vertices; a polygon needs at least 3",
-                         "dropped");
-      else
-        scan.faces.push_back(FaceInfo{line_no, tok.size() - 1, material, material_line});
+                         "face has " + std::to_string(count) + " vertices; a polygon needs at least 3", "dropped");
+      } else {
+        obj.faces.push_back(ObjFace{line_no, first, count, obj.groups.size() - 1, obj.materials.size() - 1});
+      }
+    } else if (key == "g" || key == "o") {
+      // A bare `g` or `o` (not even a blank after it) leaves the group as it is, and `g ` starts
+      // the unnamed (default) group: tinyobjloader's reading, which files were made against.
+      if (words.rest().empty()) continue;
+      obj.groups.push_back(group_name(key, words));
     } else if (key == "usemtl") {
-      material = tok.size() > 1 ? tok[1] : std::string_view();
-      material_line = line_no;
+      obj.materials.push_back(UseMaterial{words.next(), line_no, after_mtllib});
     } else if (key == "mtllib") {
-      const std::string_view line = trim(lines[n]);
-      const std::vector<std::string> names = mtllib_names(line.substr(std::min<std::size_t>(line.size(), 7)));
+      after_mtllib = true;
+      const std::vector<std::string> names = mtllib_names(trim(words.rest()));
       if (names.empty())
         warnings.forgive("empty mtllib", ErrorCode::parse_error, loc(file, line_no), "mtllib without a file name",
                          "ignored");
@@ -506,38 +580,15 @@ ObjScan scan_obj(const fs::path& file, std::string_view text, ReaderWarnings& wa
                            "its materials are the default grey");
           continue;
         }
-        if (seen_mtl.insert(p.lexically_normal()).second) scan.mtl_files.push_back(p);
+        if (seen_mtl.insert(p.lexically_normal()).second) obj.mtl_files.push_back(p);
       }
     } else if (key == "l" || key == "p") {
       warnings.forgive("line or point element", ErrorCode::parse_error, loc(file, line_no),
                        "line/point element has no area", "ignored");
     }
   }
-  return scan;
+  return obj;
 }
-
-/// Hands tinyobjloader the materials we read from every mtllib beforehand (only their names
-/// matter to it: it maps usemtl to an index). tinyobjloader would stop at the first file of a
-/// multi-file `mtllib` line, and we want all of them.
-class PreloadedMaterials : public tinyobj::MaterialReader {
- public:
-  PreloadedMaterials(const std::vector<tinyobj::material_t>& materials, const std::map<std::string, int>& map)
-      : materials_(materials), map_(map) {}
-  bool operator()(const std::string&, std::vector<tinyobj::material_t>* materials, std::map<std::string, int>* map,
-                  std::string*, std::string*) override {
-    if (!given_) {
-      *materials = materials_;
-      *map = map_;
-      given_ = true;
-    }
-    return true;
-  }
-
- private:
-  const std::vector<tinyobj::material_t>& materials_;
-  const std::map<std::string, int>& map_;
-  bool given_ = false;
-};
 
 /// "polygon 7 (group 'x'): problem" -> "problem": Scene numbers polygons of the scratch scene
 /// below, which mean nothing to the user; we give file:line instead.
@@ -560,14 +611,15 @@ class FaceAdder {
   }
 
   void add(const std::vector<glm::vec3>& vertices, MaterialId material, const std::string& group, std::size_t line) {
-    const std::string face = "face (group '" + (group.empty() ? std::string("default") : group) + "'): ";
+    // Made only for a message: most faces need none.
+    auto face = [&]() { return "face (group '" + (group.empty() ? std::string("default") : group) + "'): "; };
     const std::size_t warnings_before = scratch_.warnings().size();
     PolygonRange pieces;
     try {
       pieces = scratch_.add_polygon(vertices, 0);
     } catch (const Error& e) {
-      // The vertices are finite (the scan checked), so Scene refuses only degenerate faces.
-      warnings_.forgive("degenerate face", e.code(), loc(file_, line), face + without_polygon_prefix(e.what()),
+      // The vertices are finite (read_obj() checked), so Scene refuses only degenerate faces.
+      warnings_.forgive("degenerate face", e.code(), loc(file_, line), face() + without_polygon_prefix(e.what()),
                         "dropped");
       return;
     }
@@ -586,7 +638,7 @@ class FaceAdder {
       }
       for (std::size_t w = warnings_before; w < scratch_.warnings().size(); ++w)
         warnings_.forgive("triangulated face", ErrorCode::invalid_scene, loc(file_, line),
-                          face + without_polygon_prefix(scratch_.warnings()[w]),
+                          face() + without_polygon_prefix(scratch_.warnings()[w]),
                           slivers > 0 && w + 1 == scratch_.warnings().size()
                               ? std::to_string(slivers) + " sliver triangle(s) dropped"
                               : std::string());
@@ -611,51 +663,37 @@ class FaceAdder {
 Scene load_obj(const fs::path& path, const LoadOptions& options) {
   const std::string text = read_text(path, "OBJ file");
   ReaderWarnings warnings(options.strict);
-  ObjScan scan = scan_obj(path, text, warnings);
+  const ObjFile obj = read_obj(path, text, warnings);
 
   // Every MTL file, in order of mention, into one list; the first definition of a name wins.
   std::vector<MtlInfo> infos;
-  for (const fs::path& mtl : scan.mtl_files) scan_mtl(mtl, read_text(mtl, "MTL file"), infos);
-  std::vector<tinyobj::material_t> tmaterials(infos.size());
-  std::map<std::string, int> tmaterial_map;
-  for (std::size_t i = 0; i < infos.size(); ++i) {
-    tmaterials[i].name = infos[i].name;
-    tmaterial_map.emplace(infos[i].name, static_cast<int>(i));
-  }
-
-  tinyobj::attrib_t attrib;
-  std::vector<tinyobj::shape_t> shapes;
-  std::vector<tinyobj::material_t> used_materials;
-  std::string warn, err;
-  {
-    std::istringstream in(text);
-    PreloadedMaterials reader(tmaterials, tmaterial_map);
-    if (!tinyobj::LoadObj(&attrib, &shapes, &used_materials, &warn, &err, &in, &reader, /*triangulate=*/false)) {
-      std::string first = err.substr(0, err.find('\n'));
-      throw Error(ErrorCode::parse_error, path.string() + ": " + (first.empty() ? "cannot parse" : first));
-    }
-  }
-  // Invariants of the scan agreeing with tinyobjloader (both read the same text).
-  RADIOSITY_ASSERT(attrib.vertices.size() == 3 * scan.vertex_count);
+  for (const fs::path& mtl : obj.mtl_files) scan_mtl(mtl, read_text(mtl, "MTL file"), infos);
 
   Scene scene;
 
-  // Materials: MTL material i becomes scene material ids[i]; "default" grey is added on demand.
-  std::vector<MaterialId> ids;
-  ids.reserve(infos.size());
+  // Materials: every MTL material, in order; "default" grey is added on demand.
+  std::map<std::string_view, MaterialId, std::less<>> by_name;
   for (const MtlInfo& info : infos) {
     try {
-      ids.push_back(scene.add_material(to_material(info, warnings)));
+      by_name.emplace(info.name, scene.add_material(to_material(info, warnings)));
     } catch (const Error& e) {
       throw Error(e.code(), at(info.file, info.line) + e.what());
     }
   }
+  std::vector<std::optional<MaterialId>> used(obj.materials.size());
+  for (std::size_t u = 0; u < used.size(); ++u) {
+    auto it = by_name.find(obj.materials[u].name);
+    if (obj.materials[u].after_mtllib && it != by_name.end()) used[u] = it->second;
+  }
   std::optional<MaterialId> default_material;
-  auto material_of = [&](int mid, const FaceInfo& face) -> MaterialId {
-    if (mid >= 0 && static_cast<std::size_t>(mid) < ids.size()) return ids[static_cast<std::size_t>(mid)];
-    if (!face.material.empty())
-      warnings.forgive("undefined material", ErrorCode::invalid_scene, loc(path, face.material_line),
-                       "material " + in_quotes(face.material) + " is not defined by the mtllib files read",
+  std::set<std::string_view> undefined_reported;
+  auto material_of = [&](std::size_t u) -> MaterialId {
+    if (used[u]) return *used[u];
+    // An undefined material is reported once per name, not once per face.
+    const UseMaterial& use = obj.materials[u];
+    if (!use.name.empty() && undefined_reported.insert(use.name).second)
+      warnings.forgive("undefined material", ErrorCode::invalid_scene, loc(path, use.line),
+                       "material " + in_quotes(use.name) + " is not defined by the mtllib files read",
                        "its faces use the default grey");
     if (!default_material) {
       Material grey;
@@ -665,42 +703,18 @@ Scene load_obj(const fs::path& path, const LoadOptions& options) {
     return *default_material;
   };
 
-  // Faces, in file order: tinyobjloader's shapes are consecutive runs of the file's faces. The
-  // per-face vertex counts come from our scan (tinyobjloader stores them in an unsigned char).
+  // Faces, in file order.
   FaceAdder adder(scene, path, warnings);
-  std::size_t face = 0;
   std::vector<glm::vec3> vertices;
-  std::set<std::string_view> undefined_reported;
-  for (const tinyobj::shape_t& shape : shapes) {
-    const std::string group(trim(shape.name));
-    std::size_t corner = 0;
-    for (std::size_t f = 0; f < shape.mesh.material_ids.size(); ++f, ++face) {
-      if (face >= scan.faces.size() || corner + scan.faces[face].vertex_count > shape.mesh.indices.size())
-        throw Error(ErrorCode::internal, "load_scene: '" + path.string() +
-                                             "': could not match tinyobjloader's faces to the file's f lines");
-      const FaceInfo& info = scan.faces[face];
-      vertices.clear();
-      for (std::size_t k = 0; k < info.vertex_count; ++k) {
-        const int v = shape.mesh.indices[corner + k].vertex_index;
-        RADIOSITY_ASSERT(v >= 0 && static_cast<std::size_t>(v) < scan.vertex_count);  // check_corner() ensured it
-        const std::size_t o = 3 * static_cast<std::size_t>(v);
-        vertices.emplace_back(attrib.vertices[o], attrib.vertices[o + 1], attrib.vertices[o + 2]);
-      }
-      corner += info.vertex_count;
-      const int mid = shape.mesh.material_ids[f];
-      // An undefined material is reported once per name, not once per face.
-      const bool undefined = !(mid >= 0 && static_cast<std::size_t>(mid) < ids.size());
-      FaceInfo quiet = info;
-      if (undefined && !undefined_reported.insert(info.material).second) quiet.material = {};
-      adder.add(vertices, material_of(mid, quiet), group, info.line);
-    }
+  for (const ObjFace& face : obj.faces) {
+    RADIOSITY_ASSERT(face.count >= 3 && face.first + face.count <= obj.corners.size());
+    const auto first = obj.corners.begin() + static_cast<std::ptrdiff_t>(face.first);
+    vertices.assign(first, first + static_cast<std::ptrdiff_t>(face.count));
+    adder.add(vertices, material_of(face.material), obj.groups[face.group], face.line);
   }
-  if (face != scan.faces.size())
-    throw Error(ErrorCode::internal, "load_scene: '" + path.string() + "': could not match tinyobjloader's faces to the file's " +
-                                         std::to_string(scan.faces.size()) + " f lines");
   if (scene.polygons().empty())
     throw Error(ErrorCode::parse_error, "load_scene: '" + path.string() + "' has no faces (f lines)" +
-                                            (scan.faces.empty() ? "" : " that are not degenerate"));
+                                            (obj.faces.empty() ? "" : " that are not degenerate"));
   warnings.move_to(scene);
   return scene;
 }
