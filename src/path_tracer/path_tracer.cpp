@@ -38,7 +38,7 @@
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
-#include "core/camera_check.hpp"
+#include "image/image_options.hpp"
 #include "core/progress.hpp"
 
 namespace radiosity {
@@ -576,15 +576,10 @@ class PathTracer {
 }  // namespace
 
 void validate(const PathTraceOptions& options) {
-  if (options.width <= 0) bad_option("width must be > 0, got " + std::to_string(options.width));
-  if (options.height <= 0) bad_option("height must be > 0, got " + std::to_string(options.height));
-  if (options.spp <= 0) bad_option("spp must be > 0, got " + std::to_string(options.spp));
+  const std::string problem = detail::image_options_problem(options);
+  if (!problem.empty()) bad_option(problem);
   if (options.max_depth < 0)
     bad_option("max_depth must be >= 0 (0 = unlimited), got " + std::to_string(options.max_depth));
-  if (options.camera) {
-    const std::string problem = detail::camera_problem(*options.camera);
-    if (!problem.empty()) bad_option(problem);
-  }
 }
 
 Image render_path_traced(const Scene& scene, const PathTraceOptions& options) {

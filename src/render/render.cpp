@@ -16,7 +16,7 @@
 #include "geometry/ray_scene.hpp"
 #include "radiosity/render.hpp"
 #include "image/camera.hpp"
-#include "core/camera_check.hpp"
+#include "image/image_options.hpp"
 #include "core/streams.hpp"
 #include "core/progress.hpp"
 
@@ -24,15 +24,13 @@ namespace radiosity {
 inline namespace v1 {
 
 void validate(const RenderOptions& options) {
+  const std::string problem = detail::image_options_problem(options);
+  if (problem.empty()) return;
+  // render() names the size as one field, as it always has.
   if (options.width <= 0 || options.height <= 0)
     throw Error(ErrorCode::invalid_argument, "render: width and height must be > 0, got " +
                                                  std::to_string(options.width) + "x" + std::to_string(options.height));
-  if (options.spp <= 0)
-    throw Error(ErrorCode::invalid_argument, "render: spp must be > 0, got " + std::to_string(options.spp));
-  if (options.camera) {
-    const std::string problem = detail::camera_problem(*options.camera);
-    if (!problem.empty()) throw Error(ErrorCode::invalid_argument, "render: " + problem);
-  }
+  throw Error(ErrorCode::invalid_argument, "render: " + problem);
 }
 
 Image render(const Scene& scene, const Solution& solution, const RenderOptions& options) {

@@ -34,7 +34,7 @@
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/streams.hpp"
-#include "core/camera_check.hpp"
+#include "image/image_options.hpp"
 #include "core/progress.hpp"
 
 namespace radiosity {
@@ -353,9 +353,8 @@ class TwoPassRenderer {
 }  // namespace
 
 void validate(const TwoPassOptions& options) {
-  if (options.width <= 0) bad_option("width must be > 0, got " + std::to_string(options.width));
-  if (options.height <= 0) bad_option("height must be > 0, got " + std::to_string(options.height));
-  if (options.spp <= 0) bad_option("spp must be > 0, got " + std::to_string(options.spp));
+  const std::string problem = detail::image_options_problem(options);
+  if (!problem.empty()) bad_option(problem);
   if (options.gather_samples < 1) bad_option("gather_samples must be >= 1, got " + std::to_string(options.gather_samples));
   if (options.max_specular_depth < 0)
     bad_option("max_specular_depth must be >= 0, got " + std::to_string(options.max_specular_depth));
@@ -368,10 +367,6 @@ void validate(const TwoPassOptions& options) {
     bad_option("caustics.lookups_per_pixel must be >= 1, got " + std::to_string(c.lookups_per_pixel));
   if (!std::isfinite(c.max_radius) || c.max_radius < 0.0f)
     bad_option("caustics.max_radius must be finite and >= 0, got " + std::to_string(c.max_radius));
-  if (options.camera) {
-    const std::string problem = detail::camera_problem(*options.camera);
-    if (!problem.empty()) bad_option(problem);
-  }
 }
 
 Image render_two_pass(const Scene& scene, const Solution& pass1, const TwoPassOptions& options, TwoPassReport& report) {
