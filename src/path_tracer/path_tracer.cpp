@@ -27,19 +27,18 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "core/parallel.hpp"
 #include "core/rng.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/brdf.hpp"
-#include "image/camera.hpp"
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
+#include "image/camera.hpp"
+#include "image/image_loop.hpp"
 #include "image/image_options.hpp"
-#include "core/progress.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -175,22 +174,10 @@ class PathTracer {
   Image render() const {
     Image image(options_.width, options_.height);
     const std::size_t paths_per_row = static_cast<std::size_t>(options_.width) * g_ * g_;
-    const int band = static_cast<int>(std::max<std::size_t>(1, kPathsPerBand / paths_per_row));
-    const std::size_t grain = std::max<std::size_t>(1, 1024 / (static_cast<std::size_t>(g_) * g_));
-    // Bands of rows: parallel inside a band, progress and cancel between bands on this thread.
-    detail::ProgressGate gate(options_.on_progress);
-    for (int y0 = 0; y0 < options_.height; y0 += band) {
-      const int y1 = std::min(options_.height, y0 + band);
-      const std::size_t count = static_cast<std::size_t>(y1 - y0) * options_.width;
-      detail::parallel_for(options_.threads, count, grain, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-          const int x = static_cast<int>(k % options_.width), y = y0 + static_cast<int>(k / options_.width);
-          image.at(x, y) = pixel(x, y);
-        }
-      });
-      const Progress progress{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
-      if (!gate.report(progress, y1 == options_.height)) break;
-    }
+    detail::ImageBands bands;
+    bands.rows = static_cast<int>(std::max<std::size_t>(1, kPathsPerBand / paths_per_row));
+    bands.grain = std::max<std::size_t>(1, 1024 / (static_cast<std::size_t>(g_) * g_));
+    detail::for_each_pixel(options_, bands, [&](int x, int y) { image.at(x, y) = pixel(x, y); });
     return image;
   }
 
