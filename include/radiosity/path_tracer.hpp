@@ -1,8 +1,6 @@
 // A brute-force, unbiased path tracer: the ground truth that radiosity images are checked against.
 #pragma once
 
-#include <cstdint>
-#include <optional>
 
 #include "radiosity/common.hpp"
 #include "radiosity/render.hpp"
@@ -11,28 +9,19 @@
 namespace radiosity {
 inline namespace v1 {
 
-/// How render_path_traced() samples the image. Every field has a default.
-struct PathTraceOptions {
-  int width = 512;   ///< pixels, > 0
-  int height = 512;  ///< pixels, > 0
-  /// Paths per pixel, > 0, on a stratified jittered g x g grid with a box filter; rounded up to
-  /// a square (g = ceil(sqrt(spp))). Noise falls as 1/sqrt(spp).
-  int spp = 64;
+/// How render_path_traced() samples the image: ImageOptions (spp = paths per pixel, 64 by
+/// default; noise falls as 1/sqrt(spp)) plus the path length. Every field has a default.
+/// Thread safety: a plain value; render_path_traced() only reads it.
+struct PathTraceOptions : ImageOptions {
+  PathTraceOptions() : ImageOptions(64) {}
   /// Most scattering events (reflections and refractions, delta ones included) a path may have,
   /// >= 0: 1 = direct lighting only, 2 = one indirect bounce, ... 0 = unlimited, ended only by
   /// Russian roulette (unbiased).
   int max_depth = 0;
-  std::optional<Camera> camera;  ///< default: the scene's camera
-  unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
-  std::uint64_t seed = 1;        ///< the image is a function of (scene, options, seed) only
-  /// Called on the calling thread after each band of rows (Phase::rendering, fraction = rows
-  /// done / height). Return false to cancel: rows not yet rendered stay black.
-  ProgressFn on_progress;
 };
 
-/// Checks options; throws Error{invalid_argument} naming the first bad field (width, height,
-/// spp, max_depth, camera.fov_deg outside (0, 180), camera.eye == camera.look_at or camera.up
-/// parallel to the view direction, a non-finite camera value).
+/// Checks options; throws Error{invalid_argument} naming the first bad field: those of
+/// validate(ImageOptions) first (width, height, spp, the camera), then max_depth.
 /// Thread safety: may be called concurrently.
 RADIOSITY_API void validate(const PathTraceOptions& options);
 

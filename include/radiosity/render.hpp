@@ -28,26 +28,54 @@ struct Image {
   const Rgb& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
 };
 
-/// How render() samples the image.
-struct RenderOptions {
-  int width = 512;
-  int height = 512;
-  /// Samples per pixel, stratified on a jittered grid and box-filtered. Rounded up to a square.
+/// What the three renderers (render(), render_path_traced(), render_two_pass()) share: the image
+/// size, the sampling, the camera, threads, seed and progress. Each renderer's options derive
+/// from it, so `RenderOptions o; o.width = 64;` sets this struct's field. Every field has a
+/// default; only spp's default differs between the renderers (see spp).
+/// Thread safety: a plain value; the renderers only read it.
+struct ImageOptions {
+  int width = 512;   ///< pixels, > 0
+  int height = 512;  ///< pixels, > 0
+  /// Samples (camera rays or paths) per pixel, > 0, on a stratified jittered g x g grid with a
+  /// box filter; rounded up to a square (g = ceil(sqrt(spp))). Default 4 here and in
+  /// RenderOptions, 64 in PathTraceOptions, 16 in TwoPassOptions.
   int spp = 4;
   std::optional<Camera> camera;  ///< default: the scene's camera
-  unsigned threads = 0;          ///< 0 = all hardware threads
+  unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
+  /// The image is a function of the inputs and the seed only: bit-identical at any thread count
+  /// (each pixel draws from its own random stream keyed by (seed, pixel)).
   std::uint64_t seed = 1;
+  /// Called on the calling thread, one call at a time, after bands of rows (Phase::rendering,
+  /// fraction = rows done / height): at most about every 100 ms, and always after the last
+  /// row (fraction 1). Return false to cancel: the rows not yet rendered stay black, and the
+  /// renderer returns the image as it is.
+  ProgressFn on_progress;
+
+  ImageOptions() = default;
+  /// The defaults above with another spp: each renderer's options keep their own default.
+  explicit ImageOptions(int default_spp) : spp(default_spp) {}
+};
+
+/// Checks the shared options; throws Error{invalid_argument} naming the first bad field (width,
+/// height, spp, then the camera: camera.fov_deg outside (0, 180), camera.look_at equal to
+/// camera.eye, camera.up zero or parallel to the view direction, a non-finite camera value).
+/// The renderers' validate() overloads call it first. Thread safety: pure function.
+RADIOSITY_API void validate(const ImageOptions& options);
+
+/// How render() samples the image: ImageOptions (spp 4 by default) plus the display settings.
+/// Thread safety: a plain value; render() only reads it.
+struct RenderOptions : ImageOptions {
+  RenderOptions() : ImageOptions(4) {}
   /// Show radiosity plus reflectance x ambient (Solution::radiosity_with_ambient): the usual
   /// display of an unfinished progressive solution.
   bool ambient = false;
   /// Draw the edges of the leaf elements in black over the image (to see the mesh and the
   /// adaptive subdivision).
   bool wireframe = false;
-  ProgressFn on_progress;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field (width, height,
-/// spp, or the camera as validate(PathTraceOptions) checks it). Thread safety: pure function.
+/// spp, or the camera, as validate(ImageOptions) checks them). Thread safety: pure function.
 RADIOSITY_API void validate(const RenderOptions& options);
 
 /// Ray-casts the solution: each camera ray shows the interpolated vertex radiosity / pi of the

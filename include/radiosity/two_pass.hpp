@@ -4,8 +4,6 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdint>
-#include <optional>
 
 #include "radiosity/common.hpp"
 #include "radiosity/render.hpp"
@@ -58,17 +56,11 @@ struct PhotonOptions {
   int lookups_per_pixel = 2;
 };
 
-/// How render_two_pass() samples the image. Every field has a default.
-/// Thread safety: a plain value; render_two_pass() only reads it.
-struct TwoPassOptions {
-  int width = 512;   ///< pixels, > 0
-  int height = 512;  ///< pixels, > 0
-  /// Camera rays per pixel, > 0, on a jittered g x g grid with a box filter; rounded up to a
-  /// square (g = ceil(sqrt(spp))), as render() does.
-  int spp = 16;
-  std::optional<Camera> camera;  ///< default: the scene's camera
-  unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
-  std::uint64_t seed = 1;        ///< the image is a function of (scene, solution, options, seed)
+/// How render_two_pass() samples the image: ImageOptions (spp = camera rays per pixel, 16 by
+/// default, rounded up to a square as render() does) plus the two-pass settings. Every field
+/// has a default. Thread safety: a plain value; render_two_pass() only reads it.
+struct TwoPassOptions : ImageOptions {
+  TwoPassOptions() : ImageOptions(16) {}
   TwoPassContent content = TwoPassContent::full;
   DiffuseShading diffuse = DiffuseShading::pass1;
   /// Shadow rays per camera ray for DiffuseShading::final_gather, >= 1.
@@ -84,9 +76,6 @@ struct TwoPassOptions {
   /// pass 1 into its direct and indirect parts, >= 1.
   int direct_samples = 64;
   PhotonOptions caustics;
-  /// Called on the calling thread after each band of rows (Phase::rendering, fraction = rows
-  /// done / height). Return false to cancel: rows not yet rendered stay black.
-  ProgressFn on_progress;
 };
 
 /// Times and counts of one render_two_pass() call. Thread safety: a plain value.
@@ -100,7 +89,8 @@ struct TwoPassReport {
   double seconds_render = 0.0;  ///< camera rays
 };
 
-/// Checks options; throws Error{invalid_argument} naming the first bad field.
+/// Checks options; throws Error{invalid_argument} naming the first bad field: those of
+/// validate(ImageOptions) first (width, height, spp, the camera), then the two-pass settings.
 /// Thread safety: may be called concurrently.
 RADIOSITY_API void validate(const TwoPassOptions& options);
 

@@ -27,19 +27,18 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "core/parallel.hpp"
 #include "core/rng.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "radiosity/brdf.hpp"
-#include "image/camera.hpp"
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
-#include "core/camera_check.hpp"
-#include "core/progress.hpp"
+#include "image/camera.hpp"
+#include "image/image_loop.hpp"
+#include "image/image_options.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -175,22 +174,10 @@ class PathTracer {
   Image render() const {
     Image image(options_.width, options_.height);
     const std::size_t paths_per_row = static_cast<std::size_t>(options_.width) * g_ * g_;
-    const int band = static_cast<int>(std::max<std::size_t>(1, kPathsPerBand / paths_per_row));
-    const std::size_t grain = std::max<std::size_t>(1, 1024 / (static_cast<std::size_t>(g_) * g_));
-    // Bands of rows: parallel inside a band, progress and cancel between bands on this thread.
-    detail::ProgressGate gate(options_.on_progress);
-    for (int y0 = 0; y0 < options_.height; y0 += band) {
-      const int y1 = std::min(options_.height, y0 + band);
-      const std::size_t count = static_cast<std::size_t>(y1 - y0) * options_.width;
-      detail::parallel_for(options_.threads, count, grain, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-          const int x = static_cast<int>(k % options_.width), y = y0 + static_cast<int>(k / options_.width);
-          image.at(x, y) = pixel(x, y);
-        }
-      });
-      const Progress progress{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
-      if (!gate.report(progress, y1 == options_.height)) break;
-    }
+    detail::ImageBands bands;
+    bands.rows = static_cast<int>(std::max<std::size_t>(1, kPathsPerBand / paths_per_row));
+    bands.grain = std::max<std::size_t>(1, 1024 / (static_cast<std::size_t>(g_) * g_));
+    detail::for_each_pixel(options_, bands, [&](int x, int y) { image.at(x, y) = pixel(x, y); });
     return image;
   }
 
@@ -576,15 +563,10 @@ class PathTracer {
 }  // namespace
 
 void validate(const PathTraceOptions& options) {
-  if (options.width <= 0) bad_option("width must be > 0, got " + std::to_string(options.width));
-  if (options.height <= 0) bad_option("height must be > 0, got " + std::to_string(options.height));
-  if (options.spp <= 0) bad_option("spp must be > 0, got " + std::to_string(options.spp));
+  const std::string problem = detail::image_options_problem(options);
+  if (!problem.empty()) bad_option(problem);
   if (options.max_depth < 0)
     bad_option("max_depth must be >= 0 (0 = unlimited), got " + std::to_string(options.max_depth));
-  if (options.camera) {
-    const std::string problem = detail::camera_problem(*options.camera);
-    if (!problem.empty()) bad_option(problem);
-  }
 }
 
 Image render_path_traced(const Scene& scene, const PathTraceOptions& options) {

@@ -11,28 +11,25 @@
 #include <glm/trigonometric.hpp>
 #include <limits>
 
-#include "core/parallel.hpp"
 #include "core/rng.hpp"
-#include "geometry/ray_scene.hpp"
-#include "radiosity/render.hpp"
-#include "image/camera.hpp"
-#include "core/camera_check.hpp"
 #include "core/streams.hpp"
-#include "core/progress.hpp"
+#include "geometry/ray_scene.hpp"
+#include "image/camera.hpp"
+#include "image/image_loop.hpp"
+#include "image/image_options.hpp"
+#include "radiosity/render.hpp"
 
 namespace radiosity {
 inline namespace v1 {
 
 void validate(const RenderOptions& options) {
+  const std::string problem = detail::image_options_problem(options);
+  if (problem.empty()) return;
+  // render() names the size as one field, as it always has.
   if (options.width <= 0 || options.height <= 0)
     throw Error(ErrorCode::invalid_argument, "render: width and height must be > 0, got " +
                                                  std::to_string(options.width) + "x" + std::to_string(options.height));
-  if (options.spp <= 0)
-    throw Error(ErrorCode::invalid_argument, "render: spp must be > 0, got " + std::to_string(options.spp));
-  if (options.camera) {
-    const std::string problem = detail::camera_problem(*options.camera);
-    if (!problem.empty()) throw Error(ErrorCode::invalid_argument, "render: " + problem);
-  }
+  throw Error(ErrorCode::invalid_argument, "render: " + problem);
 }
 
 Image render(const Scene& scene, const Solution& solution, const RenderOptions& options) {
@@ -84,32 +81,20 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
     return b * inv_pi;
   };
 
-  // Bands of rows: parallel inside a band, progress and cancel between bands, so the callback
-  // runs on this thread. Each pixel has its own random stream: thread count does not matter.
-  const int band = 16;
-  detail::ProgressGate gate(options.on_progress);
-  for (int y0 = 0; y0 < options.height; y0 += band) {
-    const int y1 = std::min(options.height, y0 + band);
-    const std::size_t count = static_cast<std::size_t>(y1 - y0) * options.width;
-    detail::parallel_for(options.threads, count, 64, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k) {
-        const int x = static_cast<int>(k % options.width), y = y0 + static_cast<int>(k / options.width);
-        detail::Rng rng(options.seed, static_cast<std::uint64_t>(y) * options.width + x,
-                        detail::stream_key(detail::Stream::pixel_jitter));
-        Rgb sum(0.0f);
-        for (int i = 0; i < g; ++i)
-          for (int j = 0; j < g; ++j) {
-            glm::vec2 u = rng.uniform2();
-            float sx = (static_cast<float>(x) + (static_cast<float>(i) + u.x) / g) / options.width;
-            float sy = (static_cast<float>(y) + (static_cast<float>(j) + u.y) / g) / options.height;
-            sum += shade(camera.direction(sx, sy));
-          }
-        image.at(x, y) = sum / static_cast<float>(g * g);
+  // Each pixel has its own random stream: thread count does not matter.
+  detail::for_each_pixel(options, detail::ImageBands{16, 64}, [&](int x, int y) {
+    detail::Rng rng(options.seed, static_cast<std::uint64_t>(y) * options.width + x,
+                    detail::stream_key(detail::Stream::pixel_jitter));
+    Rgb sum(0.0f);
+    for (int i = 0; i < g; ++i)
+      for (int j = 0; j < g; ++j) {
+        glm::vec2 u = rng.uniform2();
+        float sx = (static_cast<float>(x) + (static_cast<float>(i) + u.x) / g) / options.width;
+        float sy = (static_cast<float>(y) + (static_cast<float>(j) + u.y) / g) / options.height;
+        sum += shade(camera.direction(sx, sy));
       }
-    });
-    const Progress p{Phase::rendering, static_cast<double>(y1) / options.height, 0, 0.0};
-    if (!gate.report(p, y1 == options.height)) break;
-  }
+    image.at(x, y) = sum / static_cast<float>(g * g);
+  });
   return image;
 }
 

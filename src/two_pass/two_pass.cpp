@@ -28,14 +28,14 @@
 
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
-#include "image/camera.hpp"
-#include "two_pass/photon_map.hpp"
-#include "two_pass/specular_scene.hpp"
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/streams.hpp"
-#include "core/camera_check.hpp"
-#include "core/progress.hpp"
+#include "image/camera.hpp"
+#include "image/image_loop.hpp"
+#include "image/image_options.hpp"
+#include "two_pass/photon_map.hpp"
+#include "two_pass/specular_scene.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -100,22 +100,12 @@ class TwoPassRenderer {
     Image image(options_.width, options_.height);
     std::vector<Rgb> layers[kLayers];
     for (auto& l : layers) l.assign(image.pixels.size(), Rgb(0.0f));
-    detail::ProgressGate gate(options_.on_progress);
-    for (int y0 = 0; y0 < options_.height; y0 += kBandRows) {
-      const int y1 = std::min(options_.height, y0 + kBandRows);
-      const std::size_t count = static_cast<std::size_t>(y1 - y0) * options_.width;
-      detail::parallel_for(options_.threads, count, 16, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-          const int x = static_cast<int>(k % options_.width), y = y0 + static_cast<int>(k / options_.width);
-          const Radiance r = pixel(x, y);
-          const std::size_t at = static_cast<std::size_t>(y) * options_.width + x;
-          for (int l = 0; l < kLayers; ++l) layers[l][at] = r.layer[l];
-          image.pixels[at] = r.layer[kDirect] + r.layer[kIndirect] + r.layer[kSpecular] + r.layer[kCaustic];
-        }
-      });
-      const Progress p{Phase::rendering, static_cast<double>(y1) / options_.height, 0, 0.0};
-      if (!gate.report(p, y1 == options_.height)) break;
-    }
+    detail::for_each_pixel(options_, detail::ImageBands{kBandRows, 16}, [&](int x, int y) {
+      const Radiance r = pixel(x, y);
+      const std::size_t at = static_cast<std::size_t>(y) * options_.width + x;
+      for (int l = 0; l < kLayers; ++l) layers[l][at] = r.layer[l];
+      image.pixels[at] = r.layer[kDirect] + r.layer[kIndirect] + r.layer[kSpecular] + r.layer[kCaustic];
+    });
     for (int l = 0; l < kLayers; ++l) image.layers.emplace_back(kLayerNames[l], std::move(layers[l]));
     return image;
   }
@@ -353,9 +343,8 @@ class TwoPassRenderer {
 }  // namespace
 
 void validate(const TwoPassOptions& options) {
-  if (options.width <= 0) bad_option("width must be > 0, got " + std::to_string(options.width));
-  if (options.height <= 0) bad_option("height must be > 0, got " + std::to_string(options.height));
-  if (options.spp <= 0) bad_option("spp must be > 0, got " + std::to_string(options.spp));
+  const std::string problem = detail::image_options_problem(options);
+  if (!problem.empty()) bad_option(problem);
   if (options.gather_samples < 1) bad_option("gather_samples must be >= 1, got " + std::to_string(options.gather_samples));
   if (options.max_specular_depth < 0)
     bad_option("max_specular_depth must be >= 0, got " + std::to_string(options.max_specular_depth));
@@ -368,10 +357,6 @@ void validate(const TwoPassOptions& options) {
     bad_option("caustics.lookups_per_pixel must be >= 1, got " + std::to_string(c.lookups_per_pixel));
   if (!std::isfinite(c.max_radius) || c.max_radius < 0.0f)
     bad_option("caustics.max_radius must be finite and >= 0, got " + std::to_string(c.max_radius));
-  if (options.camera) {
-    const std::string problem = detail::camera_problem(*options.camera);
-    if (!problem.empty()) bad_option(problem);
-  }
 }
 
 Image render_two_pass(const Scene& scene, const Solution& pass1, const TwoPassOptions& options, TwoPassReport& report) {

@@ -116,8 +116,8 @@ int main(int argc, char** argv) {
         scene.set_camera(c);  // validates
         camera = c;
       }
-      // What the three renderers' options share; spp defaults per renderer.
-      auto image_options = [&](auto& o, int default_spp) {
+      // What the three renderers' options share (rad::ImageOptions); spp defaults per renderer.
+      auto image_options = [&](rad::ImageOptions& o, int default_spp) {
         o.width = width;
         o.height = height;
         o.spp = spp > 0 ? spp : default_spp;
