@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -77,6 +78,21 @@ inline glm::vec3 reflect_about(const glm::vec3& w, const glm::vec3& h) { return 
 using detail::concentric_disk;
 using detail::cosine_hemisphere_pdf;
 inline glm::vec3 sample_cosine_hemisphere(const glm::vec2& u) { return detail::cosine_hemisphere(u); }
+
+/// The pdf of the models that sample cos/pi above the surface (Lambertian, measured): 0 for an
+/// outgoing direction below it.
+inline float cosine_lobe_pdf(const glm::vec3& wo, const glm::vec3& wi) {
+  return wo.z > 0.0f ? cosine_hemisphere_pdf(wi) : 0.0f;
+}
+
+/// Their sample: a cosine-distributed direction above the surface, or nothing for wo below it
+/// or for a point exactly on the disk rim (z = 0, a direction with no density).
+inline std::optional<glm::vec3> sample_cosine_lobe(const glm::vec3& wo, const glm::vec2& u) {
+  if (!(wo.z > 0.0f)) return std::nullopt;
+  const glm::vec3 wi = sample_cosine_hemisphere(clamp01(u));
+  if (!(wi.z > 0.0f)) return std::nullopt;
+  return wi;
+}
 
 /// Remaps u (in [0, 1)) that fell below `p` (or above it) back onto [0, 1) so that one uniform
 /// number both picks a lobe and drives that lobe's sampler.

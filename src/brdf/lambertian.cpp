@@ -26,17 +26,13 @@ class LambertianBrdf final : public Brdf {
     return (wo.z > 0.0f && wi.z > 0.0f) ? f_ : Rgb(0.0f);
   }
 
-  float pdf(const glm::vec3& wo, const glm::vec3& wi) const override {
-    return wo.z > 0.0f ? db::cosine_hemisphere_pdf(wi) : 0.0f;
-  }
+  float pdf(const glm::vec3& wo, const glm::vec3& wi) const override { return db::cosine_lobe_pdf(wo, wi); }
 
   std::optional<BrdfSample> sample(const glm::vec3& wo, const glm::vec2& u) const override {
-    if (!(wo.z > 0.0f)) return std::nullopt;
-    const glm::vec3 wi = db::sample_cosine_hemisphere(db::clamp01(u));
-    // A point exactly on the disk rim gives z = 0, a direction with no density.
-    if (!(wi.z > 0.0f)) return std::nullopt;
+    const std::optional<glm::vec3> wi = db::sample_cosine_lobe(wo, u);
+    if (!wi) return std::nullopt;
     // f cos / pdf = (rho / pi) cos / (cos / pi) = rho.
-    return BrdfSample{wi, rho_, db::cosine_hemisphere_pdf(wi), false};
+    return BrdfSample{*wi, rho_, db::cosine_hemisphere_pdf(*wi), false};
   }
 
   Rgb albedo(const glm::vec3& wo) const override { return wo.z > 0.0f ? rho_ : Rgb(0.0f); }

@@ -79,16 +79,13 @@ class MeasuredBrdf final : public Brdf {
     return trilinear(x_h, x_d, x_p);
   }
 
-  float pdf(const glm::vec3& wo, const glm::vec3& wi) const override {
-    return wo.z > 0.0f ? db::cosine_hemisphere_pdf(wi) : 0.0f;
-  }
+  float pdf(const glm::vec3& wo, const glm::vec3& wi) const override { return db::cosine_lobe_pdf(wo, wi); }
 
   std::optional<BrdfSample> sample(const glm::vec3& wo, const glm::vec2& u) const override {
-    if (!(wo.z > 0.0f)) return std::nullopt;
-    const glm::vec3 wi = db::sample_cosine_hemisphere(db::clamp01(u));
-    if (!(wi.z > 0.0f)) return std::nullopt;
+    const std::optional<glm::vec3> wi = db::sample_cosine_lobe(wo, u);
+    if (!wi) return std::nullopt;
     // f cos / (cos / pi) = pi f.
-    return BrdfSample{wi, eval(wo, wi) * db::kPi, db::cosine_hemisphere_pdf(wi), false};
+    return BrdfSample{*wi, eval(wo, *wi) * db::kPi, db::cosine_hemisphere_pdf(*wi), false};
   }
 
   Rgb albedo(const glm::vec3& wo) const override {

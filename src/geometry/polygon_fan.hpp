@@ -13,13 +13,9 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-namespace radiosity::detail {
+#include "core/distribution.hpp"
 
-/// Index i with cdf[i-1] <= u < cdf[i] in a normalised cumulative table (last entry 1).
-inline std::size_t sample_cdf(const std::vector<float>& cdf, float u) {
-  auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
-  return std::min(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
-}
+namespace radiosity::detail {
 
 /// The fan triangles (a, b[k], c[k]) of a polygon and the cumulative area fraction over them.
 /// Thread safety: immutable after construction.

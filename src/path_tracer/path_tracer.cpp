@@ -137,7 +137,7 @@ class PathTracer {
     for (const Material& m : scene.materials()) shading_.push_back(make_shading(m));
     const auto& polygons = scene.polygons();
     surfaces_.resize(polygons.size());
-    double total_power = 0.0;
+    std::vector<double> emitter_power;
     for (std::size_t p = 0; p < polygons.size(); ++p) {
       const Polygon& poly = polygons[p];
       const Material& m = scene.material(poly.material);
@@ -154,19 +154,14 @@ class PathTracer {
       const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;
       if (!(power > 0.0)) continue;
       emitters_.push_back(Emitter{static_cast<std::uint32_t>(p), detail::PolygonFan(poly.vertices)});
-      emitter_power_.push_back(power);
-      total_power += power;
+      emitter_power.push_back(power);
     }
     // Emitters are chosen in proportion to their power summed over channels.
-    double running = 0.0;
+    emitter_choice_ = detail::DiscreteDistribution(emitter_power);
     for (std::size_t i = 0; i < emitters_.size(); ++i) {
-      const double probability = emitter_power_[i] / total_power;
-      running += probability;
-      emitter_cdf_.push_back(static_cast<float>(running));
       const std::uint32_t p = emitters_[i].polygon;
-      surfaces_[p].light_pdf_area = static_cast<float>(probability / polygons[p].area);
+      surfaces_[p].light_pdf_area = static_cast<float>(emitter_choice_.probability(i) / polygons[p].area);
     }
-    if (!emitter_cdf_.empty()) emitter_cdf_.back() = 1.0f;
     // Ray offsets: far above float rounding at the scene's scale, far below any feature.
     epsilon_ = std::max(1e-5f * scene.bounds().diagonal(), 1e-6f);
   }
@@ -417,8 +412,14 @@ class PathTracer {
     prev_pdf = pdf;
     prev_delta = delta;
     mirror_sampled = mirrors_sampled_here && !delta;
-    origin = x + (glm::dot(dir, s.normal) > 0.0f ? epsilon_ : -epsilon_) * s.normal;
+    origin = offset_towards(x, s.normal, dir);
     return true;
+  }
+
+  /// x moved off its surface (unit normal `normal`) to the side that direction `w` leaves
+  /// from, so that a ray from there does not hit the surface itself.
+  glm::vec3 offset_towards(const glm::vec3& x, const glm::vec3& normal, const glm::vec3& w) const {
+    return x + (glm::dot(w, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
   }
 
   /// The cosine at an emitter of light leaving it against `wi` (the direction from the lit
@@ -432,7 +433,7 @@ class PathTracer {
 
   /// A uniform point on an emitter chosen by power, and that emitter.
   const Surface& sample_light(detail::Rng& rng, glm::vec3& y) const {
-    const Emitter& e = emitters_[detail::sample_cdf(emitter_cdf_, rng.uniform())];
+    const Emitter& e = emitters_[emitter_choice_.sample(rng.uniform())];
     const std::size_t tri = e.fan.triangle(rng.uniform());
     y = e.fan.point(tri, rng.uniform2());
     return surfaces_[e.polygon];
@@ -487,7 +488,7 @@ class PathTracer {
     if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
 
     // Shadow ray from the side of x that wi leaves from to the lit side of the emitter.
-    const glm::vec3 start = x + (glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
+    const glm::vec3 start = offset_towards(x, normal, wi);
     const glm::vec3 sw = y + epsilon_ * lit_side - start;
     const float dist = glm::length(sw);
     if (rays_.occluded(start, sw / dist, 0.0f, dist)) return Rgb(0.0f);
@@ -534,7 +535,7 @@ class PathTracer {
     if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
 
     // Both legs unoccluded: x to just in front of p, and from there to the emitter.
-    const glm::vec3 start = x + (glm::dot(wi, normal) > 0.0f ? epsilon_ : -epsilon_) * normal;
+    const glm::vec3 start = offset_towards(x, normal, wi);
     const glm::vec3 at_mirror = p + epsilon_ * m.normal;
     const glm::vec3 leg1 = at_mirror - start, leg2 = y + epsilon_ * lit_side - at_mirror;
     const float l1 = glm::length(leg1), l2 = glm::length(leg2);
@@ -556,8 +557,7 @@ class PathTracer {
   std::vector<Shading> shading_;  ///< by material id
   std::vector<Emitter> emitters_;
   std::vector<MirrorFace> mirrors_;
-  std::vector<double> emitter_power_;
-  std::vector<float> emitter_cdf_;
+  detail::DiscreteDistribution emitter_choice_;  ///< over emitters_, by power
 };
 
 }  // namespace

@@ -52,7 +52,6 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
   }
 
   surfaces_.resize(polygons.size());
-  double total_power = 0.0;
   std::vector<double> powers;
   for (std::size_t p = 0; p < polygons.size(); ++p) {
     const Polygon& poly = polygons[p];
@@ -79,16 +78,10 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
     e.fan = PolygonFan(poly.vertices);
     emitters_.push_back(std::move(e));
     powers.push_back(power);
-    total_power += power;
   }
-  double running = 0.0;
-  for (std::size_t i = 0; i < emitters_.size(); ++i) {
-    const double probability = powers[i] / total_power;
-    running += probability;
-    emitter_cdf_.push_back(static_cast<float>(running));
-    emitters_[i].pdf_area = static_cast<float>(probability / polygons[emitters_[i].polygon].area);
-  }
-  if (!emitter_cdf_.empty()) emitter_cdf_.back() = 1.0f;
+  emitter_choice_ = DiscreteDistribution(powers);
+  for (std::size_t i = 0; i < emitters_.size(); ++i)
+    emitters_[i].pdf_area = static_cast<float>(emitter_choice_.probability(i) / polygons[emitters_[i].polygon].area);
 
   element_polygon_.resize(hierarchy.elements().size());
   for (std::size_t e = 0; e < element_polygon_.size(); ++e)
@@ -97,7 +90,7 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
 }
 
 EmitterSample SpecularScene::sample_emitter(float u_emitter, const glm::vec2& u_point) const {
-  const Emitter& e = emitters_[sample_cdf(emitter_cdf_, u_emitter)];
+  const Emitter& e = emitters_[emitter_choice_.sample(u_emitter)];
   const SplitSurface& s = surfaces_[e.polygon];
   EmitterSample out;
   out.position = e.fan.sample(u_point);  // u_point.x picks the triangle and drives the point

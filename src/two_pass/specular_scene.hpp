@@ -93,7 +93,7 @@ class SpecularScene {
   std::vector<SplitSurface> surfaces_;
   std::vector<PolygonId> element_polygon_;
   std::vector<Emitter> emitters_;
-  std::vector<float> emitter_cdf_;
+  DiscreteDistribution emitter_choice_;  ///< over emitters_, by power summed over channels
   Rgb emitted_power_{0.0f};
   float epsilon_ = 0.0f;
   bool has_specular_ = false;
