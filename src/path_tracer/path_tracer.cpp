@@ -416,6 +416,27 @@ class PathTracer {
     return true;
   }
 
+  /// A path from a surface point to a point on an emitter, before its shadow rays.
+  struct Connection {
+    glm::vec3 lit_side{0.0f};  ///< normal of the emitter's side that the light leaves
+    float cos_y = 0.0f;        ///< cosine at the emitter
+    Rgb f{0.0f};               ///< the BSDF at the surface point for the arriving direction
+    float pdf_bounce = 0.0f;   ///< the BSDF's pdf of sampling that direction (for MIS)
+    float cos_x = 0.0f;        ///< cosine at the surface point
+  };
+
+  /// Fills `c` for light that arrives at `light` along `at_light` (the last leg's direction,
+  /// towards the emitter) and leaves the surface point along `wi`; false when that side of the
+  /// emitter does not emit or the BSDF is 0 (nothing to trace).
+  template <class Bsdf>
+  static bool connect(const Surface& light, const glm::vec3& at_light, const glm::vec3& wi, const Bsdf& bsdf,
+                      Connection& c) {
+    c.cos_y = emitter_cosine(light, at_light, c.lit_side);
+    if (c.cos_y <= 0.0f) return false;
+    c.f = bsdf(wi, c.pdf_bounce, c.cos_x);
+    return max_component(c.f) > 0.0f;
+  }
+
   /// x moved off its surface (unit normal `normal`) to the side that direction `w` leaves
   /// from, so that a ray from there does not hit the surface itself.
   glm::vec3 offset_towards(const glm::vec3& x, const glm::vec3& normal, const glm::vec3& w) const {
@@ -480,12 +501,9 @@ class PathTracer {
     const float d2 = glm::dot(w, w);
     if (!(d2 > 0.0f)) return Rgb(0.0f);
     const glm::vec3 wi = w / std::sqrt(d2);
-    glm::vec3 lit_side;
-    const float cos_y = emitter_cosine(light, wi, lit_side);
-    if (cos_y <= 0.0f) return Rgb(0.0f);
-    float pdf_bounce = 0.0f, cos_x = 0.0f;
-    const Rgb f = bsdf(wi, pdf_bounce, cos_x);
-    if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
+    Connection c;
+    if (!connect(light, wi, wi, bsdf, c)) return Rgb(0.0f);
+    const glm::vec3& lit_side = c.lit_side;
 
     // Shadow ray from the side of x that wi leaves from to the lit side of the emitter.
     const glm::vec3 start = offset_towards(x, normal, wi);
@@ -493,8 +511,8 @@ class PathTracer {
     const float dist = glm::length(sw);
     if (rays_.occluded(start, sw / dist, 0.0f, dist)) return Rgb(0.0f);
 
-    const float pdf_light = light.light_pdf_area * d2 / cos_y;
-    return f * light.emission * (kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
+    const float pdf_light = light.light_pdf_area * d2 / c.cos_y;
+    return c.f * light.emission * (kInvPi * c.cos_x / pdf_light * power_heuristic(pdf_light, c.pdf_bounce));
   }
 
   /// Light that reaches x by one reflection in a plain planar mirror, sampled through the
@@ -527,12 +545,9 @@ class PathTracer {
       if (glm::dot(glm::cross(m.vertices[(i + 1) % n] - a, p - a), m.normal) < 0.0f) return Rgb(0.0f);
     }
     const glm::vec3 wr = wi - 2.0f * glm::dot(wi, m.normal) * m.normal;  // from p towards y
-    glm::vec3 lit_side;
-    const float cos_y = emitter_cosine(light, wr, lit_side);
-    if (cos_y <= 0.0f) return Rgb(0.0f);
-    float pdf_bounce = 0.0f, cos_x = 0.0f;
-    const Rgb f = bsdf(wi, pdf_bounce, cos_x);
-    if (!(max_component(f) > 0.0f)) return Rgb(0.0f);
+    Connection c;
+    if (!connect(light, wr, wi, bsdf, c)) return Rgb(0.0f);
+    const glm::vec3& lit_side = c.lit_side;
 
     // Both legs unoccluded: x to just in front of p, and from there to the emitter.
     const glm::vec3 start = offset_towards(x, normal, wi);
@@ -543,9 +558,9 @@ class PathTracer {
     if (rays_.occluded(start, leg1 / l1, 0.0f, l1) || rays_.occluded(at_mirror, leg2 / l2, 0.0f, l2))
       return Rgb(0.0f);
 
-    const float pdf_light = light.light_pdf_area * d2 / cos_y / static_cast<float>(mirrors_.size());
-    return f * m.reflectance * light.emission *
-           (kInvPi * cos_x / pdf_light * power_heuristic(pdf_light, pdf_bounce));
+    const float pdf_light = light.light_pdf_area * d2 / c.cos_y / static_cast<float>(mirrors_.size());
+    return c.f * m.reflectance * light.emission *
+           (kInvPi * c.cos_x / pdf_light * power_heuristic(pdf_light, c.pdf_bounce));
   }
 
   const PathTraceOptions& options_;
