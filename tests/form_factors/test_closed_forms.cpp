@@ -163,7 +163,7 @@ std::vector<Poly> box(double sx, double sy, double sz) {
 
 }  // namespace
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE(
       "parallel rectangles (Howell C-11) at several sizes and distances - rotated: ray_cast and analytic within 0.5% - "
       "hemicube within 2%") {

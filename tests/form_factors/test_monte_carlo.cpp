@@ -48,7 +48,7 @@ rad::MeshOptions mesh(float patch, float element) {
 
 }  // namespace
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE("monte_carlo: unit cube faces within four standard errors of 0.1998249 and 0.2000438 and rows sum to 1") {
     const rad::Scene s = test::closed_box(rad::Material{});
     rad::ViewFactorOptions o;
@@ -179,7 +179,7 @@ TEST_SUITE("formfactor") {
   }
 }
 
-TEST_SUITE("solve") {
+TEST_SUITE("form_factors") {
   TEST_CASE("monte_carlo furnace: B = E/(1-rho) within 0.1% for the matrix methods and on average for progressive") {
     rad::Material m;
     m.emission = rad::Rgb(1.0f, 2.0f, 0.5f);
@@ -285,7 +285,7 @@ rad::Scene mirror_room(float mirror) {
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("form_factors") {
   TEST_CASE("mirror form factors: a tile above a mirror floor gets rho r F(tile -> mirrored light) E plus its own image") {
     // The reference: the factor to the light's mirror image, by the analytic estimator.
     rad::Scene image;
@@ -339,7 +339,7 @@ TEST_SUITE("solve") {
   }
 }
 
-TEST_SUITE("solve") {
+TEST_SUITE("form_factors") {
   TEST_CASE("window form factors: light through a clear pane of transmittance T reaches a tile T times as strongly") {
     // Howell C-11 for the tile and the light (1 x 1, 2 apart), a 4 x 4 window halfway between.
     const double F = test::parallel_rectangles(1, 1, 2);
@@ -379,7 +379,7 @@ TEST_SUITE("solve") {
   }
 }
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE("many emitting patches: exact factors for the strongest few - the rest by rays - within noise") {
     // A closed unit box whose every face is 4 x 4 emitting facets (96 emitting patches, more
     // than exact_emitters = 16): a furnace, B = E / (1 - rho) everywhere, whichever emitters a

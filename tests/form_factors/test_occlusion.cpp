@@ -70,7 +70,7 @@ std::vector<Config> configs() {
 
 }  // namespace
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE(
       "occluded pairs match an independent Monte Carlo reference: ray_cast within 1% - hemicube within 2% - also "
       "rotated") {

@@ -26,7 +26,7 @@ double polygon_factor(const rad::Scene& scene, rad::FormFactorOptions o, std::ui
 
 }  // namespace
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE("point-to-polygon factor of a differential area under a unit square matches the closed form") {
     // Howell B-1 style: dA at distance c below the corner of an a x b rectangle, parallel.
     const double a = 1.0, b = 2.0, c = 0.5;

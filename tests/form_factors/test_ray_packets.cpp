@@ -12,7 +12,7 @@
 
 namespace rad = radiosity;
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE("batched occlusion rays answer exactly as single rays - including a partial last packet") {
     const rad::Scene scene = rad::cornell_box();
     const rad::detail::RayScene rays = rad::detail::RayScene::from_polygons(scene);

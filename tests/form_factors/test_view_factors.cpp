@@ -45,7 +45,7 @@ rad::MeshOptions coarse() {
 
 }  // namespace
 
-TEST_SUITE("formfactor") {
+TEST_SUITE("form_factors") {
   TEST_CASE(
       "view_factors names the groups - sums element areas - and is bit-identical at 1 and 2 threads for every "
       "estimator") {

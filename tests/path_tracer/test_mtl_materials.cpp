@@ -112,7 +112,7 @@ void check_within_noise(const std::string& mode, const std::string& tall, const 
 
 }  // namespace
 
-TEST_SUITE("path") {
+TEST_SUITE("path_tracer") {
   TEST_CASE("the standard exported glass (illum 7 - Ks 1 - Tf 1 - Ni 1.5) renders as the shipped glass Cornell box reference") {
     const rad::Scene scene = rad::load_scene(
         write_box("mtl_standard_glass", "Kd 0.725 0.71 0.68", "Kd 0 0 0\nKs 1 1 1\nTf 1 1 1\nNi 1.5\nNs 96\nillum 7"));

@@ -148,7 +148,7 @@ void check_error_names(const rad::PathTraceOptions& o, const std::string& field)
 
 }  // namespace
 
-TEST_SUITE("path") {
+TEST_SUITE("path_tracer") {
   TEST_CASE("inside a furnace every pixel converges to E/((1-rho) pi) - per channel") {
     // A closed box whose faces all emit E and reflect rho: L = E/pi sum_k rho^k = E/((1-rho) pi).
     // Every face is an emitter, so this exercises next-event estimation, the MIS-weighted emitter
@@ -425,7 +425,7 @@ TEST_SUITE("path") {
 
   TEST_CASE("regenerate the Cornell box reference" * doctest::skip()) {
     // Not run by default (about 5 minutes on 2 cores). Run it with
-    //   radiosity_tests -ts=path -tc="regenerate*" --no-skip
+    //   radiosity_tests -ts=path_tracer -tc="regenerate*" --no-skip
     rad::PathTraceOptions o;
     o.width = 64;
     o.height = 64;

@@ -162,7 +162,7 @@ rad::Image quad_in_uniform_field(const rad::Material& material, bool from_front,
 
 }  // namespace
 
-TEST_SUITE("path") {
+TEST_SUITE("path_tracer") {
   TEST_CASE("a camera facing an ideal mirror of reflectance r in front of an emitter sees r E/pi exactly") {
     // Mirror at z = 1 facing the camera at the origin; a black emitter at z = -1 facing +z fills
     // the mirror image. The path is camera -> mirror (delta) -> emitter, counted in full: no
@@ -461,7 +461,7 @@ TEST_SUITE("path") {
 
   TEST_CASE("regenerate the mirror and glass Cornell box references" * doctest::skip()) {
     // Not run by default (about 4 and 6 minutes on 2 shared cores). Run it with
-    //   radiosity_tests -ts=path -tc="regenerate the mirror*" --no-skip
+    //   radiosity_tests -ts=path_tracer -tc="regenerate the mirror*" --no-skip
     // or, equivalently, radiosity render cornell-mirror --method path --width 64 --height 64
     //   --spp 32400 --seed 1 -o cornell_mirror_path_64.exr (and cornell-glass).
     rad::PathTraceOptions o;

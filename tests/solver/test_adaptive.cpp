@@ -25,7 +25,7 @@ float distance_to_outline(glm::vec2 p, const std::vector<glm::vec2>& outline) {
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("adaptive subdivision refines the floor along the blocks' shadow edges - not in flat regions") {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;

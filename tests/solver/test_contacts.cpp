@@ -43,7 +43,7 @@ rad::Scene props_on_floor() {
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("a box resting on the floor and a sphere sunk into it are lit as the path tracer lights them") {
     const rad::Scene scene = props_on_floor();
     // The geometry really touches: the box's bottom lies on the floor, the ball crosses it.

@@ -37,7 +37,7 @@ std::vector<double> lu_solve(std::vector<double> A, std::vector<double> b, std::
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("every method agrees with a dense LU solve of the same discrete system within 0.1%") {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;

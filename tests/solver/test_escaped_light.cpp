@@ -52,7 +52,7 @@ rad::Scene floor_and_light(bool light_faces_down) {
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("escaped power: a closed room with an inward light loses nothing and gets no warning") {
     rad::Material white;
     white.reflectance = rad::Rgb(0.6f);

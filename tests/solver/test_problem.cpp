@@ -69,7 +69,7 @@ double max_relative_difference(const std::vector<rad::Rgb>& a, const std::vector
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("Problem: its first solve is solve()'s, bit for bit, for every solver method") {
     const rad::Scene scene = rad::cornell_box();
     for (rad::SolverMethod method :

@@ -30,7 +30,7 @@ rad::SolveOptions coarse(rad::SolverMethod method) {
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("furnace: a closed box with uniform E and rho gives B = E/(1-rho) within 0.1% for every method") {
     const rad::Material m = furnace_material();
     const rad::Scene scene = test::closed_box(m);

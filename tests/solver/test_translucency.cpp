@@ -114,7 +114,7 @@ rad::SolveOptions box_options(rad::SolverMethod method) {
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("translucent panel: lamp light reaches the tile through it as tau E F and every solver agrees") {
     // F between parallel unit squares at distance 1 (Howell C-11) is every factor involved:
     // panel back -> lamp, panel front -> tile and back. With the lamp's E, the panel's rho and

@@ -57,7 +57,7 @@ double relative(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
 
 }  // namespace
 
-TEST_SUITE("solve") {
+TEST_SUITE("solver") {
   TEST_CASE("a two-sided panel lit from both sides has the closed-form radiosity on each side") {
     // Unit squares on the z axis: lamp A at z = 2 facing down, the panel at z = 1 facing up
     // (front towards A), lamp B at z = 0 facing up. Each side sees one lamp with Howell's C-11
