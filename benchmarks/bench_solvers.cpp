@@ -7,6 +7,7 @@
 //        bench_solvers --compare PATCHES   (accuracy of monte_carlo against ray_cast on one mesh)
 //        bench_solvers --defaults [PATCHES] (default SolveOptions, only the mesh set; default 4000:
 //          the estimator automatic chose and its time, against ray_cast's in the same run)
+//        bench_solvers --relight [PATCHES] (a kept Problem: first solve against a relit one)
 // Prints one line per configuration: patches, elements, method, seconds (form factors, solve),
 // iterations, residual reached, peak RSS.
 #include <sys/resource.h>
@@ -161,6 +162,50 @@ void defaults(std::size_t target_patches) {
               automatic / ray_cast);
 }
 
+/// A kept Problem solved again for other emission (relighting): each method's first solve
+/// (form factors and sweeps) against a relit solve of the same Problem, which reuses the factors
+/// (matrix rows, progressive's columns), in one run. The relit emission halves the light and
+/// makes the tall block's faces glow, so the solve is a new one, not a repeat.
+void relight(std::size_t target_patches) {
+  const radiosity::Scene scene = radiosity::cornell_box();
+  std::vector<radiosity::Rgb> emission(scene.polygons().size(), radiosity::Rgb(0.0f));
+  std::size_t glowing = 0;
+  for (std::size_t p = 0; p < scene.polygons().size(); ++p) {
+    const radiosity::Polygon& polygon = scene.polygons()[p];
+    emission[p] = 0.5f * scene.material(polygon.material).emission;
+    if (scene.groups()[polygon.group] == "tall_block") {
+      emission[p] = radiosity::Rgb(2.0f, 4.0f, 8.0f);
+      ++glowing;
+    }
+  }
+  std::printf("bench_solvers --relight: Cornell box at about %zu patches, monte_carlo, 2 threads; relit: the "
+              "light at half and %zu faces of the tall block emitting\n",
+              target_patches, glowing);
+  for (radiosity::SolverMethod method : {radiosity::SolverMethod::gauss_seidel, radiosity::SolverMethod::progressive}) {
+    radiosity::SolveOptions opt;
+    opt.method = method;
+    opt.threads = 2;
+    opt.form_factors.method = radiosity::FormFactorMethod::monte_carlo;
+    opt.mesh.max_patch_area = static_cast<float>(scene.total_area() / static_cast<double>(target_patches));
+    opt.mesh.max_element_area = opt.mesh.max_patch_area;
+    radiosity::Problem problem(scene, opt);
+    auto timed = [&](const std::vector<radiosity::Rgb>* e) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const radiosity::Solution sol = e ? problem.solve(*e) : problem.solve();
+      return std::pair<double, int>(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                                    sol.report().iterations);
+    };
+    const auto first = timed(nullptr);
+    const auto relit = timed(&emission);
+    std::printf("  %-13s %6zu patches  first solve %6.2f s (%d iterations), relit %6.3f s (%d iterations): "
+                "relit / first %.3f, factors kept %.1f MiB\n",
+                method == radiosity::SolverMethod::progressive ? "progressive" : "gauss-seidel",
+                problem.hierarchy().patches().size(), first.first, first.second, relit.first, relit.second,
+                relit.first / first.first, problem.form_factor_bytes() / (1024.0 * 1024.0));
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 /// A positive integer argument, or 0 when `text` is not one.
@@ -175,7 +220,8 @@ int usage(const char* bad) {
   std::fprintf(stderr,
                "usage: bench_solvers [--ray-cast] [--rays N] [--only jacobi|gauss-seidel|progressive] [PATCHES...]\n"
                "       bench_solvers --compare PATCHES\n"
-               "       bench_solvers --defaults [PATCHES]\n");
+               "       bench_solvers --defaults [PATCHES]\n"
+               "       bench_solvers --relight [PATCHES]\n");
   return bad ? 2 : 0;
 }
 
@@ -198,6 +244,15 @@ int main(int argc, char** argv) {
       else
         n = 4000;
       defaults(n);
+      return 0;
+    }
+    if (arg == "--relight") {
+      std::size_t n = 4000;
+      if (has_value && (n = count_arg(argv[i + 1])) != 0)
+        ++i;
+      else
+        n = 4000;
+      relight(n);
       return 0;
     }
     if (arg == "--only" && has_value) {
