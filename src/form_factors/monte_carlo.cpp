@@ -47,6 +47,7 @@
 #include "radiosity/brdf.hpp"
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
+#include "form_factors/visibility.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "form_factors/pass1_material.hpp"
@@ -403,10 +404,18 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     });
   }
 
-  /// Kernel-weighted fraction of shadow rays from element e (from its back side when `back`) to
-  /// light polygon `light` that are clear: 1 without rays when a shaft test shows nothing can
-  /// come between. 64 rays, and 256 more in a penumbra (some blocked, some clear). Its own
-  /// random stream per pair, so the value does not depend on the caller.
+  /// The visible fraction of light polygon `light` from element e (from its back side when
+  /// `back`), by the shared shadow-ray estimator (visibility.hpp): 1 without rays when a shaft
+  /// test shows nothing can come between. Its own random stream per pair, so the value does not
+  /// depend on the caller.
+  ///
+  /// The budget differs from ray_cast's, which sizes its passes by the pair's unoccluded factor:
+  /// this visibility multiplies the exact factors of all the polygon's patches (and is kept for
+  /// later columns), so no one factor sizes it. 64 rays settle unshadowed and fully shadowed
+  /// pairs, 256 more resolve a penumbra. The rays pair shuffled point strata one to one and are
+  /// weighted by their kernel (one kernel-weighted ratio over all rays), as this estimator has
+  /// always done: ray_cast's grid with exact point-factor weights would have lower variance near
+  /// shared edges, but would change every result.
   double visibility(std::uint32_t e, std::uint32_t light, bool back = false) const {
     const Light& L = lights_[light];
     const Element& el = hierarchy_.element(e);
@@ -415,39 +424,18 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     std::array<glm::vec3, 4> corners{};
     for (int k = 0; k < el.corner_count(); ++k)
       corners[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
-    if (L.vertices.size() <= 4) {
-      Shaft shaft;
-      if (!shaft.build(corners.data(), el.corner_count(), normal, L.vertices.data(),
-                       static_cast<int>(L.vertices.size()), L.normal, epsilon_) ||
-          !occluders_.any(shaft, patch.polygon, L.polygon))
-        return 1.0;
-    }
+    // Shafts take receivers of up to 4 corners; larger lights always cast rays.
+    if (L.vertices.size() <= 4 &&
+        !occluders_.may_block(corners.data(), el.corner_count(), normal, L.vertices.data(),
+                              static_cast<int>(L.vertices.size()), L.normal, epsilon_, patch.polygon, L.polygon))
+      return 1.0;
+    static constexpr ShadowBudget kBudget{{64, 1}, {256, 1}, ShadowPairing::shuffled};
     const CellSampler sampler(corners.data(), el.corner_count());
+    auto light_point = [&L](glm::vec2 uv) { return L.fan.sample(uv); };
+    auto ray_kernel = [](const glm::vec3&, double kernel) { return kernel; };
     Rng rng(options_.seed, e, stream_key(back ? Stream::monte_carlo_back_light : Stream::monte_carlo_light, light));
-    std::array<glm::vec2, 256> from, to;
-    double weight = 0.0, clear_weight = 0.0;
-    std::uint32_t clear = 0, blocked = 0;
-    auto pass = [&](std::uint32_t count) {
-      stratified(count, rng, true, from.data());
-      stratified(count, rng, true, to.data());
-      for (std::uint32_t i = count; i > 1; --i) std::swap(to[i - 1], to[rng.next() % i]);
-      for (std::uint32_t r = 0; r < count; ++r) {
-        const glm::vec3 x = sampler(from[r]) + epsilon_ * normal;
-        const glm::vec3 d = (L.fan.sample(to[r]) + epsilon_ * L.normal) - x;
-        const float r2 = glm::dot(d, d);
-        if (!(r2 > 0.0f)) continue;
-        const float w = std::max(0.0f, glm::dot(d, normal)) * std::max(0.0f, -glm::dot(d, L.normal)) / (r2 * r2);
-        const bool visible = !shadow_rays_->occluded(x, d, 0.0f, 1.0f - 1e-4f);
-        (visible ? clear : blocked) += 1;
-        weight += w;
-        clear_weight += visible ? w : 0.0f;
-      }
-    };
-    pass(64);
-    if (clear > 0 && blocked > 0) pass(256);
-    if (blocked == 0) return 1.0;
-    if (clear == 0) return 0.0;
-    return weight > 0.0 ? clear_weight / weight : static_cast<double>(clear) / (clear + blocked);
+    return visible_fraction(sampler, normal, light_point, L.normal, epsilon_, kBudget, rng, *shadow_rays_, ray_kernel)
+        .value;
   }
 
   /// Element id -> position in `elements` (kNone elsewhere), so hits on leaves map to indices.
