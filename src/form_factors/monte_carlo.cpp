@@ -94,19 +94,13 @@ class HitCounter {
   std::vector<std::uint32_t> touched_;
 };
 
-FormFactorOptions serial(FormFactorOptions o) {
-  o.threads = 1;
-  return o;
-}
-
 class MonteCarloEstimator final : public FormFactorEstimator {
  public:
   MonteCarloEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options)
       : FormFactorEstimator(hierarchy.patches().size()),
         hierarchy_(hierarchy),
         options_(options),
-        analytic_(make_analytic_estimator(scene, hierarchy, options)),
-        analytic_serial_(make_analytic_estimator(scene, hierarchy, serial(options))) {
+        analytic_(make_analytic_estimator(scene, hierarchy, options)) {
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
     const auto& polygons = scene.polygons();
@@ -257,8 +251,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
     const std::uint32_t N = options_.hemisphere_rays;
     const float per_ray = 1.0f / static_cast<float>(N);
-    // One parallel loop does everything for a run of elements; the analytic estimator used
-    // inside is single-threaded, so no nested parallel region is opened per emitting patch.
+    // One parallel loop does everything for a run of elements. The analytic estimator's loops
+    // inside it are nested: they run isolated in this loop's threads (core/parallel.hpp), and a
+    // run's few elements make them one chunk each.
     const bool limited = options_.exact_emitters > 0 && emitters_.size() > options_.exact_emitters;
     parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
       HitCounter counter(target_count());
@@ -274,9 +269,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         // Every emitting patch exact: unoccluded factors, column by column over the run...
         for (std::uint32_t j : emitters_) {
           if (back)
-            back_patch_column(*analytic_serial_, j, run, column.data());
+            back_patch_column(*analytic_, j, run, column.data());
           else
-            analytic_serial_->patch_column(j, run, column.data());
+            analytic_->patch_column(j, run, column.data());
           for (std::size_t k = 0; k < run.size(); ++k)
             if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
         }
@@ -311,9 +306,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
             by_rays[j] = 0;
             float f = 0.0f;
             if (back)
-              back_patch_column(*analytic_serial_, j, one, &f);
+              back_patch_column(*analytic_, j, one, &f);
             else
-              analytic_serial_->patch_column(j, one, &f);
+              analytic_->patch_column(j, one, &f);
             if (f > 0.0f) own.emplace_back(j, f);
           }
           std::sort(own.begin(), own.end());
@@ -389,19 +384,35 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   /// Multiplies each factor column[k] > 0 of elements[k] by the element's visible fraction of
   /// light polygon `light` (from its back when `back`), kept per element for later columns.
+  /// The lock guards the cache only: the missing fractions are computed in parallel without it
+  /// and published after. Each is a function of its (element, light) stream alone, so a value
+  /// computed twice by concurrent calls is the same, and no result depends on the order of the
+  /// calls or the thread count.
   void times_visibility(std::uint32_t light, bool back, const std::vector<std::uint32_t>& elements,
                         float* column) const {
-    std::lock_guard<std::mutex> lock(visible_mutex_);
-    std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
-    if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k) {
+    std::vector<float> v(elements.size(), -1.0f);
+    std::vector<std::uint32_t> missing;  // positions k whose fraction is not cached yet
+    {
+      std::lock_guard<std::mutex> lock(visible_mutex_);
+      std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
+      if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
+      for (std::size_t k = 0; k < elements.size(); ++k) {
         if (!(column[k] > 0.0f)) continue;
-        float& v = cache[elements[k]];
-        if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light, back));
-        column[k] *= v;
+        v[k] = cache[elements[k]];
+        if (v[k] < 0.0f) missing.push_back(static_cast<std::uint32_t>(k));
       }
+    }
+    parallel_for(options_.threads, missing.size(), 64, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        v[missing[i]] = static_cast<float>(visibility(elements[missing[i]], light, back));
     });
+    if (!missing.empty()) {
+      std::lock_guard<std::mutex> lock(visible_mutex_);
+      std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
+      for (std::uint32_t k : missing) cache[elements[k]] = v[k];
+    }
+    for (std::size_t k = 0; k < elements.size(); ++k)
+      if (column[k] > 0.0f) column[k] *= v[k];
   }
 
   /// The visible fraction of light polygon `light` from element e (from its back side when
@@ -626,20 +637,27 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   }
 
   /// The Embree scene of the current leaves (element ids), rebuilt after the hierarchy was
-  /// refined: a column must land on the leaves that exist now.
+  /// refined: a column must land on the leaves that exist now. Built without the lock (Embree
+  /// builds in parallel); concurrent first calls may each build the same scene, and one is kept.
   std::shared_ptr<const LeafRays> leaf_scene() const {
+    const std::size_t leaves = hierarchy_.leaves().size();
+    {
+      std::lock_guard<std::mutex> lock(leaf_mutex_);
+      if (leaf_rays_ && leaf_count_ == leaves) return leaf_rays_;
+    }
+    RayScene scene = RayScene::from_leaves(hierarchy_);
+    std::vector<std::uint32_t> patch, polygon, back;
+    for (std::uint32_t e : scene.triangle_ids()) {
+      patch.push_back(hierarchy_.element(e).patch);
+      polygon.push_back(hierarchy_.patches()[patch.back()].polygon);
+      back.push_back(back_target_[patch.back()]);
+    }
+    auto built = std::make_shared<const LeafRays>(
+        LeafRays{std::move(scene), std::move(patch), std::move(polygon), std::move(back)});
     std::lock_guard<std::mutex> lock(leaf_mutex_);
-    if (!leaf_rays_ || leaf_count_ != hierarchy_.leaves().size()) {
-      RayScene scene = RayScene::from_leaves(hierarchy_);
-      std::vector<std::uint32_t> patch, polygon, back;
-      for (std::uint32_t e : scene.triangle_ids()) {
-        patch.push_back(hierarchy_.element(e).patch);
-        polygon.push_back(hierarchy_.patches()[patch.back()].polygon);
-        back.push_back(back_target_[patch.back()]);
-      }
-      leaf_rays_ = std::make_shared<const LeafRays>(
-          LeafRays{std::move(scene), std::move(patch), std::move(polygon), std::move(back)});
-      leaf_count_ = hierarchy_.leaves().size();
+    if (!leaf_rays_ || leaf_count_ != leaves) {
+      leaf_rays_ = std::move(built);
+      leaf_count_ = leaves;
     }
     return leaf_rays_;
   }
@@ -647,7 +665,6 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   const PatchHierarchy& hierarchy_;
   FormFactorOptions options_;
   std::unique_ptr<FormFactorEstimator> analytic_;  ///< unoccluded factors to emitting patches
-  std::unique_ptr<FormFactorEstimator> analytic_serial_;  ///< the same on the calling thread only
   /// Per polygon, for extended form factors: mean reflectance of an ideal mirror, mean
   /// transmittance of a window (0 = neither).
   struct SpecularSurface {
