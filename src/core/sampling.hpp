@@ -16,6 +16,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/assert.hpp"
 #include "core/constants.hpp"
 
 namespace radiosity::detail {
@@ -79,6 +80,7 @@ class CellSampler {
   CellSampler() = default;
   /// `count` is 3 or 4.
   CellSampler(const glm::vec3* corners, int count) : count_(count) {
+    RADIOSITY_ASSERT(count == 3 || count == 4);
     for (int k = 0; k < count; ++k) c_[k] = corners[k];
     if (count == 4) {
       const glm::vec3 n = glm::cross(c_[1] - c_[0], c_[2] - c_[0]) + glm::cross(c_[2] - c_[0], c_[3] - c_[0]);

@@ -62,14 +62,23 @@ struct RayCastCounters {
 /// Fills `out` and returns true when `estimator` is a ray-cast or analytic estimator.
 bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& out);
 
-/// patch_column() of a ray-cast or analytic estimator from the backs of the elements (each a
-/// Lambertian surface facing -normal): F(back of e -> patch) for diffuse transmission.
-void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch,
-                       const std::vector<std::uint32_t>& elements, float* out);
+/// A form-factor estimator that also gives columns from the elements' backs: the ray-cast and
+/// analytic estimators, whose backward factors the Monte Carlo estimator uses (a type, so that
+/// asking another estimator for them cannot compile).
+/// Thread safety: as FormFactorEstimator, const members may be called concurrently.
+class BackColumnEstimator : public FormFactorEstimator {
+ public:
+  /// patch_column() from the backs of the elements, each a Lambertian surface facing -normal:
+  /// F(back of e -> patch) for diffuse transmission.
+  virtual void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const = 0;
+
+ protected:
+  using FormFactorEstimator::FormFactorEstimator;
+};
 
 /// The unoccluded estimator: the ray-cast estimator's exact point-to-polygon factor integrated
 /// over the element by adaptive Gauss quadrature, without visibility.
-std::unique_ptr<FormFactorEstimator> make_analytic_estimator(const Scene&, const PatchHierarchy&,
+std::unique_ptr<BackColumnEstimator> make_analytic_estimator(const Scene&, const PatchHierarchy&,
                                                              const FormFactorOptions&);
 
 }  // namespace radiosity::detail

@@ -269,7 +269,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         // Every emitting patch exact: unoccluded factors, column by column over the run...
         for (std::uint32_t j : emitters_) {
           if (back)
-            back_patch_column(*analytic_, j, run, column.data());
+            analytic_->back_column(j, run, column.data());
           else
             analytic_->patch_column(j, run, column.data());
           for (std::size_t k = 0; k < run.size(); ++k)
@@ -306,7 +306,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
             by_rays[j] = 0;
             float f = 0.0f;
             if (back)
-              back_patch_column(*analytic_, j, one, &f);
+              analytic_->back_column(j, one, &f);
             else
               analytic_->patch_column(j, one, &f);
             if (f > 0.0f) own.emplace_back(j, f);
@@ -358,7 +358,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
           where.push_back(static_cast<std::uint32_t>(k));
         }
       std::vector<float> column(translucent.size());
-      back_patch_column(*analytic_, patch, translucent, column.data());
+      analytic_->back_column(patch, translucent, column.data());
       times_visibility(light, true, translucent, column.data());
       back.assign(elements.size(), 0.0f);
       for (std::size_t k = 0; k < translucent.size(); ++k) back[where[k]] = column[k];
@@ -664,7 +664,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   const PatchHierarchy& hierarchy_;
   FormFactorOptions options_;
-  std::unique_ptr<FormFactorEstimator> analytic_;  ///< unoccluded factors to emitting patches
+  std::unique_ptr<BackColumnEstimator> analytic_;  ///< unoccluded factors to emitting patches
   /// Per polygon, for extended form factors: mean reflectance of an ideal mirror, mean
   /// transmittance of a window (0 = neither).
   struct SpecularSurface {

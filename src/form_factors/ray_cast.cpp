@@ -69,11 +69,11 @@ namespace {
 // Gauss-Legendre 2x2 nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).
 constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.28867513459481287f;
 
-class SampledEstimator final : public FormFactorEstimator {
+class SampledEstimator final : public BackColumnEstimator {
  public:
   SampledEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options,
                    bool with_visibility)
-      : FormFactorEstimator(hierarchy.patches().size()),
+      : BackColumnEstimator(hierarchy.patches().size()),
         hierarchy_(hierarchy),
         options_(options),
         visibility_(with_visibility) {
@@ -139,9 +139,7 @@ class SampledEstimator final : public FormFactorEstimator {
     });
   }
 
-  /// patch_column() for the backs of the elements: each treated as a Lambertian surface facing
-  /// -normal (diffuse transmission's backward form factors).
-  void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
+  void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
     parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
       Source source;
       RayCastCounters counts;
@@ -467,19 +465,12 @@ bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& ou
   return true;
 }
 
-void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch, const std::vector<std::uint32_t>& elements,
-                       float* out) {
-  const auto* e = dynamic_cast<const SampledEstimator*>(&estimator);
-  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not a ray-cast or analytic estimator");
-  e->back_column(patch, elements, out);
-}
-
 std::unique_ptr<FormFactorEstimator> make_ray_cast_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                              const FormFactorOptions& options) {
   return std::make_unique<SampledEstimator>(scene, hierarchy, options, true);
 }
 
-std::unique_ptr<FormFactorEstimator> make_analytic_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
+std::unique_ptr<BackColumnEstimator> make_analytic_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                              const FormFactorOptions& options) {
   return std::make_unique<SampledEstimator>(scene, hierarchy, options, false);
 }
