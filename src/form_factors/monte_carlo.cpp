@@ -252,8 +252,8 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::uint32_t N = options_.hemisphere_rays;
     const float per_ray = 1.0f / static_cast<float>(N);
     // One parallel loop does everything for a run of elements. The analytic estimator's loops
-    // inside it are nested: they run isolated in this loop's threads (core/parallel.hpp), and a
-    // run's few elements make them one chunk each.
+    // inside it are nested parallel_for calls, which core/parallel.hpp runs isolated (a waiting
+    // thread takes no outer task), and a run's few elements make each of them one chunk.
     const bool limited = options_.exact_emitters > 0 && emitters_.size() > options_.exact_emitters;
     parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
       HitCounter counter(target_count());
