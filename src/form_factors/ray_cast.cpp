@@ -73,7 +73,7 @@ class SampledEstimator final : public BackColumnEstimator {
  public:
   SampledEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options,
                    bool with_visibility)
-      : BackColumnEstimator(hierarchy.patches().size()),
+      : BackColumnEstimator(hierarchy),
         hierarchy_(hierarchy),
         options_(options),
         visibility_(with_visibility) {
@@ -151,45 +151,6 @@ class SampledEstimator final : public BackColumnEstimator {
     });
   }
 
-  // With diffuse transmission, rows run over every target (backs after the patches).
-  void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    if (translucent_patches().empty()) {
-      FormFactorEstimator::sparse_element_rows(elements, out);
-      return;
-    }
-    target_rows(elements, false, out);
-  }
-
-  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    check_back_rows(*this, hierarchy_, elements);
-    target_rows(elements, true, out);
-  }
-
-  void sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
-                           SparseFactors& out) const override {
-    if (translucent_patches().empty()) {
-      FormFactorEstimator::sparse_patch_column(target, elements, out);
-      return;
-    }
-    check_target(*this, target);
-    // Fronts of all elements, then the backs of the translucent ones (index m + k).
-    const std::size_t m = elements.size();
-    std::vector<float> column(2 * m, 0.0f);
-    parallel_for(options_.threads, m, 64, [&](std::size_t begin, std::size_t end) {
-      Source source;
-      RayCastCounters counts;
-      for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source);
-        column[k] = static_cast<float>(factor(source, target, counts));
-        if (back_target_[source.patch] == kNone) continue;
-        prepare(elements[k], source, true);
-        column[m + k] = static_cast<float>(factor(source, target, counts));
-      }
-      add(counts);
-    });
-    compress(column.data(), column.size(), out);
-  }
-
   RayCastCounters counters() const {
     RayCastCounters c;
     c.factors = factors_.load(std::memory_order_relaxed);
@@ -199,8 +160,9 @@ class SampledEstimator final : public BackColumnEstimator {
   }
 
  private:
-  // The rows of the elements' fronts (or backs) over every target, non-zero entries only.
-  void target_rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
+  // With diffuse transmission, rows and columns run over every target (backs after the patches).
+  void target_rows(const std::vector<std::uint32_t>& elements, bool back,
+                   std::vector<SparseFactors>& out) const override {
     out.assign(elements.size(), SparseFactors{});
     const auto targets = static_cast<std::uint32_t>(target_count());
     parallel_for(options_.threads, elements.size(), 4, [&](std::size_t begin, std::size_t end) {
@@ -215,6 +177,22 @@ class SampledEstimator final : public BackColumnEstimator {
             out[k].value.push_back(f);
           }
         }
+      }
+      add(counts);
+    });
+  }
+
+  void target_column(std::uint32_t target, const std::vector<std::uint32_t>& elements, float* column) const override {
+    const std::size_t m = elements.size();
+    parallel_for(options_.threads, m, 64, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source);
+        column[k] = static_cast<float>(factor(source, target, counts));
+        if (back_target_[source.patch] == kNone) continue;
+        prepare(elements[k], source, true);
+        column[m + k] = static_cast<float>(factor(source, target, counts));
       }
       add(counts);
     });
