@@ -128,27 +128,11 @@ class SampledEstimator final : public BackColumnEstimator {
   }
 
   void patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      Source source;
-      RayCastCounters counts;
-      for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source);
-        out[k] = static_cast<float>(factor(source, patch, counts));
-      }
-      add(counts);
-    });
+    column(patch, elements, false, out);
   }
 
   void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      Source source;
-      RayCastCounters counts;
-      for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source, true);
-        out[k] = static_cast<float>(factor(source, patch, counts));
-      }
-      add(counts);
-    });
+    column(patch, elements, true, out);
   }
 
   RayCastCounters counters() const {
@@ -177,6 +161,19 @@ class SampledEstimator final : public BackColumnEstimator {
             out[k].value.push_back(f);
           }
         }
+      }
+      add(counts);
+    });
+  }
+
+  // F(e -> target) for the elements' fronts, or their backs when `back`.
+  void column(std::uint32_t target, const std::vector<std::uint32_t>& elements, bool back, float* out) const {
+    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source, back);
+        out[k] = static_cast<float>(factor(source, target, counts));
       }
       add(counts);
     });
