@@ -3,15 +3,20 @@
 // Based on: P. Shirley, K. Chiu, "A low distortion map between disk and square", Journal of
 // Graphics Tools 2(3), 1997 (the concentric map); Malley's method (T. Malley, MSc thesis,
 // University of Utah, 1988): cosine-weighted directions are uniform disk points lifted to the
-// hemisphere.
+// hemisphere; G. Turk, "Generating random points in triangles", Graphics Gems (1990) (the square
+// root warp for triangles); for quads, the bilinear map's Jacobian is linear in (s, t), so
+// warping through the inverse CDFs of its marginal and conditional keeps strata intact (the
+// inversion method of L. Devroye, "Non-Uniform Random Variate Generation", Springer 1986, ch. 2).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/assert.hpp"
 #include "core/constants.hpp"
 
 namespace radiosity::detail {
@@ -53,5 +58,70 @@ inline glm::vec3 cosine_hemisphere_polar(const glm::vec2& u) {
 /// Solid-angle density of both cosine warps at the local direction w: cos(theta) / pi above,
 /// 0 below.
 inline float cosine_hemisphere_pdf(const glm::vec3& w) { return w.z > 0.0f ? w.z * kInvPi : 0.0f; }
+
+/// Area-uniform point of the triangle (c0, c1, c2) by the square-root warp: barycentrics
+/// (1 - sqrt(u.x), sqrt(u.x) (1 - u.y), sqrt(u.x) u.y). Area density CellSampler::pdf().
+inline glm::vec3 uniform_triangle(const glm::vec3& c0, const glm::vec3& c1, const glm::vec3& c2, const glm::vec2& u) {
+  const float su = std::sqrt(u.x);
+  return (1.0f - su) * c0 + (su * (1.0f - u.y)) * c1 + (su * u.y) * c2;
+}
+
+/// Area-uniform points of a cell, a triangle or a planar convex quad (corners counter-clockwise),
+/// from [0,1)^2, with the per-cell constants computed once: the estimators draw millions of
+/// them. Both warps are continuous and monotone, so (u,v) strata map to compact cells of equal
+/// area. Quads use the bilinear map P(s,t) = (1-s)(1-t)c0 + s(1-t)c1 + st c2 + (1-s)t c3, whose
+/// Jacobian J = A + B s + C t is linear for a planar quad: s is the inverse CDF of the marginal
+/// density in s at u.x, t that of the conditional density in t at u.y (unlike picking one of two
+/// triangles, which folds strata onto each other). A parallelogram (B = C = 0 up to rounding)
+/// takes the plain affine map c0 + u.x (c1 - c0) + u.y (c3 - c0), the same map, cheaper.
+/// Thread safety: a value; const members may be called concurrently.
+class CellSampler {
+ public:
+  CellSampler() = default;
+  /// `count` is 3 or 4.
+  CellSampler(const glm::vec3* corners, int count) : count_(count) {
+    RADIOSITY_ASSERT(count == 3 || count == 4);
+    for (int k = 0; k < count; ++k) c_[k] = corners[k];
+    if (count == 4) {
+      const glm::vec3 n = glm::cross(c_[1] - c_[0], c_[2] - c_[0]) + glm::cross(c_[2] - c_[0], c_[3] - c_[0]);
+      const glm::vec3 e0 = c_[1] - c_[0], e3 = c_[3] - c_[0], d = c_[0] - c_[1] + c_[2] - c_[3];
+      A_ = glm::dot(n, glm::cross(e0, e3));
+      B_ = glm::dot(n, glm::cross(e0, d));
+      C_ = glm::dot(n, glm::cross(d, e3));
+      parallelogram_ = std::fabs(B_) <= 1e-6f * std::fabs(A_) && std::fabs(C_) <= 1e-6f * std::fabs(A_);
+    }
+  }
+
+  glm::vec3 operator()(const glm::vec2& u) const {
+    if (count_ == 3) return uniform_triangle(c_[0], c_[1], c_[2], u);
+    if (parallelogram_) return c_[0] + u.x * (c_[1] - c_[0]) + u.y * (c_[3] - c_[0]);
+    const float s = linear(u.x, A_ + 0.5f * C_, A_ + B_ + 0.5f * C_);
+    const float t = linear(u.y, A_ + B_ * s, A_ + B_ * s + C_);
+    return (1.0f - s) * (1.0f - t) * c_[0] + s * (1.0f - t) * c_[1] + s * t * c_[2] + (1.0f - s) * t * c_[3];
+  }
+
+  /// Area density of the points: 1 / area (0 for a degenerate cell).
+  float pdf() const {
+    glm::vec3 n = glm::cross(c_[1] - c_[0], c_[2] - c_[0]);
+    if (count_ == 4) n += glm::cross(c_[2] - c_[0], c_[3] - c_[0]);
+    const float twice_area = glm::length(n);
+    return twice_area > 0.0f ? 2.0f / twice_area : 0.0f;
+  }
+
+ private:
+  // Inverse CDF of the density on [0,1] that is linear from f0 at 0 to f1 at 1 (both > 0), in
+  // the form 2uT / (f0 + sqrt(f0^2 + 2(f1-f0)uT)), T = (f0+f1)/2, which stays exact as f1 -> f0.
+  static float linear(float u, float f0, float f1) {
+    const float total = 0.5f * (f0 + f1);
+    const float disc = std::max(0.0f, f0 * f0 + 2.0f * (f1 - f0) * u * total);
+    const float denom = f0 + std::sqrt(disc);
+    return denom > 0.0f ? std::clamp(2.0f * u * total / denom, 0.0f, 1.0f) : u;
+  }
+
+  glm::vec3 c_[4]{};
+  int count_ = 0;
+  float A_ = 0.0f, B_ = 0.0f, C_ = 0.0f;
+  bool parallelogram_ = false;
+};
 
 }  // namespace radiosity::detail

@@ -60,6 +60,33 @@ void check_target(const FormFactorEstimator& estimator, std::uint32_t target) {
                                                  " targets)");
 }
 
+void TargetEstimator::sparse_element_rows(const std::vector<std::uint32_t>& elements,
+                                          std::vector<SparseFactors>& out) const {
+  if (translucent_patches().empty()) {
+    FormFactorEstimator::sparse_element_rows(elements, out);
+    return;
+  }
+  target_rows(elements, false, out);
+}
+
+void TargetEstimator::sparse_back_rows(const std::vector<std::uint32_t>& elements,
+                                       std::vector<SparseFactors>& out) const {
+  check_back_rows(*this, targets_of_, elements);
+  target_rows(elements, true, out);
+}
+
+void TargetEstimator::sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
+                                          SparseFactors& out) const {
+  if (translucent_patches().empty()) {
+    FormFactorEstimator::sparse_patch_column(target, elements, out);
+    return;
+  }
+  check_target(*this, target);
+  std::vector<float> column(2 * elements.size(), 0.0f);
+  target_column(target, elements, column.data());
+  compress(column.data(), column.size(), out);
+}
+
 void compress(const float* dense, std::size_t count, SparseFactors& out) {
   out.index.clear();
   out.value.clear();

@@ -62,14 +62,50 @@ struct RayCastCounters {
 /// Fills `out` and returns true when `estimator` is a ray-cast or analytic estimator.
 bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& out);
 
-/// patch_column() of a ray-cast or analytic estimator from the backs of the elements (each a
-/// Lambertian surface facing -normal): F(back of e -> patch) for diffuse transmission.
-void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch,
-                       const std::vector<std::uint32_t>& elements, float* out);
+/// An estimator whose sparse rows and columns, once some patches have backs (diffuse
+/// transmission), run over every target and come from its own target_rows() and
+/// target_column(); without backs they are FormFactorEstimator's, from the dense rows and
+/// columns. The ray-cast, analytic and hemicube estimators are.
+/// Thread safety: as FormFactorEstimator, const members may be called concurrently.
+class TargetEstimator : public FormFactorEstimator {
+ public:
+  void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override;
+  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override;
+  void sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
+                           SparseFactors& out) const override;
+
+ protected:
+  explicit TargetEstimator(const PatchHierarchy& hierarchy)
+      : FormFactorEstimator(hierarchy.patches().size()), targets_of_(hierarchy) {}
+  /// The rows of the elements' fronts (backs when `back`) over every target, entries > 0 only.
+  virtual void target_rows(const std::vector<std::uint32_t>& elements, bool back,
+                           std::vector<SparseFactors>& out) const = 0;
+  /// F(. -> target) into `column` (2 elements.size() zeros): the front of elements[k] at k, its
+  /// back at elements.size() + k when its patch has one.
+  virtual void target_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
+                             float* column) const = 0;
+
+ private:
+  const PatchHierarchy& targets_of_;
+};
+
+/// A form-factor estimator that also gives columns from the elements' backs: the ray-cast and
+/// analytic estimators, whose backward factors the Monte Carlo estimator uses (a type, so that
+/// asking another estimator for them cannot compile).
+/// Thread safety: as FormFactorEstimator, const members may be called concurrently.
+class BackColumnEstimator : public TargetEstimator {
+ public:
+  /// patch_column() from the backs of the elements, each a Lambertian surface facing -normal:
+  /// F(back of e -> patch) for diffuse transmission.
+  virtual void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const = 0;
+
+ protected:
+  using TargetEstimator::TargetEstimator;
+};
 
 /// The unoccluded estimator: the ray-cast estimator's exact point-to-polygon factor integrated
 /// over the element by adaptive Gauss quadrature, without visibility.
-std::unique_ptr<FormFactorEstimator> make_analytic_estimator(const Scene&, const PatchHierarchy&,
+std::unique_ptr<BackColumnEstimator> make_analytic_estimator(const Scene&, const PatchHierarchy&,
                                                              const FormFactorOptions&);
 
 }  // namespace radiosity::detail

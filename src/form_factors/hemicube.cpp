@@ -125,10 +125,10 @@ struct Raster {
   Scissor touched{0, 0, 0, 0};      // bounds of the pixels drawn since it was reset
 };
 
-class HemicubeEstimator final : public FormFactorEstimator {
+class HemicubeEstimator final : public TargetEstimator {
  public:
   HemicubeEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options)
-      : FormFactorEstimator(hierarchy.patches().size()), hierarchy_(hierarchy), options_(options) {
+      : TargetEstimator(hierarchy), hierarchy_(hierarchy), options_(options) {
     const float diagonal = std::max(scene.bounds().diagonal(), 1e-6f);
     offset_ = 1e-5f * diagonal;
     near_ = 1e-7f * diagonal;
@@ -190,43 +190,6 @@ class HemicubeEstimator final : public FormFactorEstimator {
     });
   }
 
-  // With diffuse transmission, rows run over every target (backs after the patches).
-  void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    if (translucent_patches().empty()) {
-      FormFactorEstimator::sparse_element_rows(elements, out);
-      return;
-    }
-    sparse_rows(elements, false, out);
-  }
-
-  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    check_back_rows(*this, hierarchy_, elements);
-    sparse_rows(elements, true, out);
-  }
-
-  void sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
-                           SparseFactors& out) const override {
-    if (translucent_patches().empty()) {
-      FormFactorEstimator::sparse_patch_column(target, elements, out);
-      return;
-    }
-    check_target(*this, target);
-    // Fronts of all elements, then the backs of the translucent ones (index m + k).
-    const std::size_t m = elements.size();
-    std::vector<float> column(2 * m, 0.0f);
-    parallel_for(options_.threads, m, 16, [&](std::size_t begin, std::size_t end) {
-      Raster raster;
-      std::vector<std::uint32_t> candidates;
-      std::vector<Projected> projected;
-      for (std::size_t k = begin; k < end; ++k) {
-        column[k] = static_cast<float>(column_entry(elements[k], target, false, raster, candidates, projected));
-        if (back_item_[hierarchy_.element(elements[k]).patch] != kNoItem)
-          column[m + k] = static_cast<float>(column_entry(elements[k], target, true, raster, candidates, projected));
-      }
-    });
-    compress(column.data(), column.size(), out);
-  }
-
   // Only the pixels that patch j covers matter, and only patches inside the pyramid from the
   // eye to j can cover them: those are found by a shaft query, rasterised within j's screen
   // rectangle, so a column costs about (sources x samples x 5 faces) small rasterisations
@@ -271,7 +234,9 @@ class HemicubeEstimator final : public FormFactorEstimator {
     });
   }
 
-  void sparse_rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
+  // With diffuse transmission, rows and columns run over every target (backs after the patches).
+  void target_rows(const std::vector<std::uint32_t>& elements, bool back,
+                   std::vector<SparseFactors>& out) const override {
     out.assign(elements.size(), SparseFactors{});
     rows(elements, back, [&](std::size_t k, const std::vector<double>& row) {
       for (std::size_t t = 0; t < row.size(); ++t)
@@ -279,6 +244,20 @@ class HemicubeEstimator final : public FormFactorEstimator {
           out[k].index.push_back(static_cast<std::uint32_t>(t));
           out[k].value.push_back(static_cast<float>(std::min(row[t], 1.0)));
         }
+    });
+  }
+
+  void target_column(std::uint32_t target, const std::vector<std::uint32_t>& elements, float* column) const override {
+    const std::size_t m = elements.size();
+    parallel_for(options_.threads, m, 16, [&](std::size_t begin, std::size_t end) {
+      Raster raster;
+      std::vector<std::uint32_t> candidates;
+      std::vector<Projected> projected;
+      for (std::size_t k = begin; k < end; ++k) {
+        column[k] = static_cast<float>(column_entry(elements[k], target, false, raster, candidates, projected));
+        if (back_item_[hierarchy_.element(elements[k]).patch] != kNoItem)
+          column[m + k] = static_cast<float>(column_entry(elements[k], target, true, raster, candidates, projected));
+      }
     });
   }
 

@@ -47,6 +47,7 @@
 #include "radiosity/brdf.hpp"
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
+#include "form_factors/visibility.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "form_factors/pass1_material.hpp"
@@ -93,19 +94,13 @@ class HitCounter {
   std::vector<std::uint32_t> touched_;
 };
 
-FormFactorOptions serial(FormFactorOptions o) {
-  o.threads = 1;
-  return o;
-}
-
 class MonteCarloEstimator final : public FormFactorEstimator {
  public:
   MonteCarloEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options)
       : FormFactorEstimator(hierarchy.patches().size()),
         hierarchy_(hierarchy),
         options_(options),
-        analytic_(make_analytic_estimator(scene, hierarchy, options)),
-        analytic_serial_(make_analytic_estimator(scene, hierarchy, serial(options))) {
+        analytic_(make_analytic_estimator(scene, hierarchy, options)) {
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
     const auto& patches = hierarchy.patches();
     const auto& polygons = scene.polygons();
@@ -256,8 +251,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const std::shared_ptr<const LeafRays> rays = leaf_scene();
     const std::uint32_t N = options_.hemisphere_rays;
     const float per_ray = 1.0f / static_cast<float>(N);
-    // One parallel loop does everything for a run of elements; the analytic estimator used
-    // inside is single-threaded, so no nested parallel region is opened per emitting patch.
+    // One parallel loop does everything for a run of elements. The analytic estimator's loops
+    // inside it are nested parallel_for calls, which core/parallel.hpp runs isolated (a waiting
+    // thread takes no outer task), and a run's few elements make each of them one chunk.
     const bool limited = options_.exact_emitters > 0 && emitters_.size() > options_.exact_emitters;
     parallel_for(options_.threads, m, 8, [&](std::size_t begin, std::size_t end) {
       HitCounter counter(target_count());
@@ -273,9 +269,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         // Every emitting patch exact: unoccluded factors, column by column over the run...
         for (std::uint32_t j : emitters_) {
           if (back)
-            back_patch_column(*analytic_serial_, j, run, column.data());
+            analytic_->back_column(j, run, column.data());
           else
-            analytic_serial_->patch_column(j, run, column.data());
+            analytic_->patch_column(j, run, column.data());
           for (std::size_t k = 0; k < run.size(); ++k)
             if (column[k] > 0.0f) exact[k].emplace_back(j, column[k]);
         }
@@ -310,9 +306,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
             by_rays[j] = 0;
             float f = 0.0f;
             if (back)
-              back_patch_column(*analytic_serial_, j, one, &f);
+              analytic_->back_column(j, one, &f);
             else
-              analytic_serial_->patch_column(j, one, &f);
+              analytic_->patch_column(j, one, &f);
             if (f > 0.0f) own.emplace_back(j, f);
           }
           std::sort(own.begin(), own.end());
@@ -362,7 +358,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
           where.push_back(static_cast<std::uint32_t>(k));
         }
       std::vector<float> column(translucent.size());
-      back_patch_column(*analytic_, patch, translucent, column.data());
+      analytic_->back_column(patch, translucent, column.data());
       times_visibility(light, true, translucent, column.data());
       back.assign(elements.size(), 0.0f);
       for (std::size_t k = 0; k < translucent.size(); ++k) back[where[k]] = column[k];
@@ -388,25 +384,49 @@ class MonteCarloEstimator final : public FormFactorEstimator {
 
   /// Multiplies each factor column[k] > 0 of elements[k] by the element's visible fraction of
   /// light polygon `light` (from its back when `back`), kept per element for later columns.
+  /// The lock guards the cache only: the missing fractions are computed in parallel without it
+  /// and published after. Each is a function of its (element, light) stream alone, so a value
+  /// computed twice by concurrent calls is the same, and no result depends on the order of the
+  /// calls or the thread count.
   void times_visibility(std::uint32_t light, bool back, const std::vector<std::uint32_t>& elements,
                         float* column) const {
-    std::lock_guard<std::mutex> lock(visible_mutex_);
-    std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
-    if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k) {
+    std::vector<float> v(elements.size(), -1.0f);
+    std::vector<std::uint32_t> missing;  // positions k whose fraction is not cached yet
+    {
+      std::lock_guard<std::mutex> lock(visible_mutex_);
+      std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
+      if (cache.size() < hierarchy_.elements().size()) cache.resize(hierarchy_.elements().size(), -1.0f);
+      for (std::size_t k = 0; k < elements.size(); ++k) {
         if (!(column[k] > 0.0f)) continue;
-        float& v = cache[elements[k]];
-        if (v < 0.0f) v = static_cast<float>(visibility(elements[k], light, back));
-        column[k] *= v;
+        v[k] = cache[elements[k]];
+        if (v[k] < 0.0f) missing.push_back(static_cast<std::uint32_t>(k));
       }
+    }
+    parallel_for(options_.threads, missing.size(), 64, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        v[missing[i]] = static_cast<float>(visibility(elements[missing[i]], light, back));
     });
+    if (!missing.empty()) {
+      std::lock_guard<std::mutex> lock(visible_mutex_);
+      std::vector<float>& cache = (back ? visible_back_ : visible_)[light];
+      for (std::uint32_t k : missing) cache[elements[k]] = v[k];
+    }
+    for (std::size_t k = 0; k < elements.size(); ++k)
+      if (column[k] > 0.0f) column[k] *= v[k];
   }
 
-  /// Kernel-weighted fraction of shadow rays from element e (from its back side when `back`) to
-  /// light polygon `light` that are clear: 1 without rays when a shaft test shows nothing can
-  /// come between. 64 rays, and 256 more in a penumbra (some blocked, some clear). Its own
-  /// random stream per pair, so the value does not depend on the caller.
+  /// The visible fraction of light polygon `light` from element e (from its back side when
+  /// `back`), by the shared shadow-ray estimator (visibility.hpp): 1 without rays when a shaft
+  /// test shows nothing can come between. Its own random stream per pair, so the value does not
+  /// depend on the caller.
+  ///
+  /// The budget differs from ray_cast's, which sizes its passes by the pair's unoccluded factor:
+  /// this visibility multiplies the exact factors of all the polygon's patches (and is kept for
+  /// later columns), so no one factor sizes it. 64 rays settle unshadowed and fully shadowed
+  /// pairs, 256 more resolve a penumbra. The rays pair shuffled point strata one to one and are
+  /// weighted by their kernel (one kernel-weighted ratio over all rays), as this estimator has
+  /// always done: ray_cast's grid with exact point-factor weights would have lower variance near
+  /// shared edges, but would change every result.
   double visibility(std::uint32_t e, std::uint32_t light, bool back = false) const {
     const Light& L = lights_[light];
     const Element& el = hierarchy_.element(e);
@@ -415,39 +435,18 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     std::array<glm::vec3, 4> corners{};
     for (int k = 0; k < el.corner_count(); ++k)
       corners[static_cast<std::size_t>(k)] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
-    if (L.vertices.size() <= 4) {
-      Shaft shaft;
-      if (!shaft.build(corners.data(), el.corner_count(), normal, L.vertices.data(),
-                       static_cast<int>(L.vertices.size()), L.normal, epsilon_) ||
-          !occluders_.any(shaft, patch.polygon, L.polygon))
-        return 1.0;
-    }
+    // Shafts take receivers of up to 4 corners; larger lights always cast rays.
+    if (L.vertices.size() <= 4 &&
+        !occluders_.may_block(corners.data(), el.corner_count(), normal, L.vertices.data(),
+                              static_cast<int>(L.vertices.size()), L.normal, epsilon_, patch.polygon, L.polygon))
+      return 1.0;
+    static constexpr ShadowBudget kBudget{{64, 1}, {256, 1}, ShadowPairing::shuffled};
     const CellSampler sampler(corners.data(), el.corner_count());
+    auto light_point = [&L](glm::vec2 uv) { return L.fan.sample(uv); };
+    auto ray_kernel = [](const glm::vec3&, double kernel) { return kernel; };
     Rng rng(options_.seed, e, stream_key(back ? Stream::monte_carlo_back_light : Stream::monte_carlo_light, light));
-    std::array<glm::vec2, 256> from, to;
-    double weight = 0.0, clear_weight = 0.0;
-    std::uint32_t clear = 0, blocked = 0;
-    auto pass = [&](std::uint32_t count) {
-      stratified(count, rng, true, from.data());
-      stratified(count, rng, true, to.data());
-      for (std::uint32_t i = count; i > 1; --i) std::swap(to[i - 1], to[rng.next() % i]);
-      for (std::uint32_t r = 0; r < count; ++r) {
-        const glm::vec3 x = sampler(from[r]) + epsilon_ * normal;
-        const glm::vec3 d = (L.fan.sample(to[r]) + epsilon_ * L.normal) - x;
-        const float r2 = glm::dot(d, d);
-        if (!(r2 > 0.0f)) continue;
-        const float w = std::max(0.0f, glm::dot(d, normal)) * std::max(0.0f, -glm::dot(d, L.normal)) / (r2 * r2);
-        const bool visible = !shadow_rays_->occluded(x, d, 0.0f, 1.0f - 1e-4f);
-        (visible ? clear : blocked) += 1;
-        weight += w;
-        clear_weight += visible ? w : 0.0f;
-      }
-    };
-    pass(64);
-    if (clear > 0 && blocked > 0) pass(256);
-    if (blocked == 0) return 1.0;
-    if (clear == 0) return 0.0;
-    return weight > 0.0 ? clear_weight / weight : static_cast<double>(clear) / (clear + blocked);
+    return visible_fraction(sampler, normal, light_point, L.normal, epsilon_, kBudget, rng, *shadow_rays_, ray_kernel)
+        .value;
   }
 
   /// Element id -> position in `elements` (kNone elsewhere), so hits on leaves map to indices.
@@ -638,28 +637,34 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   }
 
   /// The Embree scene of the current leaves (element ids), rebuilt after the hierarchy was
-  /// refined: a column must land on the leaves that exist now.
+  /// refined: a column must land on the leaves that exist now. Built without the lock (Embree
+  /// builds in parallel); concurrent first calls may each build the same scene, and one is kept.
   std::shared_ptr<const LeafRays> leaf_scene() const {
+    const std::size_t leaves = hierarchy_.leaves().size();
+    {
+      std::lock_guard<std::mutex> lock(leaf_mutex_);
+      if (leaf_rays_ && leaf_count_ == leaves) return leaf_rays_;
+    }
+    RayScene scene = RayScene::from_leaves(hierarchy_);
+    std::vector<std::uint32_t> patch, polygon, back;
+    for (std::uint32_t e : scene.triangle_ids()) {
+      patch.push_back(hierarchy_.element(e).patch);
+      polygon.push_back(hierarchy_.patches()[patch.back()].polygon);
+      back.push_back(back_target_[patch.back()]);
+    }
+    auto built = std::make_shared<const LeafRays>(
+        LeafRays{std::move(scene), std::move(patch), std::move(polygon), std::move(back)});
     std::lock_guard<std::mutex> lock(leaf_mutex_);
-    if (!leaf_rays_ || leaf_count_ != hierarchy_.leaves().size()) {
-      RayScene scene = RayScene::from_leaves(hierarchy_);
-      std::vector<std::uint32_t> patch, polygon, back;
-      for (std::uint32_t e : scene.triangle_ids()) {
-        patch.push_back(hierarchy_.element(e).patch);
-        polygon.push_back(hierarchy_.patches()[patch.back()].polygon);
-        back.push_back(back_target_[patch.back()]);
-      }
-      leaf_rays_ = std::make_shared<const LeafRays>(
-          LeafRays{std::move(scene), std::move(patch), std::move(polygon), std::move(back)});
-      leaf_count_ = hierarchy_.leaves().size();
+    if (!leaf_rays_ || leaf_count_ != leaves) {
+      leaf_rays_ = std::move(built);
+      leaf_count_ = leaves;
     }
     return leaf_rays_;
   }
 
   const PatchHierarchy& hierarchy_;
   FormFactorOptions options_;
-  std::unique_ptr<FormFactorEstimator> analytic_;  ///< unoccluded factors to emitting patches
-  std::unique_ptr<FormFactorEstimator> analytic_serial_;  ///< the same on the calling thread only
+  std::unique_ptr<BackColumnEstimator> analytic_;  ///< unoccluded factors to emitting patches
   /// Per polygon, for extended form factors: mean reflectance of an ideal mirror, mean
   /// transmittance of a window (0 = neither).
   struct SpecularSurface {

@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/assert.hpp"
 #include "form_factors/estimators.hpp"
 #include "radiosity/form_factors.hpp"
 
@@ -102,10 +103,11 @@ inline float atan2_nonnegative(float y, float x) {
 float point_to_polygon_factor_fast(const glm::vec3& x, const glm::vec3& n, const glm::vec3* polygon, int vertex_count) {
   // Same contour integral as point_to_polygon_factor(), in float and for at most 8 corners
   // (patches have 3 or 4): clip to the hemisphere above x, then sum the edge terms.
+  RADIOSITY_ASSERT(vertex_count >= 3 && vertex_count <= 8);
   std::array<glm::vec3, 9> r;
   std::array<float, 8> h;
   bool all_above = true;
-  const int count = std::min(vertex_count, 8);
+  const int count = std::min(vertex_count, 8);  // (in Release too: the arrays hold 8)
   for (int i = 0; i < count; ++i) {
     r[static_cast<std::size_t>(i)] = polygon[i] - x;
     h[static_cast<std::size_t>(i)] = glm::dot(r[static_cast<std::size_t>(i)], n);

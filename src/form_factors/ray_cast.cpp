@@ -35,6 +35,7 @@
 #include "form_factors/estimators.hpp"
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
+#include "form_factors/visibility.hpp"
 #include "geometry/ray_scene.hpp"
 #include "core/streams.hpp"
 
@@ -68,28 +69,11 @@ namespace {
 // Gauss-Legendre 2x2 nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).
 constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.28867513459481287f;
 
-// The rays of one visibility pass; one per thread, reused (a pass has up to 256 x 64 rays).
-struct RayBatch {
-  std::vector<glm::vec3> source, origin, direction;
-  std::vector<std::uint8_t> blocked;
-  void resize(std::size_t rays) {
-    source.resize(std::max<std::size_t>(source.size(), 256));
-    origin.resize(rays);
-    direction.resize(rays);
-    blocked.resize(rays);
-  }
-};
-
-RayBatch& ray_batch() {
-  thread_local RayBatch batch;
-  return batch;
-}
-
-class SampledEstimator final : public FormFactorEstimator {
+class SampledEstimator final : public BackColumnEstimator {
  public:
   SampledEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options,
                    bool with_visibility)
-      : FormFactorEstimator(hierarchy.patches().size()),
+      : BackColumnEstimator(hierarchy),
         hierarchy_(hierarchy),
         options_(options),
         visibility_(with_visibility) {
@@ -144,68 +128,11 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
   void patch_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      Source source;
-      RayCastCounters counts;
-      for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source);
-        out[k] = static_cast<float>(factor(source, patch, counts));
-      }
-      add(counts);
-    });
+    column(patch, elements, false, out);
   }
 
-  /// patch_column() for the backs of the elements: each treated as a Lambertian surface facing
-  /// -normal (diffuse transmission's backward form factors).
-  void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const {
-    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
-      Source source;
-      RayCastCounters counts;
-      for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source, true);
-        out[k] = static_cast<float>(factor(source, patch, counts));
-      }
-      add(counts);
-    });
-  }
-
-  // With diffuse transmission, rows run over every target (backs after the patches).
-  void sparse_element_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    if (translucent_patches().empty()) {
-      FormFactorEstimator::sparse_element_rows(elements, out);
-      return;
-    }
-    target_rows(elements, false, out);
-  }
-
-  void sparse_back_rows(const std::vector<std::uint32_t>& elements, std::vector<SparseFactors>& out) const override {
-    check_back_rows(*this, hierarchy_, elements);
-    target_rows(elements, true, out);
-  }
-
-  void sparse_patch_column(std::uint32_t target, const std::vector<std::uint32_t>& elements,
-                           SparseFactors& out) const override {
-    if (translucent_patches().empty()) {
-      FormFactorEstimator::sparse_patch_column(target, elements, out);
-      return;
-    }
-    check_target(*this, target);
-    // Fronts of all elements, then the backs of the translucent ones (index m + k).
-    const std::size_t m = elements.size();
-    std::vector<float> column(2 * m, 0.0f);
-    parallel_for(options_.threads, m, 64, [&](std::size_t begin, std::size_t end) {
-      Source source;
-      RayCastCounters counts;
-      for (std::size_t k = begin; k < end; ++k) {
-        prepare(elements[k], source);
-        column[k] = static_cast<float>(factor(source, target, counts));
-        if (back_target_[source.patch] == kNone) continue;
-        prepare(elements[k], source, true);
-        column[m + k] = static_cast<float>(factor(source, target, counts));
-      }
-      add(counts);
-    });
-    compress(column.data(), column.size(), out);
+  void back_column(std::uint32_t patch, const std::vector<std::uint32_t>& elements, float* out) const override {
+    column(patch, elements, true, out);
   }
 
   RayCastCounters counters() const {
@@ -217,8 +144,9 @@ class SampledEstimator final : public FormFactorEstimator {
   }
 
  private:
-  // The rows of the elements' fronts (or backs) over every target, non-zero entries only.
-  void target_rows(const std::vector<std::uint32_t>& elements, bool back, std::vector<SparseFactors>& out) const {
+  // With diffuse transmission, rows and columns run over every target (backs after the patches).
+  void target_rows(const std::vector<std::uint32_t>& elements, bool back,
+                   std::vector<SparseFactors>& out) const override {
     out.assign(elements.size(), SparseFactors{});
     const auto targets = static_cast<std::uint32_t>(target_count());
     parallel_for(options_.threads, elements.size(), 4, [&](std::size_t begin, std::size_t end) {
@@ -233,6 +161,35 @@ class SampledEstimator final : public FormFactorEstimator {
             out[k].value.push_back(f);
           }
         }
+      }
+      add(counts);
+    });
+  }
+
+  // F(e -> target) for the elements' fronts, or their backs when `back`.
+  void column(std::uint32_t target, const std::vector<std::uint32_t>& elements, bool back, float* out) const {
+    parallel_for(options_.threads, elements.size(), 64, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source, back);
+        out[k] = static_cast<float>(factor(source, target, counts));
+      }
+      add(counts);
+    });
+  }
+
+  void target_column(std::uint32_t target, const std::vector<std::uint32_t>& elements, float* column) const override {
+    const std::size_t m = elements.size();
+    parallel_for(options_.threads, m, 64, [&](std::size_t begin, std::size_t end) {
+      Source source;
+      RayCastCounters counts;
+      for (std::size_t k = begin; k < end; ++k) {
+        prepare(elements[k], source);
+        column[k] = static_cast<float>(factor(source, target, counts));
+        if (back_target_[source.patch] == kNone) continue;
+        prepare(elements[k], source, true);
+        column[m + k] = static_cast<float>(factor(source, target, counts));
       }
       add(counts);
     });
@@ -349,119 +306,53 @@ class SampledEstimator final : public FormFactorEstimator {
     const std::uint32_t j = r.patch;
     const Patch& target = hierarchy_.patches()[j];
     const PatchCorners& poly = corners_[j];
-    Shaft shaft;
-    if (!verdicts_ || s.back || r.target != r.patch) {
-      return shaft.build(s.corners.data(), s.corner_count, s.normal, poly.p.data(), poly.count, r.normal,
-                         epsilon_) &&
-             occluders_.any(shaft, s.polygon, target.polygon);
-    }
+    if (!verdicts_ || s.back || r.target != r.patch)
+      return occluders_.may_block(s.corners.data(), s.corner_count, s.normal, poly.p.data(), poly.count, r.normal,
+                                  epsilon_, s.polygon, target.polygon);
     std::atomic<std::uint8_t>& slot = verdicts_[static_cast<std::size_t>(s.patch) * corners_.size() + j];
     std::uint8_t v = slot.load(std::memory_order_relaxed);
     if (v == kUnknown) {
       // Concurrent first uses compute the same value, so the race is benign.
       const PatchCorners& own = corners_[s.patch];
-      const bool shadowed =
-          shaft.build(own.p.data(), own.count, s.normal, poly.p.data(), poly.count, target.normal, epsilon_) &&
-          occluders_.any(shaft, s.polygon, target.polygon);
+      const bool shadowed = occluders_.may_block(own.p.data(), own.count, s.normal, poly.p.data(), poly.count,
+                                                 target.normal, epsilon_, s.polygon, target.polygon);
       v = shadowed ? kShadowed : kClear;
       slot.store(v, std::memory_order_relaxed);
     }
     return v == kShadowed;
   }
 
-  // Visible fraction of the pair, V = sum_x F(dx -> j) V(x) / sum_x F(dx -> j) over stratified
-  // source points x, where F(dx -> j) is the exact point factor and V(x) is the fraction of
-  // occlusion rays from x to stratified points y of the patch that are clear, each ray weighted
-  // by the point-to-point kernel cos(theta_x) cos(theta_y) / r^2 (so V(x) measures transport,
-  // not solid angle). Each V(x) lies in [0, 1], so a source point near a shared edge, where the
-  // kernel has a 1/r^2 spike, cannot dominate the estimate (weighting all rays by the kernel in
-  // one ratio would let a few of them decide it). The samples have their own stream per pair,
-  // so the result does not depend on which thread computes the pair or in which order.
+  // Visible fraction of the pair (visibility.hpp): V = sum_x F(dx -> j) V(x) / sum_x F(dx -> j)
+  // over stratified source points x, each with its own stratified points y of the patch (a grid
+  // pairing), where F(dx -> j) is the exact point factor and V(x) the kernel-weighted fraction of
+  // x's clear rays. The exact F(dx -> j) is at hand here and is the right weight: its integral is
+  // the unoccluded factor, and each V(x) lies in [0, 1], so a source point near a shared edge,
+  // where the kernel has a 1/r^2 spike, cannot dominate the estimate. The samples have their own
+  // stream per pair, so the result does not depend on which thread computes the pair or in which
+  // order.
   //
-  // The rays come in passes of S stratified source points times T rays each, sized in
-  // proportion to the unoccluded factor F: max(n, min(256 n F, 1024)) rays first (n = ns nv),
-  // and when those disagree (a penumbra) max(4 n, min(1024 n F, 4096)) more. Allocating rays in
-  // proportion to F minimises the variance of sums of factors (a row, a group's factor, the
-  // gathered radiosity) for a given number of rays: small factors keep ns x nv rays, large ones
-  // get up to 64 x 64.
+  // The passes have S stratified source points times T rays each, sized in proportion to the
+  // unoccluded factor F: max(n, min(256 n F, 1024)) rays first (n = ns nv), and when those
+  // disagree (a penumbra) max(4 n, min(1024 n F, 4096)) more. Allocating rays in proportion to F
+  // minimises the variance of sums of factors (a row, a group's factor, the gathered radiosity)
+  // for a given number of rays: small factors keep ns x nv rays, large ones get up to 64 x 64.
+  // (The Monte Carlo estimator's shadow rays have a fixed budget instead: see there.)
   double visible_fraction(const Source& s, const Receiver& to, double unoccluded, std::uint64_t& rays_cast) const {
     const Patch& target = hierarchy_.patches()[to.patch];
     const PatchCorners& poly = corners_[to.patch];
     const glm::vec3 nx = s.normal, ny = to.normal;
     const std::uint32_t ns = options_.source_samples, nv = options_.visibility_rays;
-    Rng rng(options_.seed, s.element, stream_key(s.back ? Stream::ray_cast_back : Stream::ray_cast_front, to.target));
-    RayBatch& batch = ray_batch();
     // A pass of about `budget` rays: S = g^2 stratified source points, T = h^2 rays from each
-    // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays. All rays of a pass
-    // are generated first (in the same random order as one source point at a time) and traced
-    // together: they run between the element and the patch, so Embree traces them as coherent
-    // packets, several times faster than one by one. Returns the number of clear rays.
-    std::uint32_t S = 0, T = 0;
+    // (S <= 256, T <= 64); the smallest budget is exactly ns points x nv rays.
     auto pass = [&](double budget) {
-      S = ns;
-      T = nv;
+      ShadowPass p{ns, nv};
       if (budget > static_cast<double>(ns * nv)) {
-        S = static_cast<std::uint32_t>(std::clamp(std::lround(std::sqrt(std::sqrt(budget))), 1l, 16l));
-        S *= S;
-        const auto h = static_cast<std::uint32_t>(std::clamp(std::lround(std::sqrt(budget / S)), 1l, 8l));
-        T = h * h;
+        p.points = static_cast<std::uint32_t>(std::clamp(std::lround(std::sqrt(std::sqrt(budget))), 1l, 16l));
+        p.points *= p.points;
+        const auto h = static_cast<std::uint32_t>(std::clamp(std::lround(std::sqrt(budget / p.points)), 1l, 8l));
+        p.rays_per_point = h * h;
       }
-      std::array<glm::vec2, 256> uv;
-      std::array<glm::vec2, 64> target_uv;
-      stratified(S, rng, true, uv.data());
-      const std::size_t count = static_cast<std::size_t>(S) * T;
-      batch.resize(count);
-      for (std::uint32_t k = 0; k < S; ++k) {
-        const glm::vec3 x = s.sampler(uv[k]);
-        batch.source[k] = x;
-        const glm::vec3 origin = x + epsilon_ * nx;
-        stratified(T, rng, true, target_uv.data());
-        for (std::uint32_t t = 0; t < T; ++t) {
-          const std::size_t r = static_cast<std::size_t>(k) * T + t;
-          batch.origin[r] = origin;
-          batch.direction[r] = (poly.sampler(target_uv[t]) + epsilon_ * ny) - origin;
-        }
-      }
-      rays_->occluded(count, batch.origin.data(), batch.direction.data(), 0.0f, 1.0f - 1e-4f, batch.blocked.data());
-      rays_cast += count;
-      std::uint32_t clear = 0;
-      for (std::size_t r = 0; r < count; ++r) {
-        const glm::vec3& d = batch.direction[r];
-        if (!(glm::dot(d, d) > 0.0f)) batch.blocked[r] = 1;  // a degenerate segment counts as blocked
-        clear += batch.blocked[r] == 0 ? 1u : 0u;
-      }
-      return clear;
-    };
-    // The sums of the ratio over the source points of the last pass. Only a pair whose rays
-    // disagree needs them: all clear is V = 1, all blocked V = 0, whatever the weights.
-    double factor_sum = 0.0, visible_sum = 0.0, fraction_sum = 0.0;
-    std::uint32_t points = 0;
-    auto weigh = [&] {
-      for (std::uint32_t k = 0; k < S; ++k) {
-        const glm::vec3 x = batch.source[k];
-        double weight = 0.0, visible_weight = 0.0;
-        std::uint32_t visible_count = 0;
-        for (std::uint32_t t = 0; t < T; ++t) {
-          const std::size_t r = static_cast<std::size_t>(k) * T + t;
-          const glm::vec3 d = batch.direction[r];
-          const float r2 = glm::dot(d, d);
-          if (!(r2 > 0.0f)) continue;
-          const float w = std::max(0.0f, glm::dot(d, nx)) * std::max(0.0f, -glm::dot(d, ny)) / (r2 * r2);
-          const bool visible = batch.blocked[r] == 0;
-          visible_count += visible ? 1u : 0u;
-          weight += w;
-          visible_weight += visible ? w : 0.0f;
-        }
-        // All segments grazing (weight 0): the plain fraction of clear rays.
-        const double v = weight > 0.0 ? visible_weight / weight : static_cast<double>(visible_count) / T;
-        const double f = glm::dot(x - target.centroid, ny) > 0.0f
-                             ? static_cast<double>(point_to_polygon_factor_fast(x, nx, poly.p.data(), poly.count))
-                             : 0.0;
-        factor_sum += f;
-        visible_sum += f * v;
-        fraction_sum += v;
-        ++points;
-      }
+      return p;
     };
     // The first pass grows with F too: a penumbra that blocks a fraction b of the pair escapes N
     // rays with probability (1 - b)^N, which costs at most about F / (e N) of the factor.
@@ -469,14 +360,18 @@ class SampledEstimator final : public FormFactorEstimator {
     auto rays_for = [&](double per_factor, double lo, double hi) {
       return std::max(lo, std::min(per_factor * base * unoccluded, hi));  // lo wins over hi
     };
-    const std::uint32_t clear = pass(rays_for(256.0, base, 1024.0));
-    if (clear == 0) return 0.0;
-    if (clear == S * T) return 1.0;
-    weigh();
-    pass(rays_for(1024.0, 4.0 * base, 4096.0));
-    weigh();
-    // No sampled point sees the receiver's front (a grazing pair): the plain mean of V(x).
-    return factor_sum > 0.0 ? visible_sum / factor_sum : fraction_sum / points;
+    const ShadowBudget budget{pass(rays_for(256.0, base, 1024.0)), pass(rays_for(1024.0, 4.0 * base, 4096.0)),
+                              ShadowPairing::grid};
+    auto point_factor = [&](const glm::vec3& x, double) {
+      return glm::dot(x - target.centroid, ny) > 0.0f
+                 ? static_cast<double>(point_to_polygon_factor_fast(x, nx, poly.p.data(), poly.count))
+                 : 0.0;
+    };
+    Rng rng(options_.seed, s.element, stream_key(s.back ? Stream::ray_cast_back : Stream::ray_cast_front, to.target));
+    const VisibleFraction v =
+        detail::visible_fraction(s.sampler, nx, poly.sampler, ny, epsilon_, budget, rng, *rays_, point_factor);
+    rays_cast += v.rays;
+    return v.value;
   }
 
   // Gauss-Legendre 2x2 on the square [lo, lo + size]^2 of the element's (s,t) domain: with the
@@ -545,19 +440,12 @@ bool ray_cast_counters(const FormFactorEstimator& estimator, RayCastCounters& ou
   return true;
 }
 
-void back_patch_column(const FormFactorEstimator& estimator, std::uint32_t patch, const std::vector<std::uint32_t>& elements,
-                       float* out) {
-  const auto* e = dynamic_cast<const SampledEstimator*>(&estimator);
-  if (e == nullptr) throw Error(ErrorCode::internal, "back_patch_column: not a ray-cast or analytic estimator");
-  e->back_column(patch, elements, out);
-}
-
 std::unique_ptr<FormFactorEstimator> make_ray_cast_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                              const FormFactorOptions& options) {
   return std::make_unique<SampledEstimator>(scene, hierarchy, options, true);
 }
 
-std::unique_ptr<FormFactorEstimator> make_analytic_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
+std::unique_ptr<BackColumnEstimator> make_analytic_estimator(const Scene& scene, const PatchHierarchy& hierarchy,
                                                              const FormFactorOptions& options) {
   return std::make_unique<SampledEstimator>(scene, hierarchy, options, false);
 }

@@ -8,6 +8,8 @@
 // scenes", SIGGRAPH 1986) with a separating-plane test at the leaves.
 #include "form_factors/shaft.hpp"
 
+#include "core/assert.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -22,6 +24,7 @@ void Shaft::add(const glm::vec3& normal, float offset) {
 
 bool Shaft::build(const glm::vec3* a, int na, const glm::vec3& a_normal, const glm::vec3* b, int nb,
                   const glm::vec3& b_normal, float tolerance) {
+  RADIOSITY_ASSERT(na >= 1 && na <= 4 && nb >= 3 && nb <= 4);
   plane_count_ = 0;
   corner_count_ = 0;
   tolerance_ = tolerance;

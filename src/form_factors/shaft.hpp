@@ -61,6 +61,14 @@ class ShaftCuller {
 
   /// True when some polygon other than `skip_a` and `skip_b` may enter the shaft.
   bool any(const Shaft& shaft, std::uint32_t skip_a, std::uint32_t skip_b) const;
+  /// Whether a polygon other than `skip_a` and `skip_b` may block a segment between source `a`
+  /// and receiver `b` (Shaft::build's arguments): false when the shaft is empty or nothing
+  /// enters it, so the pair needs no shadow rays.
+  bool may_block(const glm::vec3* a, int na, const glm::vec3& a_normal, const glm::vec3* b, int nb,
+                 const glm::vec3& b_normal, float tolerance, std::uint32_t skip_a, std::uint32_t skip_b) const {
+    Shaft shaft;
+    return shaft.build(a, na, a_normal, b, nb, b_normal, tolerance) && any(shaft, skip_a, skip_b);
+  }
   /// Appends the polygons other than `skip` that may enter the shaft to `out`, in increasing order.
   void collect(const Shaft& shaft, std::uint32_t skip, std::vector<std::uint32_t>& out) const;
 

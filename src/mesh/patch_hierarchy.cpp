@@ -10,6 +10,7 @@
 //   M. F. Cohen & J. R. Wallace, "Radiosity and Realistic Image Synthesis", Academic Press 1993,
 //     ch. 8 (quadtree element meshes, vertex radiosities by area-weighted averaging).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -20,6 +21,8 @@
 #include <glm/vec3.hpp>
 
 #include "radiosity/mesh.hpp"
+
+#include "core/sampling.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -76,22 +79,6 @@ void check_area_option(float value, const char* field) {
   if (!(value >= 0.0f))
     throw Error(ErrorCode::invalid_argument,
                 std::string("MeshOptions::") + field + " must be >= 0 (0 derives it), got " + std::to_string(value));
-}
-
-// Standard square-root warp from the unit square to a uniformly distributed point of a triangle
-// (Turk, "Generating random points in triangles", Graphics Gems 1990).
-glm::vec3 sample_triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, float u, float v) {
-  const float su = std::sqrt(u);
-  return (1.0f - su) * a + (su * (1.0f - v)) * b + (su * v) * c;
-}
-
-// Inverse CDF of the density on [0,1] that is linear from f0 at 0 to f1 at 1 (both > 0), in
-// the form 2uT / (f0 + sqrt(f0^2 + 2(f1-f0)uT)), T = (f0+f1)/2, which stays exact as f1 -> f0.
-float sample_linear(float u, float f0, float f1) {
-  const float total = 0.5f * (f0 + f1);
-  const float disc = std::max(0.0f, f0 * f0 + 2.0f * (f1 - f0) * u * total);
-  const float denom = f0 + std::sqrt(disc);
-  return denom > 0.0f ? std::clamp(2.0f * u * total / denom, 0.0f, 1.0f) : u;
 }
 
 }  // namespace
@@ -378,21 +365,13 @@ std::uint32_t PatchHierarchy::subdivide(std::uint32_t element) {
 }
 
 glm::vec3 PatchHierarchy::sample_point(std::uint32_t element, glm::vec2 uv) const {
+  // The estimators' warp (core/sampling.hpp): area-uniform, and (u,v) strata stay compact cells
+  // of equal area on quads too.
   const Element& e = elements_[element];
-  const glm::vec3 &c0 = vertices_[e.corners[0]], &c1 = vertices_[e.corners[1]], &c2 = vertices_[e.corners[2]];
-  if (e.corner_count() == 3) return sample_triangle(c0, c1, c2, uv.x, uv.y);
-  // Quads: the bilinear map P(s,t) of a planar quad has a Jacobian that is linear in (s,t),
-  // J = A + B s + C t, so warping (u,v) through the inverse CDFs of the marginal in s and the
-  // conditional in t gives area-uniform points that keep the stratification of (u,v) (unlike
-  // picking one of two triangles, which folds strata onto each other).
-  const glm::vec3& c3 = vertices_[e.corners[3]];
-  const glm::vec3 n = glm::cross(c1 - c0, c2 - c0) + glm::cross(c2 - c0, c3 - c0);
-  const glm::vec3 e0 = c1 - c0, e3 = c3 - c0, d = c0 - c1 + c2 - c3;
-  const float A = glm::dot(n, glm::cross(e0, e3)), B = glm::dot(n, glm::cross(e0, d)),
-              C = glm::dot(n, glm::cross(d, e3));
-  const float s = sample_linear(uv.x, A + 0.5f * C, A + B + 0.5f * C);
-  const float t = sample_linear(uv.y, A + B * s, A + B * s + C);
-  return (1.0f - s) * (1.0f - t) * c0 + s * (1.0f - t) * c1 + s * t * c2 + (1.0f - s) * t * c3;
+  std::array<glm::vec3, 4> corners{};
+  for (int k = 0; k < e.corner_count(); ++k)
+    corners[static_cast<std::size_t>(k)] = vertices_[e.corners[static_cast<std::size_t>(k)]];
+  return detail::CellSampler(corners.data(), e.corner_count())(uv);
 }
 
 std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_values) const {

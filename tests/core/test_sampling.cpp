@@ -2,7 +2,9 @@
 // orthonormal and right-handed everywhere, the seam at n.z = 0 included.
 #include <doctest/doctest.h>
 
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -13,6 +15,36 @@
 namespace core = radiosity::detail;
 
 namespace {
+
+/// Area of a polygon in the z = 0 plane (shoelace).
+double area_xy(const std::vector<glm::dvec2>& p) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const glm::dvec2 &q = p[i], &r = p[(i + 1) % p.size()];
+    a += q.x * r.y - r.x * q.y;
+  }
+  return 0.5 * std::fabs(a);
+}
+
+/// The part of convex polygon p with x_or_y (0: x, 1: y) on the `keep_below` side of `cut`
+/// (one Sutherland-Hodgman step).
+std::vector<glm::dvec2> clip(const std::vector<glm::dvec2>& p, int axis, double cut, bool keep_below) {
+  std::vector<glm::dvec2> out;
+  auto in = [&](const glm::dvec2& q) { return keep_below ? q[axis] <= cut : q[axis] >= cut; };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const glm::dvec2 &a = p[i], &b = p[(i + 1) % p.size()];
+    if (in(a)) out.push_back(a);
+    if (in(a) != in(b)) out.push_back(a + (b - a) * ((cut - a[axis]) / (b[axis] - a[axis])));
+  }
+  return out;
+}
+
+/// Cells of the z = 0 plane to test warps on: a trapezoid, a general convex quad, a triangle.
+std::vector<std::vector<glm::vec3>> test_cells() {
+  return {{{0, 0, 0}, {4, 0, 0}, {3, 1, 0}, {1, 1, 0}},
+          {{0, 0, 0}, {3, 0.5f, 0}, {2.5f, 2, 0}, {-0.5f, 1.5f, 0}},
+          {{0, 0, 0}, {2, 0.5f, 0}, {0.5f, 1.5f, 0}}};
+}
 
 /// Calls f(u) over the centres of an n x n grid of [0,1)^2.
 template <class F>
@@ -94,5 +126,98 @@ TEST_SUITE("core") {
       const float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 6.2831853f * u.y;
       check(glm::vec3(r * std::cos(phi), r * std::sin(phi), z));
     }
+  }
+
+  TEST_CASE("the cell warp is area-uniform: chi-square over exact sub-region areas, pdf 1 / area") {
+    // Counts of random points in a k x k grid of the bounding box against the exact areas of the
+    // grid cells clipped to the polygon; 99.99th percentile of chi-square with <= 63 degrees of
+    // freedom is about 113.
+    constexpr int k = 8, n = 200000;
+    for (const auto& corners : test_cells()) {
+      CAPTURE(corners.size());
+      const core::CellSampler warp(corners.data(), static_cast<int>(corners.size()));
+      std::vector<glm::dvec2> polygon;
+      glm::dvec2 lo(1e9), hi(-1e9);
+      for (const glm::vec3& c : corners) {
+        polygon.emplace_back(c.x, c.y);
+        lo = glm::min(lo, polygon.back());
+        hi = glm::max(hi, polygon.back());
+      }
+      const double area = area_xy(polygon);
+      CHECK(warp.pdf() == doctest::Approx(1.0 / area).epsilon(1e-6));
+      const glm::dvec2 cell = (hi - lo) / double(k);
+      std::array<int, k * k> count{};
+      core::Rng rng(11, corners.size(), 0);
+      for (int i = 0; i < n; ++i) {
+        const glm::vec3 x = warp(rng.uniform2());
+        CHECK(x.z == 0.0f);
+        const int a = std::min(k - 1, static_cast<int>((x.x - lo.x) / cell.x));
+        const int b = std::min(k - 1, static_cast<int>((x.y - lo.y) / cell.y));
+        ++count[static_cast<std::size_t>(a * k + b)];
+      }
+      double chi2 = 0.0, covered = 0.0;
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+          std::vector<glm::dvec2> part = clip(polygon, 0, lo.x + a * cell.x, false);
+          part = clip(part, 0, lo.x + (a + 1) * cell.x, true);
+          part = clip(part, 1, lo.y + b * cell.y, false);
+          part = clip(part, 1, lo.y + (b + 1) * cell.y, true);
+          const double q = part.size() >= 3 ? area_xy(part) / area : 0.0;
+          covered += q;
+          const int c = count[static_cast<std::size_t>(a * k + b)];
+          if (q > 0.0) {
+            chi2 += (c - n * q) * (c - n * q) / (n * q);
+          } else {
+            CHECK(c == 0);
+          }
+        }
+      CHECK(covered == doctest::Approx(1.0).epsilon(1e-9));
+      CHECK(chi2 < 113.0);
+    }
+  }
+
+  TEST_CASE("the cell warp keeps strata: each (u,v) stratum maps to 1/g^2 of the area") {
+    // The image of a stratum, measured as the sum of the areas of the images of an m x m
+    // sub-grid (chords for the curved edges: error O(1/m^2)). The plain bilinear map would miss
+    // by a third on the trapezoid, whose Jacobian doubles from its short side to its long one.
+    constexpr int g = 6, m = 16;
+    for (const auto& corners : test_cells()) {
+      CAPTURE(corners.size());
+      const core::CellSampler warp(corners.data(), static_cast<int>(corners.size()));
+      auto image = [&](double u, double v) {
+        const glm::vec3 x = warp(glm::vec2(static_cast<float>(u), static_cast<float>(v)));
+        return glm::dvec2(x.x, x.y);
+      };
+      const double area = 1.0 / warp.pdf();
+      double worst = 0.0;
+      for (int i = 0; i < g; ++i)
+        for (int j = 0; j < g; ++j) {
+          double a = 0.0;
+          for (int p = 0; p < m; ++p)
+            for (int q = 0; q < m; ++q) {
+              const double u0 = (i + double(p) / m) / g, u1 = (i + double(p + 1) / m) / g;
+              const double v0 = (j + double(q) / m) / g, v1 = (j + double(q + 1) / m) / g;
+              a += area_xy({image(u0, v0), image(u1, v0), image(u1, v1), image(u0, v1)});
+            }
+          worst = std::max(worst, std::fabs(a / area * g * g - 1.0));
+        }
+      CHECK(worst < 1e-4);
+    }
+  }
+
+  TEST_CASE("the cell warp of a parallelogram is the plain affine map") {
+    const std::array<glm::vec3, 4> p{glm::vec3(1, 2, 3), glm::vec3(4, 2.5f, 3), glm::vec3(5, 4.5f, 4),
+                                     glm::vec3(2, 4, 4)};
+    const core::CellSampler warp(p.data(), 4);
+    // A quad just beyond the parallelogram test takes the general bilinear warp: it agrees to
+    // the size of the change.
+    std::array<glm::vec3, 4> q = p;
+    q[2] += glm::vec3(1e-3f, 0, 0);
+    const core::CellSampler near(q.data(), 4);
+    grid(16, [&](glm::vec2 u) {
+      const glm::vec3 affine = p[0] + u.x * (p[1] - p[0]) + u.y * (p[3] - p[0]);
+      CHECK(warp(u) == affine);
+      CHECK(glm::length(near(u) - affine) < 2e-3f);
+    });
   }
 }

@@ -1,10 +1,14 @@
 // The Monte Carlo ray-shooting estimator: closed forms within its statistical error, exact row
 // sums in closed enclosures, exact factors to emitting patches where nothing occludes, columns
-// consistent with rows through reciprocity, determinism, and the solvers on sparse rows.
+// consistent with rows through reciprocity, determinism (at any thread count and under concurrent
+// calls), and the solvers on sparse rows.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numeric>
+#include <thread>
 #include <vector>
 
 #include "form_factors/ff_support.hpp"
@@ -164,6 +168,64 @@ TEST_SUITE("form_factors") {
       const double rays = 1024.0 * A / 0.125;
       INFO("patch ", j, ": F(j -> all) from rows ", F, ", from its column ", from_column / A);
       CHECK(std::fabs(from_column / A - F) <= 2.0 * four_sigma(std::min(F, 0.5), rays));
+    }
+  }
+
+  TEST_CASE("monte_carlo: const calls from several threads at once equal the serial results bit for bit") {
+    // Columns of the emitting patches fill the per-light visibility caches, a shot column builds
+    // the leaf scene, and rows use both: four threads make these calls at once, each in its own
+    // order, on an estimator with empty caches, and must get what one thread got one call after
+    // another on a fresh estimator with threads = 1.
+    const rad::Scene s = rad::cornell_box();
+    const rad::PatchHierarchy h(s, mesh(8000.0f, 2000.0f));
+    std::vector<std::uint32_t> targets;
+    for (std::uint32_t j = 0; j < h.patches().size(); ++j)
+      if (s.material(h.patches()[j].material).emission.x > 0.0f) targets.push_back(j);
+    REQUIRE(targets.size() >= 2);
+    targets.push_back(0);  // a non-emitting patch: a shot column
+    const std::vector<std::uint32_t>& leaves = h.leaves();
+    const std::vector<std::uint32_t> some(leaves.begin(), leaves.begin() + static_cast<std::ptrdiff_t>(leaves.size() / 4));
+    rad::FormFactorOptions o = monte_carlo(256);
+    o.threads = 1;
+    const auto serial = rad::make_form_factor_estimator(s, h, o);
+    std::vector<rad::SparseFactors> columns(targets.size()), rows;
+    for (std::size_t i = 0; i < targets.size(); ++i) serial->sparse_patch_column(targets[i], leaves, columns[i]);
+    serial->sparse_element_rows(some, rows);
+
+    o.threads = 2;  // and each call parallel inside
+    const auto shared = rad::make_form_factor_estimator(s, h, o);
+    constexpr std::size_t kThreads = 4;
+    std::vector<std::vector<rad::SparseFactors>> got_columns(kThreads, std::vector<rad::SparseFactors>(targets.size()));
+    std::vector<std::vector<rad::SparseFactors>> got_rows(kThreads);
+    std::atomic<int> failures{0};
+    std::vector<std::thread> pool;
+    for (std::size_t t = 0; t < kThreads; ++t)
+      pool.emplace_back([&, t] {
+        try {
+          if (t % 2 == 1) shared->sparse_element_rows(some, got_rows[t]);
+          for (std::size_t i = 0; i < targets.size(); ++i) {
+            const std::size_t k = (i + t) % targets.size();
+            shared->sparse_patch_column(targets[k], leaves, got_columns[t][k]);
+          }
+          if (t % 2 == 0) shared->sparse_element_rows(some, got_rows[t]);
+        } catch (...) {
+          ++failures;
+        }
+      });
+    for (std::thread& thread : pool) thread.join();
+    REQUIRE(failures == 0);
+    for (std::size_t t = 0; t < kThreads; ++t) {
+      CAPTURE(t);
+      for (std::size_t i = 0; i < targets.size(); ++i) {
+        CAPTURE(targets[i]);
+        CHECK(got_columns[t][i].index == columns[i].index);
+        CHECK(got_columns[t][i].value == columns[i].value);
+      }
+      REQUIRE(got_rows[t].size() == rows.size());
+      bool same = true;
+      for (std::size_t k = 0; k < rows.size(); ++k)
+        same = same && got_rows[t][k].index == rows[k].index && got_rows[t][k].value == rows[k].value;
+      CHECK(same);
     }
   }
 
