@@ -460,17 +460,34 @@ class PathTracer {
     return surfaces_[e.polygon];
   }
 
+  /// A point on an emitter seen from a surface point x.
+  struct LightSample {
+    const Surface* light = nullptr;
+    glm::vec3 y{0.0f};   ///< the point on the emitter
+    glm::vec3 wi{0.0f};  ///< unit direction from x to y
+    float d2 = 0.0f;     ///< squared distance from x to y
+  };
+
+  /// A point on an emitter chosen by power (sample_light()) and where it lies from x; false
+  /// when it coincides with x.
+  bool sample_towards_light(const glm::vec3& x, detail::Rng& rng, LightSample& s) const {
+    s.light = &sample_light(rng, s.y);
+    const glm::vec3 w = s.y - x;
+    s.d2 = glm::dot(w, w);
+    if (!(s.d2 > 0.0f)) return false;
+    s.wi = w / std::sqrt(s.d2);
+    return true;
+  }
+
   /// Next-event estimate of the light reflected at x towards the previous vertex, divided by
   /// the throughput: one point on one emitter, MIS-weighted against the cosine bounce.
   Rgb direct_light(const glm::vec3& x, const glm::vec3& offset_origin, const glm::vec3& n, const Rgb& rho,
                    detail::Rng& rng) const {
-    glm::vec3 y;
-    const Surface& light = sample_light(rng, y);
-
-    const glm::vec3 w = y - x;
-    const float d2 = glm::dot(w, w);
-    if (!(d2 > 0.0f)) return Rgb(0.0f);
-    const glm::vec3 wi = w / std::sqrt(d2);
+    LightSample ls;
+    if (!sample_towards_light(x, rng, ls)) return Rgb(0.0f);
+    const Surface& light = *ls.light;
+    const glm::vec3 &y = ls.y, &wi = ls.wi;
+    const float d2 = ls.d2;
     glm::vec3 lit_side;
     const float cos_x = glm::dot(n, wi), cos_y = emitter_cosine(light, wi, lit_side);
     if (cos_x <= 0.0f || cos_y <= 0.0f) return Rgb(0.0f);
@@ -494,13 +511,11 @@ class PathTracer {
   /// shadow rays.
   template <class Bsdf>
   Rgb direct_light(const glm::vec3& x, const glm::vec3& normal, detail::Rng& rng, const Bsdf& bsdf) const {
-    glm::vec3 y;
-    const Surface& light = sample_light(rng, y);
-
-    const glm::vec3 w = y - x;
-    const float d2 = glm::dot(w, w);
-    if (!(d2 > 0.0f)) return Rgb(0.0f);
-    const glm::vec3 wi = w / std::sqrt(d2);
+    LightSample ls;
+    if (!sample_towards_light(x, rng, ls)) return Rgb(0.0f);
+    const Surface& light = *ls.light;
+    const glm::vec3 &y = ls.y, &wi = ls.wi;
+    const float d2 = ls.d2;
     Connection c;
     if (!connect(light, wi, wi, bsdf, c)) return Rgb(0.0f);
     const glm::vec3& lit_side = c.lit_side;
