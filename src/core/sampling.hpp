@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -18,6 +19,7 @@
 
 #include "core/assert.hpp"
 #include "core/constants.hpp"
+#include "core/rng.hpp"
 
 namespace radiosity::detail {
 
@@ -123,5 +125,24 @@ class CellSampler {
   float A_ = 0.0f, B_ = 0.0f, C_ = 0.0f;
   bool parallelogram_ = false;
 };
+
+/// Stratified points on [0,1]^2: a g x g grid (jittered, or cell centres) when count is a square
+/// g^2, otherwise `count` strata along u with random (or centred) v.
+inline void stratified(std::uint32_t count, Rng& rng, bool jitter, glm::vec2* out) {
+  auto g = static_cast<std::uint32_t>(std::lround(std::sqrt(static_cast<double>(count))));
+  if (g * g == count) {
+    for (std::uint32_t i = 0; i < g; ++i)
+      for (std::uint32_t k = 0; k < g; ++k) {
+        glm::vec2 u = jitter ? rng.uniform2() : glm::vec2(0.5f);
+        out[i * g + k] = glm::vec2((static_cast<float>(i) + u.x) / static_cast<float>(g),
+                                   (static_cast<float>(k) + u.y) / static_cast<float>(g));
+      }
+  } else {
+    for (std::uint32_t i = 0; i < count; ++i) {
+      glm::vec2 u = jitter ? rng.uniform2() : glm::vec2(0.5f);
+      out[i] = glm::vec2((static_cast<float>(i) + u.x) / static_cast<float>(count), u.y);
+    }
+  }
+}
 
 }  // namespace radiosity::detail

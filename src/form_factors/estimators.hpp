@@ -48,10 +48,6 @@ std::unique_ptr<FormFactorEstimator> make_monte_carlo_estimator(const Scene&, co
 /// ~1e-5 for the configurations of a patch hierarchy (falls back to double when x is a corner).
 float point_to_polygon_factor_fast(const glm::vec3& x, const glm::vec3& n, const glm::vec3* polygon, int vertex_count);
 
-class Rng;
-/// Stratified points on [0,1]^2: a g x g grid (jittered, or cell centres) when count is a square
-/// g^2, otherwise `count` strata along u with random (or centred) v.
-void stratified(std::uint32_t count, Rng& rng, bool jitter, glm::vec2* out);
 
 /// What a ray-cast (or analytic) estimator has done since it was made, for benchmarks.
 struct RayCastCounters {

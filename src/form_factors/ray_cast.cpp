@@ -47,23 +47,6 @@ FormFactorEstimator::~FormFactorEstimator() = default;
 
 namespace radiosity::detail {
 
-void stratified(std::uint32_t count, Rng& rng, bool jitter, glm::vec2* out) {
-  auto g = static_cast<std::uint32_t>(std::lround(std::sqrt(static_cast<double>(count))));
-  if (g * g == count) {
-    for (std::uint32_t i = 0; i < g; ++i)
-      for (std::uint32_t k = 0; k < g; ++k) {
-        glm::vec2 u = jitter ? rng.uniform2() : glm::vec2(0.5f);
-        out[i * g + k] = glm::vec2((static_cast<float>(i) + u.x) / static_cast<float>(g),
-                                   (static_cast<float>(k) + u.y) / static_cast<float>(g));
-      }
-  } else {
-    for (std::uint32_t i = 0; i < count; ++i) {
-      glm::vec2 u = jitter ? rng.uniform2() : glm::vec2(0.5f);
-      out[i] = glm::vec2((static_cast<float>(i) + u.x) / static_cast<float>(count), u.y);
-    }
-  }
-}
-
 namespace {
 
 // Gauss-Legendre 2x2 nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).

@@ -31,6 +31,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/rng.hpp"
+#include "core/sampling.hpp"
 #include "form_factors/estimators.hpp"
 #include "geometry/ray_scene.hpp"
 
