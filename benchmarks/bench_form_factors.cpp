@@ -148,6 +148,7 @@ double bare_rays_per_second(const detail::RayScene& rs, const RaySet& rays, unsi
 // All rows of the scene with the ray-cast estimator; returns rays per second.
 double ray_cast_rows(const rad::Scene& scene, const rad::PatchHierarchy& h, unsigned threads, double bare) {
   rad::FormFactorOptions o;
+  o.method = rad::FormFactorMethod::ray_cast;  // the default (automatic) would pick monte_carlo here
   o.threads = threads;
   const auto est = rad::make_form_factor_estimator(scene, h, o);
   const std::size_t m = h.leaves().size(), n = h.patches().size();

@@ -25,11 +25,17 @@ inline int thread_count(unsigned requested) {
 /// The process's arena of `n` threads. Arenas are never destroyed: a static destructor could
 /// run after oneTBB's own shutdown. Thread safety: may be called concurrently.
 inline tbb::task_arena& arena_of(int n) {
+  // Most calls ask for the count the thread asked for last: no lock then.
+  thread_local int last_count = 0;
+  thread_local tbb::task_arena* last_arena = nullptr;
+  if (n == last_count) return *last_arena;
   static std::mutex mutex;
   static std::map<int, tbb::task_arena*> arenas;
   const std::lock_guard<std::mutex> lock(mutex);
   tbb::task_arena*& arena = arenas[n];
   if (arena == nullptr) arena = new tbb::task_arena(n);
+  last_count = n;
+  last_arena = arena;
   return *arena;
 }
 
@@ -39,7 +45,8 @@ template <typename Body>
 void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const Body& body) {
   if (count == 0) return;
   const int n = thread_count(threads);
-  if (n == 1) {
+  // One thread, or one chunk: nothing to share out (nested calls are often this small).
+  if (n == 1 || count <= grain) {
     body(std::size_t{0}, count);
     return;
   }
