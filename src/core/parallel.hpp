@@ -22,15 +22,17 @@ inline int thread_count(unsigned requested) {
   return std::max(1, static_cast<int>(tbb::this_task_arena::max_concurrency()));
 }
 
-/// The process's arena of `n` threads. Arenas are never destroyed: a static destructor could
-/// run after oneTBB's own shutdown. Thread safety: may be called concurrently.
+/// The process's arena of `n` threads. Arenas are never destroyed (nor is the map that holds
+/// them, so they stay reachable for leak checkers): a static destructor could run after
+/// oneTBB's own shutdown, or while a detached thread still uses one. Thread safety: may be
+/// called concurrently.
 inline tbb::task_arena& arena_of(int n) {
   // Most calls ask for the count the thread asked for last: no lock then.
   thread_local int last_count = 0;
   thread_local tbb::task_arena* last_arena = nullptr;
   if (n == last_count) return *last_arena;
   static std::mutex mutex;
-  static std::map<int, tbb::task_arena*> arenas;
+  static std::map<int, tbb::task_arena*>& arenas = *new std::map<int, tbb::task_arena*>();
   const std::lock_guard<std::mutex> lock(mutex);
   tbb::task_arena*& arena = arenas[n];
   if (arena == nullptr) arena = new tbb::task_arena(n);

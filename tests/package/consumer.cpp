@@ -1,7 +1,9 @@
-// Links the installed library, checks header/binary versions agree and runs a coarse Cornell box.
+// Links the installed library, checks header/binary versions agree and runs a coarse Cornell box,
+// once by solve() and once relit through a kept Problem.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 #include <radiosity/radiosity.hpp>
 
@@ -18,5 +20,15 @@ int main() {
   radiosity::Rgb floor = sol.group_radiosity("floor");
   std::printf("consumer: radiosity %s, floor B = (%.4g, %.4g, %.4g)\n", radiosity::version(),
               floor.x, floor.y, floor.z);
-  return (floor.x > 0.0f && std::isfinite(floor.x)) ? 0 : 1;
+  if (!(floor.x > 0.0f && std::isfinite(floor.x))) return 1;
+
+  // The kept stages: a Problem relit with the light at twice its emission gives twice the
+  // radiosity (linearity), through the installed headers and binary.
+  radiosity::Problem problem(scene, opt);
+  std::vector<radiosity::Rgb> emission(scene.polygons().size(), radiosity::Rgb(0.0f));
+  for (std::size_t p = 0; p < emission.size(); ++p)
+    emission[p] = 2.0f * scene.material(scene.polygons()[p].material).emission;
+  const radiosity::Rgb relit = problem.solve(emission).group_radiosity("floor");
+  std::printf("consumer: relit at 2x, floor B = (%.4g, %.4g, %.4g)\n", relit.x, relit.y, relit.z);
+  return std::fabs(relit.x / floor.x - 2.0f) < 1e-3f ? 0 : 1;
 }
