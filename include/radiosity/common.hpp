@@ -18,6 +18,9 @@ static_assert(sizeof(glm::vec3) == 12, "radiosity requires glm::vec3 to be three
 namespace radiosity {
 inline namespace v1 {
 
+/// Marks "no element / vertex / polygon" wherever an index may be absent.
+inline constexpr std::uint32_t kNone = 0xffffffffu;
+
 /// Linear RGB triple. Radiosity, emission (W/m^2) and reflectance are always solved for
 /// R, G and B together.
 using Rgb = glm::vec3;

@@ -13,18 +13,6 @@
 namespace radiosity {
 inline namespace v1 {
 
-/// How forgiving the scene readers are (load_scene(), parse_scene_json()).
-struct LoadOptions {
-  /// false (the default): the readers step over what a renderer would and say so, each kind of
-  /// problem in one warning in Scene::warnings() (how many, the first "file:line: ", the next
-  /// few places): degenerate (zero-area) faces and faces of fewer than 3 vertices are dropped;
-  /// a diffuse reflectance of 1 or more is clamped to 0.99 and Kd + Ks above 0.99 scaled down;
-  /// negative colours are clamped to 0; a missing MTL file or an undefined material gives the
-  /// default grey; non-planar or non-convex faces are triangulated. true: each such problem
-  /// is an Error naming the file and line instead, so a loaded scene has no warnings.
-  bool strict = false;
-};
-
 /// Loads a scene, choosing the reader by extension (.obj with its .mtl files, .json).
 /// OBJ: `o`/`g` names become groups, `Kd` the diffuse reflectance, `Ke` emitted radiance (so
 /// E = pi * Ke); without materials everything is grey 0.5. MTL `illum` modes map as the format

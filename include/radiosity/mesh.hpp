@@ -17,9 +17,6 @@
 namespace radiosity {
 inline namespace v1 {
 
-/// Marks "no element / no vertex".
-inline constexpr std::uint32_t kNone = 0xffffffffu;
-
 /// How finely polygons are meshed. Areas are in scene units squared; 0 means "derive from the
 /// scene": max_patch_area = total area / 512 and max_element_area = max_patch_area / 4, which
 /// gives the default Cornell box a few hundred patches and a few thousand elements. A derived

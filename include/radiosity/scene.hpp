@@ -1,6 +1,7 @@
 // Scenes: planar polygons with materials, grouped by name, and a camera.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "radiosity/common.hpp"
@@ -21,6 +23,7 @@ class Brdf;  // brdf.hpp; only the two-pass compositor evaluates it
 using MaterialId = std::uint32_t;
 using GroupId = std::uint32_t;
 using PolygonId = std::uint32_t;
+using MeshId = std::uint32_t;
 
 /// Surface description. The diffuse part (emission, reflectance, diffuse transmittance) drives
 /// radiosity; the specular parts are for the extended first pass and the ray-traced second pass.
@@ -43,6 +46,13 @@ struct Material {
   std::shared_ptr<const Brdf> brdf;
 };
 
+/// The polygons that one add_polygon() call produced: more than one when the input had to be
+/// triangulated.
+struct PolygonRange {
+  PolygonId first = 0;
+  std::uint32_t count = 0;
+};
+
 /// A planar convex polygon as stored in a Scene (after validation and any triangulation).
 struct Polygon {
   std::vector<glm::vec3> vertices;  ///< counter-clockwise seen from the front
@@ -50,6 +60,53 @@ struct Polygon {
   float area = 0.0f;
   MaterialId material = 0;
   GroupId group = 0;
+  MeshId mesh = kNone;                ///< the mesh it came from (Scene::add_mesh()), or kNone
+  std::uint32_t mesh_triangle = kNone;  ///< its triangle's index in that mesh, or kNone
+};
+
+/// How forgiving the scene readers are (load_scene(), parse_scene_json()) and
+/// Scene::add_mesh().
+struct LoadOptions {
+  /// false (the default): the readers step over what a renderer would and say so, each kind of
+  /// problem in one warning in Scene::warnings() (how many, the first "file:line: ", the next
+  /// few places): degenerate (zero-area) faces and faces of fewer than 3 vertices are dropped;
+  /// a diffuse reflectance of 1 or more is clamped to 0.99 and Kd + Ks above 0.99 scaled down;
+  /// negative colours are clamped to 0; a missing MTL file or an undefined material gives the
+  /// default grey; non-planar or non-convex faces are triangulated. true: each such problem
+  /// is an Error naming the file and line instead, so a loaded scene has no warnings.
+  bool strict = false;
+};
+
+/// An indexed triangle mesh as a host renderer holds it, in meshoptimizer's pointer-and-count
+/// style: Scene::add_mesh() reads the arrays during the call and keeps no pointer. The optional
+/// arrays are null when absent; each has vertex_count entries (triangle_materials has
+/// index_count / 3). Positions are in scene units; triangles are counter-clockwise seen from
+/// their front.
+struct MeshDesc {
+  const glm::vec3* positions = nullptr;
+  std::size_t vertex_count = 0;
+  const std::uint32_t* indices = nullptr;  ///< three per triangle, into positions
+  std::size_t index_count = 0;             ///< a multiple of 3
+  MaterialId material = 0;                 ///< of every triangle, unless triangle_materials is given
+  const MaterialId* triangle_materials = nullptr;  ///< per triangle; overrides `material`
+  std::string_view group;                  ///< the group of every triangle; empty means "default"
+  const glm::vec3* normals = nullptr;      ///< per vertex (shading normals; kept, not used by radiosity)
+  const glm::vec2* uv0 = nullptr;          ///< per vertex: texture coordinates
+  const glm::vec2* uv1 = nullptr;          ///< per vertex: lightmap coordinates
+};
+
+/// What a Scene keeps of a mesh given to add_mesh(): copies of the host's arrays in its own
+/// order, and where each triangle went, so results can be handed back on the host's vertices
+/// and triangles.
+struct Mesh {
+  GroupId group = 0;
+  std::vector<glm::vec3> positions;    ///< vertex_count entries
+  std::vector<std::uint32_t> indices;  ///< three per triangle, as given
+  std::vector<glm::vec3> normals;      ///< empty when the host gave none
+  std::vector<glm::vec2> uv0, uv1;     ///< empty when absent
+  /// Per triangle: the polygon it became, or kNone when it was skipped (degenerate).
+  std::vector<PolygonId> triangle_polygon;
+  PolygonRange polygons;               ///< the polygons of its triangles, consecutive
 };
 
 /// Pinhole camera. `fov_deg` is the vertical field of view in degrees.
@@ -67,12 +124,6 @@ struct Bounds {
   float diagonal() const;
 };
 
-/// The polygons that one add_polygon() call produced: more than one when the input had to be
-/// triangulated.
-struct PolygonRange {
-  PolygonId first = 0;
-  std::uint32_t count = 0;
-};
 
 /// Polygons, materials, groups and a camera. Everything is validated on entry, so a Scene that
 /// exists is usable by every solver.
@@ -94,6 +145,19 @@ class RADIOSITY_API Scene {
   /// a zero-area (degenerate) polygon, or Error{invalid_argument} for an unknown material id.
   PolygonRange add_polygon(const std::vector<glm::vec3>& vertices, MaterialId material,
                            std::string_view group = {});
+
+  /// Adds an indexed triangle mesh: one polygon per triangle (Polygon::mesh and mesh_triangle
+  /// say where it came from), with copies of the host's arrays in meshes(). Cost: linear, a few
+  /// reallocations of the scene's arrays, no allocation per triangle beyond the polygon itself.
+  /// Throws Error{invalid_argument} naming the mesh for an index_count that is not a multiple
+  /// of 3, a null array whose count is not 0, or an unknown material id (naming the triangle);
+  /// Error{invalid_scene} naming the mesh and the vertex or triangle for a NaN or infinite
+  /// value or an index out of range. A degenerate (zero-area) triangle is skipped, and all of a
+  /// mesh's skipped triangles listed by index in one warning (warnings()); with
+  /// options.strict it is an Error{invalid_scene} instead. When it throws the scene is
+  /// unchanged. Thread safety: mutates the scene.
+  MeshId add_mesh(const MeshDesc& mesh, const LoadOptions& options = {});
+  const std::vector<Mesh>& meshes() const { return meshes_; }
 
   /// Makes every material two-sided (Material::two_sided), for models whose winding cannot be
   /// trusted (CLI `--two-sided`): a closed room wound outwards then lights its inside. Costs a
@@ -123,6 +187,7 @@ class RADIOSITY_API Scene {
 
   std::vector<Material> materials_;
   std::vector<Polygon> polygons_;
+  std::vector<Mesh> meshes_;
   std::vector<std::string> groups_;
   std::optional<Camera> camera_;
   std::vector<std::string> warnings_;

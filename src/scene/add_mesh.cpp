@@ -1,0 +1,138 @@
+// Scene::add_mesh(): a host's indexed triangle mesh in, one polygon per triangle, with the
+// host's arrays kept so that results can go back onto its own vertices and triangles. The
+// rules are the readers' (LoadOptions): what cannot mean anything (an index out of range, a NaN)
+// is an error naming mesh and vertex or triangle; a degenerate triangle is skipped and reported
+// with the others of its mesh in one warning, or refused under strict.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "radiosity/scene.hpp"
+#include "scene/polygon_math.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+/// "5, 17 and 230" or "5, 17, 230, ... and 12 more".
+std::string index_list(const std::vector<std::uint32_t>& ids) {
+  constexpr std::size_t kShown = 8;
+  std::string s;
+  for (std::size_t k = 0; k < ids.size() && k < kShown; ++k) {
+    if (k > 0) s += (k + 1 == ids.size()) ? " and " : ", ";
+    s += std::to_string(ids[k]);
+  }
+  if (ids.size() > kShown) s += " and " + std::to_string(ids.size() - kShown) + " more";
+  return s;
+}
+
+}  // namespace
+
+MeshId Scene::add_mesh(const MeshDesc& desc, const LoadOptions& options) {
+  const auto id = static_cast<MeshId>(meshes_.size());
+  const std::string where =
+      "mesh " + std::to_string(id) + " (group '" + std::string(desc.group.empty() ? "default" : desc.group) + "')";
+  auto fail = [&](ErrorCode code, const std::string& problem) { throw Error(code, "add_mesh: " + where + ": " + problem); };
+
+  // The arrays and counts, before anything is read.
+  if (desc.index_count % 3 != 0)
+    fail(ErrorCode::invalid_argument, "index_count " + std::to_string(desc.index_count) + " is not a multiple of 3");
+  if (desc.vertex_count > 0 && desc.positions == nullptr)
+    fail(ErrorCode::invalid_argument, "positions is null but vertex_count is " + std::to_string(desc.vertex_count));
+  if (desc.index_count > 0 && desc.indices == nullptr)
+    fail(ErrorCode::invalid_argument, "indices is null but index_count is " + std::to_string(desc.index_count));
+  if (desc.vertex_count >= kNone)
+    fail(ErrorCode::invalid_argument, "vertex_count " + std::to_string(desc.vertex_count) +
+                                          " exceeds what 32-bit indices can address");
+  if (desc.triangle_materials == nullptr && desc.material >= materials_.size())
+    fail(ErrorCode::invalid_argument, "material id " + std::to_string(desc.material) + " does not exist (scene has " +
+                                          std::to_string(materials_.size()) + " materials)");
+  const std::size_t vertex_count = desc.vertex_count, triangles = desc.index_count / 3;
+  if (polygons_.size() + triangles >= kNone)
+    fail(ErrorCode::invalid_argument, std::to_string(triangles) + " triangles would exceed 32-bit polygon ids");
+
+  for (std::size_t v = 0; v < vertex_count; ++v) {
+    auto check = [&](bool ok, const char* what) {
+      if (!ok) fail(ErrorCode::invalid_scene, std::string(what) + " of vertex " + std::to_string(v) + " is NaN or infinite");
+    };
+    check(finite(desc.positions[v]), "the position");
+    if (desc.normals) check(finite(desc.normals[v]), "the normal");
+    if (desc.uv0) check(finite(desc.uv0[v]), "uv0");
+    if (desc.uv1) check(finite(desc.uv1[v]), "uv1");
+  }
+
+  Mesh mesh;
+  mesh.positions.assign(desc.positions, desc.positions + vertex_count);
+  mesh.indices.assign(desc.indices, desc.indices + desc.index_count);
+  if (desc.normals) mesh.normals.assign(desc.normals, desc.normals + vertex_count);
+  if (desc.uv0) mesh.uv0.assign(desc.uv0, desc.uv0 + vertex_count);
+  if (desc.uv1) mesh.uv1.assign(desc.uv1, desc.uv1 + vertex_count);
+  mesh.triangle_polygon.assign(triangles, kNone);
+
+  // Polygons go straight into the scene; on an error they (and a group made for this mesh) are
+  // taken back, so a throwing call leaves the scene as it was.
+  const std::size_t first_polygon = polygons_.size(), groups_before = groups_.size();
+  std::vector<std::uint32_t> degenerate;
+  try {
+    mesh.group = intern_group(desc.group);
+    // Geometric growth: many small meshes must not reallocate on every call.
+    if (polygons_.capacity() < polygons_.size() + triangles)
+      polygons_.reserve(std::max(polygons_.size() + triangles, 2 * polygons_.capacity()));
+    for (std::size_t t = 0; t < triangles; ++t) {
+      const std::uint32_t* corner = mesh.indices.data() + 3 * t;
+      for (int k = 0; k < 3; ++k)
+        if (corner[k] >= vertex_count)
+          fail(ErrorCode::invalid_scene, "triangle " + std::to_string(t) + ": index " + std::to_string(corner[k]) +
+                                             " is out of range (" + std::to_string(vertex_count) + " vertices)");
+      const MaterialId material = desc.triangle_materials ? desc.triangle_materials[t] : desc.material;
+      if (material >= materials_.size())
+        fail(ErrorCode::invalid_argument, "triangle " + std::to_string(t) + ": material id " + std::to_string(material) +
+                                              " does not exist (scene has " + std::to_string(materials_.size()) +
+                                              " materials)");
+      const glm::vec3 &p0 = mesh.positions[corner[0]], &p1 = mesh.positions[corner[1]], &p2 = mesh.positions[corner[2]];
+      // add_polygon()'s test: area against the diameter squared.
+      const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
+      const float area = 0.5f * glm::length(n);
+      const float diameter = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
+      if (!(area > detail::kDegenerateAreaRatio * diameter * diameter)) {
+        degenerate.push_back(static_cast<std::uint32_t>(t));
+        continue;
+      }
+      Polygon polygon;
+      polygon.vertices = {p0, p1, p2};
+      polygon.normal = n / (2.0f * area);
+      polygon.area = area;
+      polygon.material = material;
+      polygon.group = mesh.group;
+      polygon.mesh = id;
+      polygon.mesh_triangle = static_cast<std::uint32_t>(t);
+      mesh.triangle_polygon[t] = static_cast<PolygonId>(polygons_.size());
+      polygons_.push_back(std::move(polygon));
+    }
+    if (!degenerate.empty() && options.strict)
+      fail(ErrorCode::invalid_scene, "triangle " + std::to_string(degenerate.front()) + " is degenerate (zero area)" +
+                                         (degenerate.size() > 1
+                                              ? " (" + std::to_string(degenerate.size() - 1) + " more degenerate triangles)"
+                                              : std::string()));
+  } catch (...) {
+    polygons_.resize(first_polygon);
+    groups_.resize(groups_before);
+    throw;
+  }
+  if (!degenerate.empty())
+    add_warning(where + ": " + std::to_string(degenerate.size()) + " degenerate (zero-area) triangle" +
+                (degenerate.size() > 1 ? "s" : "") + " skipped: " + index_list(degenerate));
+  mesh.polygons = PolygonRange{static_cast<PolygonId>(first_polygon),
+                               static_cast<std::uint32_t>(polygons_.size() - first_polygon)};
+  meshes_.push_back(std::move(mesh));
+  return id;
+}
+
+}  // namespace v1
+}  // namespace radiosity

@@ -1,0 +1,193 @@
+// Scene::add_mesh(): a host's indexed mesh becomes one polygon per triangle, with the host's
+// arrays kept and each triangle's polygon recorded; bad input follows the readers' rules
+// (errors naming mesh and vertex or triangle, degenerate triangles skipped with one warning or
+// refused under strict, the scene unchanged by a throwing call); and a mesh lights exactly as
+// the same triangles given one add_polygon() at a time.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <radiosity/radiosity.hpp>
+
+namespace rad = radiosity;
+
+namespace {
+
+/// The host's side: a unit quad in z = 0 facing +z as two triangles sharing an edge, plus a
+/// third, degenerate one (its corners on a line).
+struct HostMesh {
+  std::vector<glm::vec3> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0}};
+  std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3, 0, 1, 4};
+  std::vector<glm::vec2> uv1{{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}};
+
+  rad::MeshDesc desc(rad::MaterialId material) const {
+    rad::MeshDesc d;
+    d.positions = positions.data();
+    d.vertex_count = positions.size();
+    d.indices = indices.data();
+    d.index_count = indices.size();
+    d.material = material;
+    d.group = "quad";
+    d.uv1 = uv1.data();
+    return d;
+  }
+};
+
+std::string error_of(rad::Scene& scene, const rad::MeshDesc& desc, bool strict = false) {
+  try {
+    scene.add_mesh(desc, rad::LoadOptions{strict});
+  } catch (const rad::Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_SUITE("scene") {
+  TEST_CASE("add_mesh: one polygon per triangle, the host's arrays kept, the degenerate triangle skipped and reported") {
+    rad::Scene scene;
+    const rad::MaterialId m = scene.add_material(rad::Material{});
+    HostMesh host;
+    const rad::MeshId id = scene.add_mesh(host.desc(m));
+    CHECK(id == 0);
+    // The host may free or reuse its buffers: the scene keeps copies.
+    host.positions.assign(host.positions.size(), glm::vec3(9.0f));
+
+    REQUIRE(scene.polygons().size() == 2);
+    REQUIRE(scene.meshes().size() == 1);
+    const rad::Mesh& mesh = scene.meshes()[0];
+    CHECK(mesh.positions.size() == 5);
+    CHECK(mesh.positions[2] == glm::vec3(1, 1, 0));
+    CHECK(mesh.indices.size() == 9);
+    CHECK(mesh.uv1.size() == 5);
+    CHECK(mesh.uv0.empty());
+    CHECK(mesh.normals.empty());
+    CHECK(mesh.triangle_polygon == std::vector<rad::PolygonId>{0, 1, rad::kNone});
+    CHECK(mesh.polygons.first == 0);
+    CHECK(mesh.polygons.count == 2);
+    CHECK(scene.groups()[mesh.group] == "quad");
+    for (rad::PolygonId p = 0; p < 2; ++p) {
+      const rad::Polygon& polygon = scene.polygons()[p];
+      CHECK(polygon.mesh == 0);
+      CHECK(polygon.mesh_triangle == p);
+      CHECK(polygon.area == doctest::Approx(0.5));
+      CHECK(polygon.normal.z == doctest::Approx(1.0));
+      CHECK(polygon.group == mesh.group);
+    }
+    CHECK(scene.polygons()[1].vertices == std::vector<glm::vec3>{{0, 0, 0}, {1, 1, 0}, {0, 1, 0}});
+    CHECK(scene.total_area() == doctest::Approx(1.0));
+    REQUIRE(scene.warnings().size() == 1);
+    CHECK(scene.warnings()[0] == "mesh 0 (group 'quad'): 1 degenerate (zero-area) triangle skipped: 2");
+  }
+
+  TEST_CASE("add_mesh: triangle_materials override the mesh's material") {
+    rad::Scene scene;
+    const rad::MaterialId grey = scene.add_material(rad::Material{});
+    rad::Material lamp;
+    lamp.emission = rad::Rgb(5.0f);
+    const rad::MaterialId light = scene.add_material(lamp);
+    HostMesh host;
+    const std::vector<rad::MaterialId> per_triangle{light, grey, grey};
+    rad::MeshDesc desc = host.desc(grey);
+    desc.triangle_materials = per_triangle.data();
+    desc.material = 99;  // ignored when per-triangle materials are given
+    scene.add_mesh(desc);
+    CHECK(scene.polygons()[0].material == light);
+    CHECK(scene.polygons()[1].material == grey);
+  }
+
+  TEST_CASE("add_mesh: bad input is an error naming the mesh and the vertex or triangle, and leaves the scene unchanged") {
+    rad::Scene scene;
+    const rad::MaterialId m = scene.add_material(rad::Material{});
+    HostMesh good;
+    scene.add_mesh(good.desc(m));  // mesh 0, so the failing ones below are mesh 1
+    const std::size_t polygons = scene.polygons().size(), groups = scene.groups().size();
+
+    HostMesh host;
+    host.indices[4] = 7;
+    rad::MeshDesc bad_index = host.desc(m);
+    bad_index.group = "new group";
+    CHECK(error_of(scene, bad_index) ==
+          "add_mesh: mesh 1 (group 'new group'): triangle 1: index 7 is out of range (5 vertices)");
+
+    HostMesh nan;
+    nan.positions[3].y = std::nanf("");
+    CHECK(error_of(scene, nan.desc(m)) == "add_mesh: mesh 1 (group 'quad'): the position of vertex 3 is NaN or infinite");
+    HostMesh inf_uv;
+    inf_uv.uv1[1].x = INFINITY;
+    CHECK(contains(error_of(scene, inf_uv.desc(m)), "uv1 of vertex 1 is NaN or infinite"));
+
+    rad::MeshDesc short_indices = good.desc(m);
+    short_indices.index_count = 8;
+    CHECK(contains(error_of(scene, short_indices), "index_count 8 is not a multiple of 3"));
+    rad::MeshDesc null_positions = good.desc(m);
+    null_positions.positions = nullptr;
+    CHECK(contains(error_of(scene, null_positions), "positions is null but vertex_count is 5"));
+    rad::MeshDesc unknown_material = good.desc(7);
+    CHECK(contains(error_of(scene, unknown_material), "material id 7 does not exist (scene has 1 materials)"));
+    const std::vector<rad::MaterialId> per_triangle{0, 3, 0};
+    rad::MeshDesc unknown_triangle_material = good.desc(m);
+    unknown_triangle_material.triangle_materials = per_triangle.data();
+    CHECK(contains(error_of(scene, unknown_triangle_material), "triangle 1: material id 3 does not exist"));
+
+    // Strict: the degenerate triangle is refused instead of skipped.
+    CHECK(error_of(scene, good.desc(m), true) == "add_mesh: mesh 1 (group 'quad'): triangle 2 is degenerate (zero area)");
+
+    CHECK(scene.polygons().size() == polygons);
+    CHECK(scene.groups().size() == groups);
+    CHECK(scene.meshes().size() == 1);
+    CHECK(scene.warnings().size() == 1);  // mesh 0's
+    // An empty mesh is no error: it adds no polygon.
+    const rad::MeshId empty = scene.add_mesh(rad::MeshDesc{});
+    CHECK(scene.meshes()[empty].polygons.count == 0);
+  }
+
+  TEST_CASE("add_mesh: a closed box as one indexed mesh lights exactly as the same triangles added one by one") {
+    // A unit cube facing inwards, 8 shared corners and 12 triangles; its floor emits.
+    const std::vector<glm::vec3> corners{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                         {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    // Each face counter-clockwise seen from inside the box.
+    const std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
+                                             3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2};
+    rad::Material wall, lamp;
+    wall.reflectance = rad::Rgb(0.6f, 0.5f, 0.4f);
+    lamp.reflectance = rad::Rgb(0.3f);
+    lamp.emission = rad::Rgb(4.0f);
+    std::vector<rad::MaterialId> materials(12, 0);
+    materials[0] = materials[1] = 1;  // the z = 0 face
+
+    rad::Scene as_mesh, as_polygons;
+    for (rad::Scene* s : {&as_mesh, &as_polygons}) {
+      s->add_material(wall);
+      s->add_material(lamp);
+    }
+    rad::MeshDesc desc;
+    desc.positions = corners.data();
+    desc.vertex_count = corners.size();
+    desc.indices = indices.data();
+    desc.index_count = indices.size();
+    desc.triangle_materials = materials.data();
+    desc.group = "box";
+    as_mesh.add_mesh(desc);
+    for (std::size_t t = 0; t < 12; ++t)
+      as_polygons.add_polygon({corners[indices[3 * t]], corners[indices[3 * t + 1]], corners[indices[3 * t + 2]]},
+                              materials[t], "box");
+    REQUIRE(as_mesh.polygons().size() == 12);
+    for (std::size_t p = 0; p < 12; ++p) {
+      CHECK(as_mesh.polygons()[p].vertices == as_polygons.polygons()[p].vertices);
+      CHECK(as_mesh.polygons()[p].normal == as_polygons.polygons()[p].normal);
+      CHECK(as_mesh.polygons()[p].area == as_polygons.polygons()[p].area);
+    }
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 0.1f;
+    const rad::Solution a = rad::solve(as_mesh, o), b = rad::solve(as_polygons, o);
+    CHECK(a.radiosity() == b.radiosity());
+    // A closed box loses nothing: what is emitted is absorbed, within the solver's tolerance.
+    CHECK(std::fabs(a.report().escaped_power.x) < 1e-2 * a.report().emitted_power.x);
+  }
+}
