@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/distribution.hpp"
+#include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
 
@@ -21,7 +22,7 @@ namespace radiosity::detail {
 /// Thread safety: immutable after construction.
 struct PolygonFan {
   PolygonFan() = default;
-  explicit PolygonFan(const std::vector<glm::vec3>& vertices) {
+  explicit PolygonFan(const PolygonVertices& vertices) {
     float area = 0.0f;
     for (std::size_t k = 1; k + 1 < vertices.size(); ++k) {
       a.push_back(vertices[0]);

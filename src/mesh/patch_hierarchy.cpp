@@ -142,7 +142,7 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
   const std::vector<Polygon>& polygons = scene.polygons();
   for (PolygonId id = 0; id < polygons.size(); ++id) {
     const Polygon& polygon = polygons[id];
-    const std::vector<glm::vec3>& p = polygon.vertices;
+    const PolygonVertices& p = polygon.vertices;
     if (p.size() == 4) {
       mesh_quad(id, polygon);
     } else if (p.size() == 3) {
@@ -222,7 +222,7 @@ void PatchHierarchy::add_patch(PolygonId polygon_id, const Polygon& polygon,
 }
 
 void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon) {
-  const std::vector<glm::vec3>& p = polygon.vertices;
+  const PolygonVertices& p = polygon.vertices;
   const glm::dvec3 p0(p[0]), p1(p[1]), p2(p[2]), p3(p[3]);
   // Bilinear map P(s,t) = (1-s)(1-t)p0 + s(1-t)p1 + st p2 + (1-s)t p3; for a planar convex quad
   // its iso-lines are straight, so the grid cells are planar convex quads.

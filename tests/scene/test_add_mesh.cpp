@@ -191,3 +191,37 @@ TEST_SUITE("scene") {
     CHECK(std::fabs(a.report().escaped_power.x) < 1e-2 * a.report().emitted_power.x);
   }
 }
+
+TEST_SUITE("scene") {
+  TEST_CASE("PolygonVertices: up to four corners inline, more on the heap, read and compared like a vector") {
+    const std::vector<glm::vec3> quad{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    std::vector<glm::vec3> hexagon;
+    for (int k = 0; k < 6; ++k)
+      hexagon.emplace_back(std::cos(1.0471976f * static_cast<float>(k)), std::sin(1.0471976f * static_cast<float>(k)), 0.0f);
+    const rad::PolygonVertices a(quad), b(hexagon), c{quad[0], quad[1], quad[2]};
+    CHECK(a.size() == 4);
+    CHECK(b.size() == 6);
+    CHECK(c.size() == 3);
+    CHECK(a == quad);
+    CHECK(b == hexagon);
+    CHECK(a != b);
+    CHECK(static_cast<std::vector<glm::vec3>>(b) == hexagon);
+    CHECK(b.back() == hexagon.back());
+    std::size_t n = 0;
+    for (const glm::vec3& v : b) CHECK(v == hexagon[n++]);
+    CHECK(n == 6);
+    // Copies are deep, moves keep the corners.
+    rad::PolygonVertices copy = b;
+    copy[0] = glm::vec3(5.0f);
+    CHECK(b[0] == hexagon[0]);
+    std::vector<glm::vec3> to_move = hexagon;
+    const rad::PolygonVertices moved(std::move(to_move));
+    CHECK(moved == hexagon);
+    // A scene keeps a hexagon as one polygon with its six corners.
+    rad::Scene scene;
+    scene.add_polygon(hexagon, scene.add_material(rad::Material{}));
+    REQUIRE(scene.polygons().size() == 1);
+    CHECK(scene.polygons()[0].vertices == hexagon);
+    CHECK(scene.polygons()[0].area == doctest::Approx(1.5 * std::sqrt(3.0)).epsilon(1e-5));
+  }
+}
