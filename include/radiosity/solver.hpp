@@ -172,7 +172,8 @@ RADIOSITY_API void validate(const SolveOptions& options);
 ///   E[lamp] = Rgb(10.0f);
 ///   Solution relit = problem.solve(E);                 // same form factors, new emission
 ///
-/// `scene` must outlive the Problem and must not change while it lives. Move-only.
+/// `scene` must outlive the Problem and must not change while it lives. Move-only; a
+/// moved-from Problem may only be assigned to or destroyed.
 /// Thread safety: solve() needs exclusive access (it may refine the hierarchy and adds factors);
 /// const member functions may be called concurrently with each other.
 class RADIOSITY_API Problem {
@@ -180,6 +181,8 @@ class RADIOSITY_API Problem {
   /// Validates `options` (validate()) and meshes the scene (PatchHierarchy(scene, options.mesh)).
   /// Throws as solve(scene, options) does for bad options and a scene without polygons.
   explicit Problem(const Scene& scene, const SolveOptions& options = {});
+  /// A Problem keeps a reference to its scene, so a temporary one cannot be given.
+  explicit Problem(Scene&& scene, const SolveOptions& options = {}) = delete;
   ~Problem();
   Problem(Problem&&) noexcept;
   Problem& operator=(Problem&&) noexcept;

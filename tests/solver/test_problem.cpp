@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <radiosity/radiosity.hpp>
@@ -181,6 +182,10 @@ TEST_SUITE("solver") {
     std::vector<rad::Rgb> nan(scene.polygons().size(), rad::Rgb(0.0f));
     nan[0].z = std::nanf("");
     CHECK(message(nan).find("polygon_emission[0]") != std::string::npos);
-    CHECK_THROWS_AS(rad::Problem(rad::Scene{}), rad::Error);
+    const rad::Scene empty;
+    CHECK_THROWS_AS(rad::Problem{empty}, rad::Error);
+    // A temporary scene would dangle: that constructor is deleted.
+    static_assert(!std::is_constructible_v<rad::Problem, rad::Scene&&>);
+    static_assert(std::is_constructible_v<rad::Problem, const rad::Scene&>);
   }
 }
