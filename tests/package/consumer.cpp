@@ -1,6 +1,7 @@
 // Links the installed library, checks header/binary versions agree and runs a coarse Cornell box,
-// once by solve() and once relit through a kept Problem.
+// once by solve() and once relit through a kept Problem, and adds a host's indexed mesh.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -30,5 +31,20 @@ int main() {
     emission[p] = 2.0f * scene.material(scene.polygons()[p].material).emission;
   const radiosity::Rgb relit = problem.solve(emission).group_radiosity("floor");
   std::printf("consumer: relit at 2x, floor B = (%.4g, %.4g, %.4g)\n", relit.x, relit.y, relit.z);
-  return std::fabs(relit.x / floor.x - 2.0f) < 1e-3f ? 0 : 1;
+  if (!(std::fabs(relit.x / floor.x - 2.0f) < 1e-3f)) return 1;
+
+  // A host's indexed mesh through the MeshDesc contract: a quad as two triangles.
+  const glm::vec3 positions[] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const std::uint32_t indices[] = {0, 1, 2, 0, 2, 3};
+  radiosity::Scene host;
+  radiosity::MeshDesc mesh;
+  mesh.positions = positions;
+  mesh.vertex_count = 4;
+  mesh.indices = indices;
+  mesh.index_count = 6;
+  mesh.material = host.add_material(radiosity::Material{});
+  mesh.group = "quad";
+  const radiosity::MeshId id = host.add_mesh(mesh);
+  std::printf("consumer: mesh %u gave %zu polygons of total area %.3g\n", id, host.polygons().size(), host.total_area());
+  return host.polygons().size() == 2 && std::fabs(host.total_area() - 1.0) < 1e-6 ? 0 : 1;
 }
