@@ -97,10 +97,12 @@ class RADIOSITY_API Solution {
   /// nodes included); `ambient_radiosity` is reflectance x ambient per element (reflectance +
   /// diffuse transmittance for a translucent one, which the ambient reaches on both sides), or
   /// empty for none; `back_radiosity` is the radiosity leaving the backs of translucent elements (0
-  /// elsewhere), or empty when the scene has no translucent material.
+  /// elsewhere), or empty when the scene has no translucent material; `irradiance` is the
+  /// front's irradiance per element id, or empty.
   Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
            SolveStatus status, SolveReport report, Rgb ambient = Rgb(0.0f),
-           std::vector<Rgb> ambient_radiosity = {}, std::vector<Rgb> back_radiosity = {});
+           std::vector<Rgb> ambient_radiosity = {}, std::vector<Rgb> back_radiosity = {},
+           std::vector<Rgb> irradiance = {});
   Solution(Solution&&) noexcept = default;
   Solution& operator=(Solution&&) noexcept = default;
   Solution(const Solution&) = delete;
@@ -119,6 +121,12 @@ class RADIOSITY_API Solution {
   /// one-sided opaque elements. Empty when the scene has no translucent or two-sided material:
   /// every back is black.
   const std::vector<Rgb>& back_radiosity() const { return back_radiosity_; }
+  /// Irradiance H (W/m^2) arriving at the front of each element id from every surface, before
+  /// the element's own reflectance: B = E + rho H (+ tau H' for a translucent one, H' its back's).
+  /// What a lightmap stores, and defined where a channel of rho is 0 (where (B - E) / rho is
+  /// not). Inner nodes hold the area-weighted mean of their children. Empty only for a Solution
+  /// constructed without it; solve() always fills it (zero when nothing emits).
+  const std::vector<Rgb>& irradiance() const { return irradiance_; }
   /// back_radiosity() per vertex for display (empty when it is empty); no ambient term.
   std::vector<Rgb> vertex_back_radiosity() const;
   Rgb patch_radiosity(std::uint32_t patch) const;
@@ -152,6 +160,7 @@ class RADIOSITY_API Solution {
   Rgb ambient_{0.0f};
   std::vector<Rgb> ambient_radiosity_;
   std::vector<Rgb> back_radiosity_;
+  std::vector<Rgb> irradiance_;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field.

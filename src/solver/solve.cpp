@@ -129,15 +129,18 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
   // The meshing phase ends (in the constructor) before the first solve reports it.
   const bool meshing_reported = meshed_reported;
   meshed_reported = true;
-  if (!meshing_reported && !gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true))
+  if (!meshing_reported && !gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true)) {
+    std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
     return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
-                    std::move(report), Rgb(0.0f), {}, std::move(B_back));
+                    std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));
+  }
 
   if (system->emitted <= 0.0) {
     // Nothing emits: B = 0 is the exact answer.
     report.warnings.push_back("the scene emits no light; every radiosity is 0");
+    std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
     return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::converged,
-                    std::move(report), Rgb(0.0f), {}, std::move(B_back));
+                    std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));
   }
 
   if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
@@ -298,6 +301,7 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
   report.escaped_power = Rgb(emitted - absorbed);
   // Inner nodes (split elements) hold the mean of their children from here on.
   hierarchy.aggregate(B_elements);
+  hierarchy.aggregate(H_elements);
   if (translucency) hierarchy.aggregate(B_back);
   std::vector<Rgb> ambient_elements;
   if (r.ambient != Rgb(0.0f)) {
@@ -312,7 +316,7 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
                                                        status == SolveStatus::converged, o.threads, emission))
     report.warnings.push_back(std::move(w));
   return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
-                  r.ambient, std::move(ambient_elements), std::move(B_back));
+                  r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements));
 }
 
 Problem::Problem(const Scene& scene, const SolveOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {}
