@@ -98,11 +98,12 @@ class RADIOSITY_API Solution {
   /// diffuse transmittance for a translucent one, which the ambient reaches on both sides), or
   /// empty for none; `back_radiosity` is the radiosity leaving the backs of translucent elements (0
   /// elsewhere), or empty when the scene has no translucent material; `irradiance` is the
-  /// front's irradiance per element id, or empty.
+  /// front's irradiance per element id, or empty, and `direct_irradiance` the part of it that
+  /// came straight from the emitters, or empty.
   Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
            SolveStatus status, SolveReport report, Rgb ambient = Rgb(0.0f),
            std::vector<Rgb> ambient_radiosity = {}, std::vector<Rgb> back_radiosity = {},
-           std::vector<Rgb> irradiance = {});
+           std::vector<Rgb> irradiance = {}, std::vector<Rgb> direct_irradiance = {});
   Solution(Solution&&) noexcept = default;
   Solution& operator=(Solution&&) noexcept = default;
   Solution(const Solution&) = delete;
@@ -127,6 +128,10 @@ class RADIOSITY_API Solution {
   /// not). Inner nodes hold the area-weighted mean of their children. Empty only for a Solution
   /// constructed without it; solve() always fills it (zero when nothing emits).
   const std::vector<Rgb>& irradiance() const { return irradiance_; }
+  /// The part of irradiance() that arrives straight from the emitters, per element id: sum over
+  /// targets t of F(e -> t) E_t. irradiance() minus it is the indirect part, light that has
+  /// been reflected (or transmitted) at least once. Empty for a cancelled solve.
+  const std::vector<Rgb>& direct_irradiance() const { return direct_irradiance_; }
   /// back_radiosity() per vertex for display (empty when it is empty); no ambient term.
   std::vector<Rgb> vertex_back_radiosity() const;
   Rgb patch_radiosity(std::uint32_t patch) const;
@@ -161,6 +166,7 @@ class RADIOSITY_API Solution {
   std::vector<Rgb> ambient_radiosity_;
   std::vector<Rgb> back_radiosity_;
   std::vector<Rgb> irradiance_;
+  std::vector<Rgb> direct_irradiance_;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field.

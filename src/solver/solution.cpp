@@ -5,7 +5,8 @@ inline namespace v1 {
 
 Solution::Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::vector<std::string> groups,
                    SolveStatus status, SolveReport report, Rgb ambient, std::vector<Rgb> ambient_radiosity,
-                   std::vector<Rgb> back_radiosity, std::vector<Rgb> irradiance)
+                   std::vector<Rgb> back_radiosity, std::vector<Rgb> irradiance,
+                   std::vector<Rgb> direct_irradiance)
     : hierarchy_(std::move(hierarchy)),
       radiosity_(std::move(radiosity)),
       groups_(std::move(groups)),
@@ -14,9 +15,12 @@ Solution::Solution(PatchHierarchy hierarchy, std::vector<Rgb> radiosity, std::ve
       ambient_(ambient),
       ambient_radiosity_(std::move(ambient_radiosity)),
       back_radiosity_(std::move(back_radiosity)),
-      irradiance_(std::move(irradiance)) {
+      irradiance_(std::move(irradiance)),
+      direct_irradiance_(std::move(direct_irradiance)) {
   if (!back_radiosity_.empty() && back_radiosity_.size() != hierarchy_.elements().size())
     throw Error(ErrorCode::invalid_argument, "Solution: back_radiosity must be empty or have one value per element");
+  if (!direct_irradiance_.empty() && direct_irradiance_.size() != hierarchy_.elements().size())
+    throw Error(ErrorCode::invalid_argument, "Solution: direct_irradiance must be empty or have one value per element");
   if (!irradiance_.empty() && irradiance_.size() != hierarchy_.elements().size())
     throw Error(ErrorCode::invalid_argument, "Solution: irradiance must be empty or have one value per element");
   if (!ambient_radiosity_.empty() && ambient_radiosity_.size() != hierarchy_.elements().size())

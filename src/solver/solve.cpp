@@ -24,6 +24,52 @@ using detail::seconds_since;
 
 constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
 
+/// Direct irradiance per front unknown, H_d(u) = sum over targets t of F(u -> t) E_t with E_t
+/// the target's mean emission: the light that arrives straight from the emitters. The matrix
+/// methods have every row in `store`; progressive refinement takes the emitting targets'
+/// columns, from `columns` when it holds them for these leaves, else from the estimator.
+std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const FormFactorEstimator& estimator,
+                                   bool progressive, const detail::MatrixStore& store,
+                                   const detail::ColumnStore& columns) {
+  std::vector<Rgb> patch_E;
+  sys.patch_means(sys.emission, patch_E);
+  std::vector<Rgb> out(sys.fronts(), Rgb(0.0f));
+  if (!progressive) {
+    for (std::size_t u = 0; u < sys.fronts(); ++u) {
+      const std::uint32_t slot = store.slot[sys.element(u)];
+      RADIOSITY_ASSERT(slot != kNone);  // solve_matrix() made a row for every unknown
+      out[u] = store.rows[slot].dot(patch_E);
+    }
+    return out;
+  }
+  const bool kept = columns.leaf_count == sys.fronts() && columns.columns.size() == sys.patches();
+  std::vector<std::uint32_t> missing;
+  auto add = [&](std::uint32_t target, const detail::FactorVector& column) {
+    column.for_each([&](std::size_t k, float f) {
+      const std::uint32_t u = sys.column_unknown(k);
+      if (u < sys.fronts()) out[u] += f * patch_E[target];
+    });
+  };
+  for (std::uint32_t t = 0; t < sys.patches(); ++t) {
+    if (patch_E[t] == Rgb(0.0f)) continue;
+    if (kept && columns.cached[t])
+      add(t, columns.columns[t]);
+    else
+      missing.push_back(t);
+  }
+  if (!missing.empty()) {
+    std::vector<SparseFactors> fetched;
+    estimator.sparse_patch_columns(missing, sys.leaves, fetched);
+    for (std::size_t k = 0; k < missing.size(); ++k) {
+      detail::FactorVector column;
+      column.index = std::move(fetched[k].index);
+      column.value = std::move(fetched[k].value);
+      add(missing[k], column);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void validate(const SolveOptions& o) {
@@ -139,8 +185,10 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
     // Nothing emits: B = 0 is the exact answer.
     report.warnings.push_back("the scene emits no light; every radiosity is 0");
     std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
+    std::vector<Rgb> no_direct = no_irradiance;
     return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::converged,
-                    std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));
+                    std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance),
+                    std::move(no_direct));
   }
 
   if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
@@ -299,6 +347,14 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
   report.emitted_power = Rgb(emitted);
   report.absorbed_power = Rgb(absorbed);
   report.escaped_power = Rgb(emitted - absorbed);
+  // What arrived straight from the emitters; not for a cancelled solve, which may lack rows.
+  std::vector<Rgb> H_direct;
+  if (status != SolveStatus::cancelled) {
+    const std::vector<Rgb> direct = direct_irradiance(*system, *estimator, progressive, store, columns);
+    H_direct.assign(hierarchy.elements().size(), Rgb(0.0f));
+    for (std::size_t u = 0; u < system->fronts(); ++u) H_direct[system->leaves[u]] = direct[u];
+    hierarchy.aggregate(H_direct);
+  }
   // Inner nodes (split elements) hold the mean of their children from here on.
   hierarchy.aggregate(B_elements);
   hierarchy.aggregate(H_elements);
@@ -316,7 +372,8 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
                                                        status == SolveStatus::converged, o.threads, emission))
     report.warnings.push_back(std::move(w));
   return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
-                  r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements));
+                  r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements),
+                  std::move(H_direct));
 }
 
 Problem::Problem(const Scene& scene, const SolveOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {}

@@ -43,6 +43,8 @@ TEST_SUITE("solver") {
       F /= kN * kN;
       const rad::Rgb H = sol.irradiance()[e];
       for (int c = 0; c < 3; ++c) CHECK(H[c] == doctest::Approx(F * lamp.emission[c]).epsilon(5e-3));
+      // Nothing reflects: all of it came straight from the lamp.
+      for (int c = 0; c < 3; ++c) CHECK(sol.direct_irradiance()[e][c] == doctest::Approx(H[c]).epsilon(1e-6));
       CHECK(sol.radiosity()[e] == rad::Rgb(0.0f));  // black: it reflects nothing of it
       ++checked;
     }
@@ -84,6 +86,44 @@ TEST_SUITE("solver") {
         for (std::uint32_t c = 0; c < 4; ++c) sum += h.element(root.first_child + c).area * sol.irradiance()[root.first_child + c];
         CHECK(sol.irradiance()[h.patches()[p].root].x == doctest::Approx(sum.x / root.area).epsilon(1e-4));
       }
+    }
+  }
+
+  TEST_CASE("direct irradiance: what the scene with every reflectance 0 receives, and at most the irradiance, for every method") {
+    const rad::Scene scene = rad::cornell_box();
+    // The same polygons with black materials that keep their emission: only direct light.
+    rad::Scene black;
+    for (const rad::Material& m : scene.materials()) {
+      rad::Material b = m;
+      b.reflectance = rad::Rgb(0.0f);
+      black.add_material(b);
+    }
+    for (const rad::Polygon& p : scene.polygons())
+      black.add_polygon(p.vertices, p.material, scene.groups()[p.group]);
+    REQUIRE(black.polygons().size() == scene.polygons().size());
+    for (rad::SolverMethod method : {rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+      CAPTURE(static_cast<int>(method));
+      rad::SolveOptions o;
+      o.method = method;
+      o.form_factors.method = rad::FormFactorMethod::ray_cast;  // the same factors for both scenes
+      o.mesh.max_patch_area = 20000.0f;
+      o.tolerance = 1e-6;
+      const rad::Solution lit = rad::solve(scene, o), direct_only = rad::solve(black, o);
+      REQUIRE(lit.direct_irradiance().size() == lit.hierarchy().elements().size());
+      double direct = 0.0, total = 0.0;
+      for (std::uint32_t e : lit.hierarchy().leaves()) {
+        const rad::Rgb& Hd = lit.direct_irradiance()[e];
+        for (int c = 0; c < 3; ++c) {
+          CHECK(Hd[c] == doctest::Approx(direct_only.irradiance()[e][c]).epsilon(1e-4));
+          CHECK(Hd[c] <= lit.irradiance()[e][c] * (1.0f + 1e-5f) + 1e-6f);
+        }
+        direct += lit.hierarchy().element(e).area * Hd.x;
+        total += lit.hierarchy().element(e).area * lit.irradiance()[e].x;
+      }
+      // In the closed-ish Cornell box the walls reflect a good share: indirect light is a
+      // substantial part of the total (a direct part equal to the total would mean no bounce).
+      CHECK(direct < 0.8 * total);
+      CHECK(direct > 0.3 * total);
     }
   }
 }
