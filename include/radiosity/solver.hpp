@@ -59,6 +59,23 @@ struct SolveOptions {
 
 enum class SolveStatus { converged, iteration_cap, cancelled };
 
+/// What Solution::mesh_vertex_values() and mesh_triangle_values() report, W/m^2 (per scene
+/// unit^2) per channel.
+enum class Quantity {
+  radiosity,            ///< B: the light leaving the surface, emission included
+  irradiance,           ///< H: the light arriving, before the reflectance (what lightmaps store)
+  direct_irradiance,    ///< the part of H that came straight from the emitters
+  indirect_irradiance,  ///< H minus its direct part: light reflected at least once
+};
+
+/// A mesh's triangles as the solve saw them (copied from Scene::meshes() by solve()), so that a
+/// Solution can put its values back on the host's vertices and triangles.
+struct SolvedMesh {
+  std::vector<glm::vec3> positions;          ///< the host's vertices
+  std::vector<std::uint32_t> indices;        ///< three per triangle, as the host gave them
+  std::vector<PolygonId> triangle_polygon;   ///< per triangle: its polygon, or kNone (skipped)
+};
+
 /// Figures about a solve, for people and for `radiosity solve --stats`.
 struct SolveReport {
   int iterations = 0;
@@ -152,10 +169,28 @@ class RADIOSITY_API Solution {
   /// one-sided, and for every group when back_radiosity() is empty). Throws as group_radiosity().
   Rgb group_back_radiosity(std::string_view group) const;
   double group_area(std::string_view group) const;
+
+  /// `quantity` per triangle of mesh `mesh` (a MeshId of the scene that was solved), in the
+  /// host's triangle order: the area-weighted mean over the triangle's elements; 0 for a
+  /// triangle add_mesh() skipped. Throws Error{invalid_argument} for an unknown mesh id, or a
+  /// quantity the solution does not hold (direct irradiance of a cancelled solve).
+  std::vector<Rgb> mesh_triangle_values(MeshId mesh, Quantity quantity) const;
+  /// `quantity` per vertex of mesh `mesh`, in the host's vertex order: at each triangle corner
+  /// the continuous interpolated field (as vertex_radiosity() interpolates), averaged over the
+  /// triangles that share the vertex, weighted by their area; 0 for a vertex no kept triangle
+  /// uses. Throws as mesh_triangle_values().
+  std::vector<Rgb> mesh_vertex_values(MeshId mesh, Quantity quantity) const;
+  /// The meshes of the solved scene, by MeshId.
+  const std::vector<SolvedMesh>& meshes() const { return meshes_; }
+  /// Gives the solution its scene's meshes (solve() does), for the mesh_*_values() calls.
+  void set_meshes(std::vector<SolvedMesh> meshes) { meshes_ = std::move(meshes); }
   const std::vector<std::string>& groups() const { return groups_; }
 
  private:
   GroupId group_id(std::string_view group) const;
+  /// Per element id, the values of `quantity` (throws when the solution does not hold them).
+  std::vector<Rgb> element_values(Quantity quantity) const;
+  const SolvedMesh& solved_mesh(MeshId mesh) const;
 
   PatchHierarchy hierarchy_;
   std::vector<Rgb> radiosity_;
@@ -167,6 +202,7 @@ class RADIOSITY_API Solution {
   std::vector<Rgb> back_radiosity_;
   std::vector<Rgb> irradiance_;
   std::vector<Rgb> direct_irradiance_;
+  std::vector<SolvedMesh> meshes_;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field.

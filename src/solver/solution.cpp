@@ -92,5 +92,116 @@ double Solution::group_area(std::string_view group) const {
   return area;
 }
 
+std::vector<Rgb> Solution::element_values(Quantity quantity) const {
+  auto held = [&](const std::vector<Rgb>& v, const char* what) -> const std::vector<Rgb>& {
+    if (v.size() != hierarchy_.elements().size())
+      throw Error(ErrorCode::invalid_argument, std::string("Solution: no ") + what +
+                                                   " in this solution (a cancelled solve has no direct irradiance)");
+    return v;
+  };
+  switch (quantity) {
+    case Quantity::radiosity: return radiosity_;
+    case Quantity::irradiance: return held(irradiance_, "irradiance");
+    case Quantity::direct_irradiance: return held(direct_irradiance_, "direct irradiance");
+    case Quantity::indirect_irradiance: {
+      const std::vector<Rgb>& H = held(irradiance_, "irradiance");
+      const std::vector<Rgb>& D = held(direct_irradiance_, "direct irradiance");
+      std::vector<Rgb> out(H.size());
+      // Rounding may leave a hair below 0 where all light is direct.
+      for (std::size_t e = 0; e < H.size(); ++e) out[e] = glm::max(H[e] - D[e], Rgb(0.0f));
+      return out;
+    }
+  }
+  throw Error(ErrorCode::invalid_argument, "Solution: unknown quantity");
+}
+
+const SolvedMesh& Solution::solved_mesh(MeshId mesh) const {
+  if (mesh >= meshes_.size())
+    throw Error(ErrorCode::invalid_argument, "Solution: mesh " + std::to_string(mesh) + " does not exist (the scene had " +
+                                                 std::to_string(meshes_.size()) + " meshes)");
+  return meshes_[mesh];
+}
+
+namespace {
+
+/// Per polygon, its first patch and patch count (PatchHierarchy meshes polygons in order, so a
+/// polygon's patches are consecutive); sized to cover every polygon the hierarchy and `mesh`
+/// name, so a lookup never leaves the table.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> patches_by_polygon(const PatchHierarchy& h, const SolvedMesh& mesh) {
+  std::size_t polygons = 0;
+  for (const Patch& p : h.patches()) polygons = std::max<std::size_t>(polygons, p.polygon + std::size_t{1});
+  for (PolygonId p : mesh.triangle_polygon)
+    if (p != kNone) polygons = std::max<std::size_t>(polygons, p + std::size_t{1});
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> out(polygons, {kNone, 0});
+  for (std::uint32_t j = 0; j < h.patches().size(); ++j) {
+    auto& range = out[h.patches()[j].polygon];
+    if (range.first == kNone) range.first = j;
+    ++range.second;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Rgb> Solution::mesh_triangle_values(MeshId mesh, Quantity quantity) const {
+  const SolvedMesh& m = solved_mesh(mesh);
+  const std::vector<Rgb> values = element_values(quantity);
+  const auto ranges = patches_by_polygon(hierarchy_, m);
+  std::vector<Rgb> out(m.triangle_polygon.size(), Rgb(0.0f));
+  for (std::size_t t = 0; t < out.size(); ++t) {
+    const PolygonId p = m.triangle_polygon[t];
+    if (p == kNone || ranges[p].first == kNone) continue;
+    glm::dvec3 sum(0.0);
+    double area = 0.0;
+    for (std::uint32_t j = ranges[p].first; j < ranges[p].first + ranges[p].second; ++j) {
+      const Patch& patch = hierarchy_.patches()[j];
+      sum += static_cast<double>(patch.area) * glm::dvec3(values[patch.root]);
+      area += patch.area;
+    }
+    if (area > 0.0) out[t] = Rgb(sum / area);
+  }
+  return out;
+}
+
+std::vector<Rgb> Solution::mesh_vertex_values(MeshId mesh, Quantity quantity) const {
+  const SolvedMesh& m = solved_mesh(mesh);
+  const std::vector<Rgb> at_vertex = hierarchy_.vertex_values(element_values(quantity));
+  const auto ranges = patches_by_polygon(hierarchy_, m);
+  std::vector<glm::dvec3> sum(m.positions.size(), glm::dvec3(0.0));
+  std::vector<double> weight(m.positions.size(), 0.0);
+  for (std::size_t t = 0; t < m.triangle_polygon.size(); ++t) {
+    const PolygonId p = m.triangle_polygon[t];
+    if (p == kNone || ranges[p].first == kNone) continue;
+    double area = 0.0;
+    for (std::uint32_t j = ranges[p].first; j < ranges[p].first + ranges[p].second; ++j)
+      area += hierarchy_.patches()[j].area;
+    // Each corner of the triangle is the hierarchy vertex of its patches nearest to it (the
+    // corner itself, up to the rounding of the patch lattice).
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = m.indices[3 * t + static_cast<std::size_t>(k)];
+      std::uint32_t nearest = kNone;
+      float best = 0.0f;
+      for (std::uint32_t j = ranges[p].first; j < ranges[p].first + ranges[p].second; ++j) {
+        const Element& root = hierarchy_.element(hierarchy_.patches()[j].root);
+        for (int c = 0; c < root.corner_count(); ++c) {
+          const std::uint32_t id = root.corners[static_cast<std::size_t>(c)];
+          const glm::vec3 d = hierarchy_.vertices()[id] - m.positions[v];
+          const float d2 = glm::dot(d, d);
+          if (nearest == kNone || d2 < best) {
+            nearest = id;
+            best = d2;
+          }
+        }
+      }
+      sum[v] += area * glm::dvec3(at_vertex[nearest]);
+      weight[v] += area;
+    }
+  }
+  std::vector<Rgb> out(m.positions.size(), Rgb(0.0f));
+  for (std::size_t v = 0; v < out.size(); ++v)
+    if (weight[v] > 0.0) out[v] = Rgb(sum[v] / weight[v]);
+  return out;
+}
+
 }  // namespace v1
 }  // namespace radiosity

@@ -117,6 +117,7 @@ struct Problem::Impl {
   /// One solve; `emission` per polygon or null (the materials'). With `last` the hierarchy is
   /// moved into the Solution (the facade's single solve: no copy).
   Solution solve(const std::vector<Rgb>* emission, bool last);
+  Solution solve_once(const std::vector<Rgb>* emission, bool last);
 };
 
 Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), options(given) {
@@ -151,7 +152,25 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), optio
   initial_leaves = hierarchy.leaves().size();
 }
 
+namespace {
+
+/// The scene's meshes as a Solution keeps them (SolvedMesh).
+std::vector<SolvedMesh> solved_meshes(const Scene& scene) {
+  std::vector<SolvedMesh> out;
+  out.reserve(scene.meshes().size());
+  for (const Mesh& m : scene.meshes()) out.push_back(SolvedMesh{m.positions, m.indices, m.triangle_polygon});
+  return out;
+}
+
+}  // namespace
+
 Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
+  Solution solution = solve_once(emission, last);
+  solution.set_meshes(solved_meshes(scene));
+  return solution;
+}
+
+Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) {
   const SolveOptions& o = options;
   detail::ProgressGate gate(o.on_progress);
   SolveReport report;
