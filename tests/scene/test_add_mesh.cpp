@@ -11,6 +11,8 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "support/scenes.hpp"
+
 namespace rad = radiosity;
 
 namespace {
@@ -148,12 +150,10 @@ TEST_SUITE("scene") {
   }
 
   TEST_CASE("add_mesh: a closed box as one indexed mesh lights exactly as the same triangles added one by one") {
-    // A unit cube facing inwards, 8 shared corners and 12 triangles; its floor emits.
-    const std::vector<glm::vec3> corners{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                                         {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-    // Each face counter-clockwise seen from inside the box.
-    const std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
-                                             3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2};
+    // The unit cube facing inwards; its z = 0 face emits.
+    const test::InwardCube cube;
+    const std::vector<glm::vec3>& corners = cube.corners;
+    const std::vector<std::uint32_t>& indices = cube.indices;
     rad::Material wall, lamp;
     wall.reflectance = rad::Rgb(0.6f, 0.5f, 0.4f);
     lamp.reflectance = rad::Rgb(0.3f);
@@ -166,11 +166,7 @@ TEST_SUITE("scene") {
       s->add_material(wall);
       s->add_material(lamp);
     }
-    rad::MeshDesc desc;
-    desc.positions = corners.data();
-    desc.vertex_count = corners.size();
-    desc.indices = indices.data();
-    desc.index_count = indices.size();
+    rad::MeshDesc desc = cube.desc(0);
     desc.triangle_materials = materials.data();
     desc.group = "box";
     as_mesh.add_mesh(desc);

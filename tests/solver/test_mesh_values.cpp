@@ -9,26 +9,15 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "support/scenes.hpp"
+
 namespace rad = radiosity;
 
 namespace {
 
-/// A unit cube facing inwards: 8 shared corners, 12 triangles, and a 13th, degenerate one.
-struct Cube {
-  std::vector<glm::vec3> corners{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                                 {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-  std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1, 3, 2, 6,
-                                     3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2, 0, 0, 1};
-  rad::MeshDesc desc(rad::MaterialId m) const {
-    rad::MeshDesc d;
-    d.positions = corners.data();
-    d.vertex_count = corners.size();
-    d.indices = indices.data();
-    d.index_count = indices.size();
-    d.material = m;
-    d.group = "cube";
-    return d;
-  }
+/// test::InwardCube with a 13th, degenerate triangle (two equal corners).
+struct Cube : test::InwardCube {
+  Cube() { indices.insert(indices.end(), {0, 0, 1}); }
 };
 
 }  // namespace

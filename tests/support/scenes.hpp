@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,28 @@ inline rad::Scene closed_box(const rad::Material& m, glm::vec3 s = glm::vec3(1.0
   add({{0, 0, Z}, {X, 0, Z}, {X, Y, Z}, {0, Y, Z}}, "z1");
   return scene;
 }
+
+/// The unit cube [0,1]^3 as an indexed triangle mesh facing inwards: 8 shared corners and 12
+/// triangles, each face counter-clockwise seen from inside, the z = 0 face first (triangles 0
+/// and 1).
+struct InwardCube {
+  std::vector<glm::vec3> corners{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                 {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3, 4, 7, 6, 4, 6, 5, 0, 4, 5, 0, 5, 1,
+                                     3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2};
+
+  /// Its MeshDesc (the arrays stay this object's), every triangle of `material`, group "cube".
+  rad::MeshDesc desc(rad::MaterialId material) const {
+    rad::MeshDesc d;
+    d.positions = corners.data();
+    d.vertex_count = corners.size();
+    d.indices = indices.data();
+    d.index_count = indices.size();
+    d.material = material;
+    d.group = "cube";
+    return d;
+  }
+};
 
 /// Howell C-11: parallel, directly opposed rectangles a x b at distance c.
 inline double parallel_rectangles(double a, double b, double c) {
