@@ -7,6 +7,7 @@
 #include "radiosity/common.hpp"
 #include "radiosity/form_factors.hpp"
 #include "radiosity/io.hpp"
+#include "radiosity/lightmap.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/path_tracer.hpp"
 #include "radiosity/render.hpp"
