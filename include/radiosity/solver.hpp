@@ -180,6 +180,11 @@ class RADIOSITY_API Solution {
   /// triangles that share the vertex, weighted by their area; 0 for a vertex no kept triangle
   /// uses. Throws as mesh_triangle_values().
   std::vector<Rgb> mesh_vertex_values(MeshId mesh, Quantity quantity) const;
+  /// `quantity` per element id (inner nodes hold the area-weighted mean of their children):
+  /// radiosity(), irradiance(), direct_irradiance() or their difference, clamped at 0. Throws
+  /// Error{invalid_argument} for a quantity the solution does not hold (direct irradiance of a
+  /// cancelled solve).
+  std::vector<Rgb> element_values(Quantity quantity) const;
   /// The meshes of the solved scene, by MeshId.
   const std::vector<SolvedMesh>& meshes() const { return meshes_; }
   /// Gives the solution its scene's meshes (solve() does), for the mesh_*_values() calls.
@@ -188,8 +193,6 @@ class RADIOSITY_API Solution {
 
  private:
   GroupId group_id(std::string_view group) const;
-  /// Per element id, the values of `quantity` (throws when the solution does not hold them).
-  std::vector<Rgb> element_values(Quantity quantity) const;
   const SolvedMesh& solved_mesh(MeshId mesh) const;
 
   PatchHierarchy hierarchy_;

@@ -27,6 +27,9 @@ enum class Stream : std::uint64_t {
   two_pass_path = 0x2a550001ull,         ///< the two-pass view's specular and glossy paths
   two_pass_direct = 0xd1ec7000ull,       ///< per element: the direct part of pass 1
   photon = 0xca057100ull,                ///< per photon block: caustic photons
+  // Lightmaps (key_a: the texel).
+  lightmap_gather = 0x1a9e0000ull,       ///< a texel's hemisphere rays (final gather)
+  lightmap_light = 0xb0000000000ull,     ///< + emitter: a texel's shadow rays to an emitting polygon
 };
 
 /// The key of `stream`, `offset` into its range.
@@ -49,6 +52,7 @@ constexpr Range kRanges[] = {
     {stream_key(Stream::hemicube_back), 1ull << 16},        {stream_key(Stream::pixel_jitter), 1},
     {stream_key(Stream::path), 1},                          {stream_key(Stream::two_pass_path), 1},
     {stream_key(Stream::two_pass_direct), 1},               {stream_key(Stream::photon), 1},
+    {stream_key(Stream::lightmap_gather), 1},               {stream_key(Stream::lightmap_light), 1ull << 31},
 };
 
 constexpr bool disjoint() {

@@ -1,0 +1,365 @@
+// bake_lightmap(): a floor under an area light against the closed-form irradiance E F(x -> light)
+// texel by texel (interpolated and final gather; with a blocker, against the exact factor of the
+// light's unblocked part), seams of a furnace cube whose faces are separate charts (dilation),
+// conservative coverage of a sliver, determinism and errors.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <radiosity/lightmap.hpp>
+#include <radiosity/radiosity.hpp>
+
+namespace rad = radiosity;
+
+namespace {
+
+constexpr float kE = 10.0f;  // the light's exitance, W/m^2
+
+/// The unit floor [0,1]^2 at z = 0 facing +z as a two-triangle mesh, its UV1 the floor's (x, y)
+/// mapped into [kPad, 1 - kPad].
+constexpr float kPad = 0.02f;
+struct Floor {
+  std::vector<glm::vec3> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  std::vector<glm::vec2> uv1;
+  std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3};
+  Floor() {
+    for (const glm::vec3& p : positions) uv1.push_back(kPad + (1.0f - 2.0f * kPad) * glm::vec2(p.x, p.y));
+  }
+  rad::MeshDesc desc(rad::MaterialId m) const {
+    rad::MeshDesc d;
+    d.positions = positions.data();
+    d.vertex_count = positions.size();
+    d.indices = indices.data();
+    d.index_count = indices.size();
+    d.material = m;
+    d.uv1 = uv1.data();
+    d.group = "floor";
+    return d;
+  }
+  /// The floor point under the centre of texel (x, y) of a size x size lightmap.
+  static glm::vec3 point(int x, int y, int size) {
+    const glm::vec2 uv((static_cast<float>(x) + 0.5f) / static_cast<float>(size),
+                       (static_cast<float>(y) + 0.5f) / static_cast<float>(size));
+    const glm::vec2 p = (uv - kPad) / (1.0f - 2.0f * kPad);
+    return {p.x, p.y, 0.0f};
+  }
+};
+
+/// The light [0.3, 0.7]^2 at z = 0.5 facing down (reflectance 0, so the floor's light does not
+/// come back), optionally a blocker [0.45, 0.55]^2 at z = 0.25 facing up (its black back towards
+/// the floor): the floor's irradiance is all direct.
+struct LitFloor {
+  rad::Scene scene;
+  rad::MeshId floor = 0;
+  Floor mesh;
+  explicit LitFloor(bool blocker) {
+    rad::Material white;
+    white.reflectance = rad::Rgb(0.5f);
+    rad::Material lamp;
+    lamp.reflectance = rad::Rgb(0.0f);
+    lamp.emission = rad::Rgb(kE);
+    floor = scene.add_mesh(mesh.desc(scene.add_material(white)));
+    rad::add_quad(scene, {0.3f, 0.3f, 0.5f}, {0.0f, 0.4f, 0.0f}, {0.4f, 0.0f, 0.0f}, scene.add_material(lamp), "light");
+    if (blocker)
+      rad::add_quad(scene, {0.45f, 0.45f, 0.25f}, {0.1f, 0.0f, 0.0f}, {0.0f, 0.1f, 0.0f}, scene.add_material(white),
+                    "blocker");
+  }
+};
+
+/// Exact direct irradiance at floor point x: E times the factor to the light, less the factor to
+/// the part of the light that the blocker hides (the blocker's shadow from x on the light's
+/// plane is the blocker scaled by 2 about x's footprint: planes at 0, 0.25 and 0.5).
+double exact_irradiance(const glm::vec3& x, bool blocker) {
+  const glm::vec3 n(0, 0, 1);
+  auto factor = [&](glm::vec2 lo, glm::vec2 hi) {
+    if (!(hi.x > lo.x && hi.y > lo.y)) return 0.0;
+    const glm::vec3 q[4] = {{lo.x, lo.y, 0.5f}, {lo.x, hi.y, 0.5f}, {hi.x, hi.y, 0.5f}, {hi.x, lo.y, 0.5f}};
+    return rad::point_to_polygon_factor(x, n, q, 4);
+  };
+  double F = factor({0.3f, 0.3f}, {0.7f, 0.7f});
+  if (blocker) {
+    const glm::vec2 foot(x.x, x.y);
+    const glm::vec2 lo = foot + 2.0f * (glm::vec2(0.45f) - foot), hi = foot + 2.0f * (glm::vec2(0.55f) - foot);
+    F -= factor(glm::max(lo, glm::vec2(0.3f)), glm::min(hi, glm::vec2(0.7f)));
+  }
+  return kE * F;
+}
+
+/// Fine elements; no visibility estimate, which is exact for the unblocked floor (and keeps the
+/// noise of the estimators out of a test of interpolation).
+rad::SolveOptions fine_solve() {
+  rad::SolveOptions o;
+  o.form_factors.method = rad::FormFactorMethod::analytic;
+  o.mesh.max_patch_area = 0.004f;
+  o.mesh.max_element_area = 0.0005f;
+  o.tolerance = 1e-6;
+  return o;
+}
+
+/// Bilinear lookup of a lightmap at uv, texel centres at (i + 0.5) / size, clamped at the border.
+rad::Rgb bilinear(const rad::Image& image, glm::vec2 uv) {
+  const float fx = uv.x * static_cast<float>(image.width) - 0.5f, fy = uv.y * static_cast<float>(image.height) - 0.5f;
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  const float tx = fx - static_cast<float>(x0), ty = fy - static_cast<float>(y0);
+  auto at = [&](int x, int y) {
+    return image.at(std::clamp(x, 0, image.width - 1), std::clamp(y, 0, image.height - 1));
+  };
+  return (1 - tx) * (1 - ty) * at(x0, y0) + tx * (1 - ty) * at(x0 + 1, y0) + (1 - tx) * ty * at(x0, y0 + 1) +
+         tx * ty * at(x0 + 1, y0 + 1);
+}
+
+}  // namespace
+
+TEST_SUITE("lightmap") {
+  TEST_CASE("bake_lightmap: a floor under an area light equals E F(x to light) texel by texel within 1 percent") {
+    const LitFloor lit(false);
+    const rad::Solution sol = rad::solve(lit.scene, fine_solve());
+    for (bool gather : {false, true}) {
+      CAPTURE(gather);
+      rad::LightmapOptions o;
+      o.width = o.height = 64;
+      o.final_gather = gather;
+      o.gather_rays = 16;
+      const rad::Lightmap map = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+      REQUIRE(map.image.width == 64);
+      double worst = 0.0;
+      int checked = 0;
+      for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+          const glm::vec3 p = Floor::point(x, y, 64);
+          // Away from the floor's edges (where a texel reads the nearest edge point).
+          if (std::min({p.x, p.y, 1.0f - p.x, 1.0f - p.y}) < 0.05f) continue;
+          REQUIRE(map.state[static_cast<std::size_t>(y) * 64 + x] == rad::TexelState::covered);
+          const double expected = exact_irradiance(p, false);
+          worst = std::max(worst, std::abs(map.image.at(x, y).y - expected) / expected);
+          ++checked;
+        }
+      CHECK(checked > 3000);
+      CHECK(worst < (gather ? 1e-4 : 0.01));
+      MESSAGE("largest relative error, " << (gather ? "final gather: " : "interpolated: ") << worst);
+    }
+  }
+
+  TEST_CASE("bake_lightmap: final gather draws the shadow of a blocker at texel resolution") {
+    const LitFloor lit(true);
+    rad::SolveOptions so = fine_solve();
+    so.form_factors.method = rad::FormFactorMethod::automatic;
+    const rad::Solution sol = rad::solve(lit.scene, so);
+    rad::LightmapOptions o;
+    o.width = o.height = 48;
+    o.final_gather = true;
+    o.gather_rays = 16;
+    o.shadow_rays = 64;
+    const rad::Lightmap map = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+    o.final_gather = false;
+    const rad::Lightmap smooth = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+    double sum_error = 0.0, smooth_error = 0.0, worst = 0.0;
+    int penumbra = 0;
+    const double open = exact_irradiance({0.5f, 0.5f, 0.0f}, false);
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 48; ++x) {
+        const glm::vec3 p = Floor::point(x, y, 48);
+        if (std::min({p.x, p.y, 1.0f - p.x, 1.0f - p.y}) < 0.05f) continue;
+        const double expected = exact_irradiance(p, true);
+        const double error = std::abs(map.image.at(x, y).y - expected) / open;
+        worst = std::max(worst, error);
+        if (expected < 0.98 * exact_irradiance(p, false)) {
+          sum_error += error;
+          smooth_error += std::abs(smooth.image.at(x, y).y - expected) / open;
+          ++penumbra;
+        }
+      }
+    REQUIRE(penumbra > 50);
+    MESSAGE("shadowed texels " << penumbra << ": mean error " << sum_error / penumbra << " (interpolated "
+                               << smooth_error / penumbra << "), worst " << worst << " of the unshadowed value");
+    // Shadow rays estimate the visible fraction: 64 rays, 256 more in a penumbra.
+    CHECK(sum_error / penumbra < 0.01);
+    CHECK(worst < 0.05);
+  }
+
+  TEST_CASE("bake_lightmap: a furnace cube whose faces are separate charts has no dark seams after dilation") {
+    // An inward cube of 24 vertices (each face its own 4), every face a chart in a 3 x 2 grid of
+    // 16 x 16 texel cells with the chart inset by 2 texels.
+    rad::Scene scene;
+    rad::Material m;
+    m.emission = rad::Rgb(1.0f);
+    m.reflectance = rad::Rgb(0.5f);
+    const rad::MaterialId id = scene.add_material(m);
+    const glm::vec3 faces[6][4] = {
+        {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}},
+        {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}},
+        {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}}, {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}}};
+    // The charts' borders fall inside texels, as they do in a packed atlas.
+    const int W = 48, H = 32, cell = 16;
+    const float inset = 2.3f;
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec2> uv1;
+    std::vector<std::uint32_t> indices;
+    std::vector<std::pair<glm::vec2, glm::vec2>> charts;  // uv rectangles
+    for (int f = 0; f < 6; ++f) {
+      const glm::vec2 lo((static_cast<float>((f % 3) * cell) + inset) / W, (static_cast<float>((f / 3) * cell) + inset) / H);
+      const glm::vec2 size((static_cast<float>(cell) - 2 * inset) / W, (static_cast<float>(cell) - 2 * inset) / H);
+      charts.emplace_back(lo, lo + size);
+      const auto base = static_cast<std::uint32_t>(positions.size());
+      const glm::vec2 corner_uv[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+      for (int k = 0; k < 4; ++k) {
+        positions.push_back(faces[f][k]);
+        uv1.push_back(lo + corner_uv[k] * size);
+      }
+      indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+    rad::MeshDesc d;
+    d.positions = positions.data();
+    d.vertex_count = positions.size();
+    d.indices = indices.data();
+    d.index_count = indices.size();
+    d.material = id;
+    d.uv1 = uv1.data();
+    const rad::MeshId mesh = scene.add_mesh(d);
+    rad::SolveOptions so;
+    so.mesh.max_patch_area = 0.05f;
+    so.form_factors.method = rad::FormFactorMethod::ray_cast;
+    so.tolerance = 1e-6;
+    const rad::Solution sol = rad::solve(scene, so);
+    const float expected = 1.0f / (1.0f - 0.5f);  // H = B = E / (1 - rho) in a furnace
+
+    for (int dilation : {0, 2}) {
+      CAPTURE(dilation);
+      rad::LightmapOptions o;
+      o.width = W;
+      o.height = H;
+      o.dilation = dilation;
+      const rad::Lightmap map = rad::bake_lightmap(scene, sol, mesh, o);
+      // Bilinear lookups along every chart's border and just inside it.
+      float darkest = expected;
+      for (const auto& [lo, hi] : charts)
+        for (int i = 0; i <= 40; ++i) {
+          const float s = static_cast<float>(i) / 40.0f;
+          for (const glm::vec2 uv : {glm::vec2(lo.x + s * (hi.x - lo.x), lo.y), glm::vec2(lo.x + s * (hi.x - lo.x), hi.y),
+                                     glm::vec2(lo.x, lo.y + s * (hi.y - lo.y)), glm::vec2(hi.x, lo.y + s * (hi.y - lo.y))})
+            darkest = std::min(darkest, bilinear(map.image, uv).x);
+        }
+      MESSAGE("dilation " << dilation << ": darkest border lookup " << darkest / expected << " of the furnace value");
+      if (dilation == 0) {
+        CHECK(darkest < 0.9f * expected);  // the gutter's black bleeds in: the check below can fail
+      } else {
+        CHECK(darkest > 0.99f * expected);
+        CHECK(map.dilated > 0);
+      }
+    }
+
+    // Final gather in the furnace: direct light E from the other faces (exact factors summing
+    // to 1) and the reflected rest E rho / (1 - rho) from the hemisphere rays.
+    rad::LightmapOptions o;
+    o.width = W;
+    o.height = H;
+    o.final_gather = true;
+    o.gather_rays = 16;
+    for (rad::Quantity q : {rad::Quantity::irradiance, rad::Quantity::direct_irradiance, rad::Quantity::indirect_irradiance}) {
+      CAPTURE(static_cast<int>(q));
+      o.quantity = q;
+      const rad::Lightmap map = rad::bake_lightmap(scene, sol, mesh, o);
+      const float want = q == rad::Quantity::irradiance ? expected : 1.0f;
+      float lo = 1e30f, hi = 0.0f;
+      for (std::size_t i = 0; i < map.state.size(); ++i)
+        if (map.state[i] == rad::TexelState::covered) {
+          lo = std::min(lo, map.image.pixels[i].x);
+          hi = std::max(hi, map.image.pixels[i].x);
+        }
+      CHECK(lo > 0.99f * want);
+      CHECK(hi < 1.01f * want);
+    }
+  }
+
+  TEST_CASE("bake_lightmap: conservative rasterisation covers every texel a sliver triangle crosses") {
+    rad::Scene scene;
+    rad::Material m;
+    m.emission = rad::Rgb(1.0f);
+    const rad::MaterialId id = scene.add_material(m);
+    // A long thin triangle whose UV footprint is a diagonal 0.1 texel wide across 32 texels.
+    const std::vector<glm::vec3> positions{{0, 0, 0}, {1, 0, 0}, {1, 0.01f, 0}};
+    const std::vector<glm::vec2> uv1{{0.0f, 0.0f}, {1.0f, 1.0f}, {1.0f - 0.1f / 32.0f, 1.0f}};
+    const std::vector<std::uint32_t> indices{0, 1, 2};
+    rad::MeshDesc d;
+    d.positions = positions.data();
+    d.vertex_count = 3;
+    d.indices = indices.data();
+    d.index_count = 3;
+    d.material = id;
+    d.uv1 = uv1.data();
+    const rad::MeshId mesh = scene.add_mesh(d);
+    const rad::Solution sol = rad::solve(scene);
+    rad::LightmapOptions o;
+    o.width = o.height = 32;
+    o.dilation = 0;
+    o.quantity = rad::Quantity::radiosity;
+    const rad::Lightmap map = rad::bake_lightmap(scene, sol, mesh, o);
+    for (int k = 0; k < 32; ++k) {
+      CAPTURE(k);
+      CHECK(map.state[static_cast<std::size_t>(k) * 32 + k] == rad::TexelState::covered);
+      CHECK(map.image.at(k, k).x == doctest::Approx(1.0f).epsilon(1e-4));  // B = E on a lone emitter
+    }
+    CHECK(map.covered >= 32);
+    CHECK(map.covered <= 3 * 32);
+  }
+
+  TEST_CASE("bake_lightmap: final gather is bit-identical at 1 and 2 threads") {
+    const LitFloor lit(true);
+    const rad::Solution sol = rad::solve(lit.scene);
+    rad::LightmapOptions o;
+    o.width = o.height = 24;
+    o.final_gather = true;
+    o.gather_rays = 16;
+    o.threads = 1;
+    const rad::Lightmap one = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+    o.threads = 2;
+    const rad::Lightmap two = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+    CHECK(one.image.pixels == two.image.pixels);
+    CHECK(one.state == two.state);
+  }
+
+  TEST_CASE("bake_lightmap: errors name the problem") {
+    const LitFloor lit(false);
+    const rad::Solution sol = rad::solve(lit.scene);
+    auto message = [&](auto&& call) -> std::string {
+      try {
+        call();
+      } catch (const rad::Error& e) {
+        CHECK(e.code() == rad::ErrorCode::invalid_argument);
+        return e.what();
+      }
+      return "no error";
+    };
+    CHECK(message([&] { rad::bake_lightmap(lit.scene, sol, 7); }).find("mesh 7 does not exist") != std::string::npos);
+    rad::LightmapOptions bad;
+    bad.width = 0;
+    CHECK(message([&] { rad::bake_lightmap(lit.scene, sol, lit.floor, bad); }).find("width") != std::string::npos);
+    bad = {};
+    bad.gather_rays = 0;
+    CHECK(message([&] { rad::bake_lightmap(lit.scene, sol, lit.floor, bad); }).find("gather_rays") != std::string::npos);
+    bad = {};
+    bad.width = bad.height = 100000;
+    CHECK(message([&] { rad::bake_lightmap(lit.scene, sol, lit.floor, bad); }).find("MiB") != std::string::npos);
+
+    // A mesh without UV1.
+    rad::Scene scene;
+    Floor f;
+    rad::MeshDesc d = f.desc(scene.add_material(rad::Material{}));
+    d.uv1 = nullptr;
+    const rad::MeshId id = scene.add_mesh(d);
+    rad::Material lamp;
+    lamp.emission = rad::Rgb(1.0f);
+    rad::add_quad(scene, {0.3f, 0.3f, 0.5f}, {0.0f, 0.4f, 0.0f}, {0.4f, 0.0f, 0.0f}, scene.add_material(lamp));
+    const rad::Solution no_uv = rad::solve(scene);
+    CHECK(message([&] { rad::bake_lightmap(scene, no_uv, id); }).find("no UV1") != std::string::npos);
+    // A solution of a scene without that mesh.
+    rad::Scene quads;
+    rad::add_quad(quads, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, quads.add_material(rad::Material{}));
+    rad::add_quad(quads, {0.3f, 0.3f, 0.5f}, {0.0f, 0.4f, 0.0f}, {0.4f, 0.0f, 0.0f}, quads.add_material(lamp));
+    const rad::Solution other = rad::solve(quads);
+    CHECK(message([&] { rad::bake_lightmap(lit.scene, other, lit.floor); }).find("not the mesh") != std::string::npos);
+  }
+}
