@@ -79,6 +79,16 @@ RADIOSITY_API void write_png(const Image& image, const std::filesystem::path& pa
 RADIOSITY_API void write_ply(const Solution& solution, const std::filesystem::path& path,
                              const PngOptions& options = {});
 
+/// Writes mesh `mesh` of `scene` with the solution on the host's own vertices (the vertex
+/// colours of `radiosity bake`), as a binary little-endian PLY: per vertex the position, the
+/// lightmap UV1 as s/t (when the mesh has one), float irradiance_r/g/b and radiosity_r/g/b
+/// (Solution::mesh_vertex_values()) and 8-bit red/green/blue (sRGB of B/pi x exposure); the
+/// faces are the mesh's kept triangles, in its order. Throws Error{invalid_argument} for an
+/// unknown mesh or a solution not solved with this mesh, Error{io_error} naming the path when
+/// the file cannot be written.
+RADIOSITY_API void write_mesh_ply(const Scene& scene, const Solution& solution, MeshId mesh,
+                                  const std::filesystem::path& path, const PngOptions& options = {});
+
 /// Writes the statistics JSON of `radiosity solve --stats` (format in docs/CLI-stats.md):
 /// status, iterations, residual history, per-group mean radiosity and area, power balance,
 /// sizes, timings and warnings. Throws Error{io_error} naming the path when it cannot be written.

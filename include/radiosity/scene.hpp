@@ -169,7 +169,7 @@ struct Mesh {
   std::vector<glm::vec2> uv0, uv1;     ///< empty when absent
   /// Per triangle: the polygon it became, or kNone when it was skipped (degenerate).
   std::vector<PolygonId> triangle_polygon;
-  PolygonRange polygons;               ///< the polygons of its triangles, consecutive
+  PolygonRange polygons;               ///< the polygons of its triangles, consecutive (add_mesh())
 };
 
 /// Pinhole camera. `fov_deg` is the vertical field of view in degrees.
@@ -222,6 +222,18 @@ class RADIOSITY_API Scene {
   /// unchanged. Thread safety: mutates the scene.
   MeshId add_mesh(const MeshDesc& mesh, const LoadOptions& options = {});
   const std::vector<Mesh>& meshes() const { return meshes_; }
+
+  /// Gives the polygons that belong to no mesh (add_polygon(), add_quad(), cornell_box(), the
+  /// readers) an indexed triangle mesh per group, so that mesh results
+  /// (Solution::mesh_vertex_values()), lightmaps (bake_lightmap()) and `radiosity bake` reach
+  /// them: corners at bit-identical positions become one vertex (an OBJ's faces that share a
+  /// `v`), and each polygon a fan of triangles that all name it in Mesh::triangle_polygon (a
+  /// quad's two triangles read the whole quad). The polygons themselves do not change, so
+  /// neither does any solve; each gets Polygon::mesh and its first triangle's index. A group
+  /// mesh's Mesh::polygons spans its first to its last polygon (others may lie between).
+  /// Returns the new meshes' ids in group order: none for a group whose polygons all belong to
+  /// meshes. Cost: linear in the polygons' corners. Thread safety: mutates the scene.
+  std::vector<MeshId> add_group_meshes();
 
   /// Makes every material two-sided (Material::two_sided), for models whose winding cannot be
   /// trusted (CLI `--two-sided`): a closed room wound outwards then lights its inside. Costs a

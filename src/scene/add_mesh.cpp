@@ -5,7 +5,9 @@
 // with the others of its mesh in one warning, or refused under strict.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <unordered_map>
 
 #include <glm/geometric.hpp>
 
@@ -132,6 +134,61 @@ MeshId Scene::add_mesh(const MeshDesc& desc, const LoadOptions& options) {
                                static_cast<std::uint32_t>(polygons_.size() - first_polygon)};
   meshes_.push_back(std::move(mesh));
   return id;
+}
+
+std::vector<MeshId> Scene::add_group_meshes() {
+  // Exact position bits as the weld key (+0.0f turns -0 into +0, which compare equal).
+  struct Key {
+    std::uint32_t x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = k.x;
+      h = h * 0x9E3779B97F4A7C15ull ^ k.y;
+      h = h * 0x9E3779B97F4A7C15ull ^ k.z;
+      return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+  };
+  auto key = [](const glm::vec3& p) {
+    Key k{};
+    const glm::vec3 q = p + glm::vec3(0.0f);
+    std::memcpy(&k.x, &q.x, 4);
+    std::memcpy(&k.y, &q.y, 4);
+    std::memcpy(&k.z, &q.z, 4);
+    return k;
+  };
+
+  std::vector<std::vector<PolygonId>> by_group(groups_.size());
+  for (PolygonId p = 0; p < polygons_.size(); ++p)
+    if (polygons_[p].mesh == kNone) by_group[polygons_[p].group].push_back(p);
+  std::vector<MeshId> made;
+  for (GroupId g = 0; g < by_group.size(); ++g) {
+    if (by_group[g].empty()) continue;
+    const auto id = static_cast<MeshId>(meshes_.size());
+    Mesh mesh;
+    mesh.group = g;
+    std::unordered_map<Key, std::uint32_t, Hash> vertex;
+    auto vertex_of = [&](const glm::vec3& p) {
+      const auto [it, added] = vertex.try_emplace(key(p), static_cast<std::uint32_t>(mesh.positions.size()));
+      if (added) mesh.positions.push_back(p);
+      return it->second;
+    };
+    for (const PolygonId p : by_group[g]) {
+      Polygon& polygon = polygons_[p];
+      polygon.mesh = id;
+      polygon.mesh_triangle = static_cast<std::uint32_t>(mesh.triangle_polygon.size());
+      const std::uint32_t first = vertex_of(polygon.vertices[0]);
+      for (std::size_t k = 1; k + 1 < polygon.vertices.size(); ++k) {
+        mesh.indices.insert(mesh.indices.end(), {first, vertex_of(polygon.vertices[k]), vertex_of(polygon.vertices[k + 1])});
+        mesh.triangle_polygon.push_back(p);
+      }
+    }
+    mesh.polygons = PolygonRange{by_group[g].front(), by_group[g].back() - by_group[g].front() + 1};
+    meshes_.push_back(std::move(mesh));
+    made.push_back(id);
+  }
+  return made;
 }
 
 }  // namespace v1

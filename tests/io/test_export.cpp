@@ -16,6 +16,7 @@
 #include "io/writers/srgb.hpp"
 #include "radiosity/io.hpp"
 #include "radiosity/radiosity.hpp"
+#include "support/scenes.hpp"
 
 namespace {
 
@@ -275,6 +276,61 @@ TEST_CASE("write_stats_json records status - sizes - power - per-group radiosity
   CHECK(j.at("residual_history") == nlohmann::json::array({0.5, 0.01, 5e-4}));
   CHECK(j.at("time_history").size() == 3);
   CHECK(j.at("warnings") == nlohmann::json::array({"first warning", "second warning"}));
+}
+
+TEST_CASE("write_mesh_ply writes the host's vertices and triangles with UV1 and the solution on each vertex") {
+  // A furnace cube as one mesh with UV1: every vertex has H = B = E / (1 - rho).
+  radiosity::Scene scene;
+  radiosity::Material m;
+  m.emission = Rgb(1.0f);
+  m.reflectance = Rgb(0.5f);
+  const test::InwardCube cube;
+  std::vector<glm::vec2> uv1;
+  for (const glm::vec3& c : cube.corners) uv1.emplace_back(0.1f + 0.8f * c.x, 0.1f + 0.4f * c.y + 0.4f * c.z);
+  radiosity::MeshDesc d = cube.desc(scene.add_material(m));
+  d.uv1 = uv1.data();
+  const radiosity::MeshId id = scene.add_mesh(d);
+  radiosity::SolveOptions o;
+  o.form_factors.method = radiosity::FormFactorMethod::ray_cast;
+  o.mesh.max_patch_area = 0.1f;
+  o.tolerance = 1e-6;
+  const radiosity::Solution sol = radiosity::solve(scene, o);
+  const fs::path path = kTmp / "mesh.ply";
+  radiosity::write_mesh_ply(scene, sol, id, path, radiosity::PngOptions{0.5f});
+  const std::string bytes = read_all(path);
+  const std::size_t end = bytes.find("end_header\n");
+  REQUIRE(end != std::string::npos);
+  const std::string header = bytes.substr(0, end);
+  CHECK(contains(header, "element vertex 8\n"));
+  CHECK(contains(header, "element face 12\n"));
+  CHECK(contains(header, "property float s\nproperty float t\nproperty float irradiance_r\n"));
+  CHECK(contains(header, "property float radiosity_b\nproperty uchar red\n"));
+  // 11 floats and 3 bytes a vertex, 13 bytes a triangle.
+  const std::size_t body = end + std::string("end_header\n").size();
+  REQUIRE(bytes.size() == body + 47 * 8 + 13 * 12);
+  for (std::size_t v = 0; v < 8; ++v) {
+    const std::size_t at = body + 47 * v;
+    CHECK(get_le<float>(bytes, at) == cube.corners[v].x);
+    CHECK(get_le<float>(bytes, at + 12) == uv1[v].x);
+    CHECK(get_le<float>(bytes, at + 16) == uv1[v].y);
+    CHECK(get_le<float>(bytes, at + 20) == doctest::Approx(2.0).epsilon(2e-3));  // H
+    CHECK(get_le<float>(bytes, at + 32) == doctest::Approx(2.0).epsilon(2e-3));  // B
+    CHECK(static_cast<std::uint8_t>(bytes[at + 44]) ==
+          radiosity::detail::srgb8(0.5f * get_le<float>(bytes, at + 32) / 3.14159265358979323846f));
+  }
+  for (std::size_t t = 0; t < 12; ++t)
+    for (std::size_t k = 0; k < 3; ++k)
+      CHECK(get_le<std::uint32_t>(bytes, body + 47 * 8 + 13 * t + 1 + 4 * k) == cube.indices[3 * t + k]);
+
+  radiosity::Scene other;
+  other.add_mesh(cube.desc(other.add_material(m)));
+  try {
+    radiosity::write_mesh_ply(scene, sol, 3, path);
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK(e.code() == ErrorCode::invalid_argument);
+    CHECK(contains(e.what(), "mesh 3 does not exist"));
+  }
 }
 
 TEST_CASE("write_stats_json with options records the scene and the solve's method") {

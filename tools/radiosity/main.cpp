@@ -1,4 +1,4 @@
-// The `radiosity` command-line tool: render, solve, factors and check.
+// The `radiosity` command-line tool: render, solve, factors, check and bake.
 // Output formats are a contract that scripts parse: see docs/CLI.md.
 #include <cstdio>
 #include <filesystem>
@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "bake.hpp"
 #include "check.hpp"
 #include "factors.hpp"
 
@@ -80,10 +81,12 @@ int main(int argc, char** argv) {
 
   Command factors = add_factors_command(app);
   Command check = add_check_command(app);
+  Command bake = add_bake_command(app);
 
   if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
   if (*factors.app) return factors.run();
   if (*check.app) return check.run();
+  if (*bake.app) return bake.run();
 
   // What the user asked of the render pipeline; contradictions are argument errors.
   ModeRequest requested;

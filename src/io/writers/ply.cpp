@@ -29,12 +29,26 @@ void put_f32(std::string& out, float v) {
   put_u32(out, u);
 }
 
+/// Writes header + body to `path`; `who` names the writer in errors.
+void write_file(const std::filesystem::path& path, const std::string& header, const std::string& body, const char* who) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(ErrorCode::io_error, std::string(who) + ": cannot open '" + path.string() + "' for writing");
+  out.write(header.data(), static_cast<std::streamsize>(header.size()));
+  out.write(body.data(), static_cast<std::streamsize>(body.size()));
+  out.close();
+  if (!out) throw Error(ErrorCode::io_error, std::string(who) + ": cannot write '" + path.string() + "'");
+}
+
+void check_exposure(const PngOptions& options, const std::string& where) {
+  if (!(options.exposure >= 0.0f) || !std::isfinite(options.exposure))
+    throw Error(ErrorCode::invalid_argument, where + "PngOptions::exposure must be finite and >= 0");
+}
+
 }  // namespace
 
 void write_ply(const Solution& solution, const std::filesystem::path& path, const PngOptions& options) {
   const std::string where = "write_ply: '" + path.string() + "': ";
-  if (!(options.exposure >= 0.0f) || !std::isfinite(options.exposure))
-    throw Error(ErrorCode::invalid_argument, where + "PngOptions::exposure must be finite and >= 0");
+  check_exposure(options, where);
 
   const PatchHierarchy& h = solution.hierarchy();
   const std::vector<glm::vec3>& positions = h.vertices();
@@ -116,12 +130,62 @@ void write_ply(const Solution& solution, const std::filesystem::path& path, cons
   for (std::uint32_t leaf : h.leaves()) put_faces(leaf, remap, false);
   for (std::uint32_t leaf : backs) put_faces(leaf, back_remap, true);
 
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(ErrorCode::io_error, "write_ply: cannot open '" + path.string() + "' for writing");
-  out.write(header.data(), static_cast<std::streamsize>(header.size()));
-  out.write(body.data(), static_cast<std::streamsize>(body.size()));
-  out.close();
-  if (!out) throw Error(ErrorCode::io_error, "write_ply: cannot write '" + path.string() + "'");
+  write_file(path, header, body, "write_ply");
+}
+
+void write_mesh_ply(const Scene& scene, const Solution& solution, MeshId mesh, const std::filesystem::path& path,
+                    const PngOptions& options) {
+  const std::string where = "write_mesh_ply: '" + path.string() + "': ";
+  check_exposure(options, where);
+  if (mesh >= scene.meshes().size())
+    throw Error(ErrorCode::invalid_argument, where + "mesh " + std::to_string(mesh) + " does not exist (the scene has " +
+                                                 std::to_string(scene.meshes().size()) + " meshes)");
+  const Mesh& m = scene.meshes()[mesh];
+  if (mesh >= solution.meshes().size() || solution.meshes()[mesh].triangle_polygon != m.triangle_polygon ||
+      solution.meshes()[mesh].positions.size() != m.positions.size())
+    throw Error(ErrorCode::invalid_argument,
+                where + "mesh " + std::to_string(mesh) + " of the scene is not the mesh the solution was solved with");
+  const std::vector<Rgb> B = solution.mesh_vertex_values(mesh, Quantity::radiosity);
+  const std::vector<Rgb> H = solution.mesh_vertex_values(mesh, Quantity::irradiance);
+  std::size_t triangles = 0;
+  for (PolygonId p : m.triangle_polygon) triangles += p != kNone ? 1 : 0;
+  if (m.positions.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+    throw Error(ErrorCode::invalid_argument, where + "too many vertices for PLY int indices");
+  const bool uv = m.uv1.size() == m.positions.size();
+
+  std::string header;
+  header += "ply\nformat binary_little_endian 1.0\n";
+  header += std::string("comment written by radiosity ") + version() + "\n";
+  header += "comment the host mesh's own vertices and kept triangles; s/t: its lightmap UV1\n";
+  header += "comment irradiance_r/g/b: H, radiosity_r/g/b: B, W/m^2 per scene unit^2; red/green/blue: sRGB of B/pi x exposure\n";
+  header += "element vertex " + std::to_string(m.positions.size()) + "\n";
+  std::vector<const char*> properties = {"x", "y", "z"};
+  if (uv) properties.insert(properties.end(), {"s", "t"});
+  properties.insert(properties.end(), {"irradiance_r", "irradiance_g", "irradiance_b", "radiosity_r", "radiosity_g", "radiosity_b"});
+  for (const char* p : properties) header += std::string("property float ") + p + "\n";
+  for (const char* p : {"red", "green", "blue"}) header += std::string("property uchar ") + p + "\n";
+  header += "element face " + std::to_string(triangles) + "\n";
+  header += "property list uchar int vertex_indices\n";
+  header += "end_header\n";
+
+  std::string body;
+  body.reserve(m.positions.size() * 47 + triangles * 13);
+  for (std::size_t v = 0; v < m.positions.size(); ++v) {
+    for (int c = 0; c < 3; ++c) put_f32(body, m.positions[v][c]);
+    if (uv) {
+      put_f32(body, m.uv1[v].x);
+      put_f32(body, m.uv1[v].y);
+    }
+    for (int c = 0; c < 3; ++c) put_f32(body, H[v][c]);
+    for (int c = 0; c < 3; ++c) put_f32(body, B[v][c]);
+    for (int c = 0; c < 3; ++c) body.push_back(static_cast<char>(detail::srgb8(options.exposure * B[v][c] / kPi)));
+  }
+  for (std::size_t t = 0; t < m.triangle_polygon.size(); ++t) {
+    if (m.triangle_polygon[t] == kNone) continue;
+    body.push_back(3);
+    for (int k = 0; k < 3; ++k) put_u32(body, m.indices[3 * t + static_cast<std::size_t>(k)]);
+  }
+  write_file(path, header, body, "write_mesh_ply");
 }
 
 }  // namespace v1
