@@ -83,44 +83,66 @@ RADIOSITY_API Lightmap bake_lightmap(const Scene& scene, const Solution& solutio
                                      const LightmapOptions& options = {});
 
 /// How generate_lightmap_uvs() cuts and packs charts. Every field has a default.
+/// Thread safety: a plain value; generate_lightmap_uvs() only reads it.
 struct LightmapUvOptions {
-  /// Texels per scene unit of length. 0 (default): the largest density at which the charts
-  /// fit a `resolution` x `resolution` lightmap.
+  /// Texels per scene unit of length, finite and >= 0. 0 (default): the largest density at
+  /// which the charts fit a `resolution` x `resolution` lightmap (found to a relative 1e-5).
   float texels_per_unit = 0.0f;
-  int resolution = 1024;  ///< the lightmap's width and height in texels, > 0
+  int resolution = 1024;  ///< the lightmap's width and height in texels, > 2 * padding
   /// Empty texels kept between charts (and from the border), >= 0; at least the
   /// LightmapOptions::dilation that the lightmap will be baked with is right.
   int padding = 4;
   /// Neighbouring triangles join one planar chart while their normals stay within this angle
-  /// (degrees, in (0, 90)) of the chart's first triangle.
+  /// (degrees, in (0, 90)) of the chart's first (largest) triangle.
   float chart_angle_deg = 30.0f;
 };
 
+/// Checks options; throws Error{invalid_argument} naming the first bad field.
+RADIOSITY_API void validate(const LightmapUvOptions& options);
+
 /// Lightmap UVs for an indexed triangle mesh, as a host adopts them: triangles keep their order
 /// and corners, but vertices on a chart border are split (one copy per chart), so the mesh gets
-/// new vertices, each naming the host vertex it copies.
+/// new vertices, each naming the host vertex it copies. New vertices are ordered by host vertex
+/// (then chart), so a mesh that needs no split (and uses every vertex) keeps its numbering;
+/// host vertices that no triangle uses get none.
 struct LightmapUvs {
   std::vector<glm::vec2> uv1;                ///< per new vertex, in [0, 1]^2
   std::vector<std::uint32_t> vertex_origin;  ///< per new vertex: the host vertex it copies
   std::vector<std::uint32_t> indices;        ///< three per triangle, into the new vertices
+  std::vector<std::uint32_t> triangle_chart; ///< per triangle: its chart, < chart_count
   std::size_t chart_count = 0;
   float texels_per_unit = 0.0f;              ///< the density used
-  double utilisation = 0.0;                  ///< fraction of the lightmap's texels that charts cover
+  /// Fraction of the lightmap's texels that the charts' triangles cover (their UV area in
+  /// texels over resolution^2; padding and the corners of chart rectangles are not counted).
+  double utilisation = 0.0;
 };
 
-/// Cuts the mesh into planar charts (triangles grouped by normal, grown across shared edges),
-/// projects each onto its plane at one texel density and packs them into rows of the lightmap
-/// with `padding` texels between them. Degenerate triangles get a zero-area spot in a chart.
-/// Throws Error{invalid_argument} for bad options or indices, and when the charts cannot fit
-/// at the requested texels_per_unit. Deterministic. Thread safety: concurrent calls are safe.
+/// Cuts the mesh into planar charts (triangles grown across shared edges, keyed by the host's
+/// vertex indices, while their normals stay within chart_angle_deg of the chart's largest
+/// triangle; a triangle whose projection would overlap the chart's is left for another chart),
+/// projects each onto its plane at one texel density (isometric for a planar chart, shrunk by
+/// the cosine of the tilt otherwise), turns it to its minimum-area bounding rectangle with the
+/// long side along u, and packs the rectangles, snapped to whole texels, into rows of the
+/// lightmap with `padding` empty texels between them and from the border. UVs keep each
+/// triangle's winding (counter-clockwise seen from its front is counter-clockwise in UV).
+/// A degenerate (zero-area) triangle goes, with zero area, into a chart that holds all three of
+/// its corners, or else into one last chart of a single texel.
+/// Throws Error{invalid_argument} for bad options, an index_count that is not a multiple of 3, a
+/// null array with a count, an index out of range, a NaN or infinite position, and when the
+/// charts cannot fit at the requested texels_per_unit (the message names the largest density
+/// that fits) or at any density (more charts than the resolution has room for).
+/// Cost: O(n log n) in the triangles (a chart's overlap test is a grid over it), 0.1 to 0.3 s
+/// for 100k triangles on one core. Deterministic: the same input gives the same result.
+/// Thread safety: concurrent calls are safe.
 RADIOSITY_API LightmapUvs generate_lightmap_uvs(const glm::vec3* positions, std::size_t vertex_count,
                                                 const std::uint32_t* indices, std::size_t index_count,
                                                 const LightmapUvOptions& options = {});
 
-/// generate_lightmap_uvs() for a mesh of `scene`, adopted by it: the mesh's vertices are split
-/// as the result says (positions, normals and uv0 copied from their origin), its indices and
-/// uv1 replaced. Its polygons do not change; solve after this for mesh values on the new
-/// vertices. Throws as generate_lightmap_uvs() and Error{invalid_argument} for an unknown mesh.
+/// generate_lightmap_uvs() for a mesh of `scene`, adopted by it (Scene::set_mesh_lightmap_uvs):
+/// the mesh's vertices are split as the result says (positions, normals and uv0 copied from
+/// their origin), its indices and uv1 replaced. Its polygons do not change; solve after this
+/// for mesh values on the new vertices. Throws as generate_lightmap_uvs() and
+/// Error{invalid_argument} for an unknown mesh; the scene is then unchanged.
 /// Thread safety: mutates `scene`.
 RADIOSITY_API LightmapUvs generate_lightmap_uvs(Scene& scene, MeshId mesh, const LightmapUvOptions& options = {});
 

@@ -222,6 +222,18 @@ class RADIOSITY_API Scene {
   /// unchanged. Thread safety: mutates the scene.
   MeshId add_mesh(const MeshDesc& mesh, const LoadOptions& options = {});
   const std::vector<Mesh>& meshes() const { return meshes_; }
+  /// Gives mesh `mesh` lightmap coordinates by splitting its vertices (what
+  /// generate_lightmap_uvs() returns): new vertex i copies host vertex vertex_origin[i] (its
+  /// position, and its normal and uv0 when the mesh has them) and gets uv1[i]; `indices` replace
+  /// the mesh's, one new vertex per corner of the same triangles in the same order, so
+  /// vertex_origin[indices[c]] must be the corner's old index. Polygons and triangle_polygon do
+  /// not change (the geometry is the same); a Solution solved before keeps the old vertices.
+  /// Throws Error{invalid_argument} naming the mesh for an unknown mesh, sizes that disagree
+  /// (indices.size() must stay, uv1 has one entry per new vertex), an index or origin out of
+  /// range, a corner whose new vertex does not copy its old one, or a NaN or infinite uv1; the
+  /// mesh is then unchanged. Thread safety: mutates the scene.
+  void set_mesh_lightmap_uvs(MeshId mesh, const std::vector<std::uint32_t>& vertex_origin,
+                             std::vector<std::uint32_t> indices, std::vector<glm::vec2> uv1);
 
   /// Gives the polygons that belong to no mesh (add_polygon(), add_quad(), cornell_box(), the
   /// readers) an indexed triangle mesh per group, so that mesh results

@@ -3,6 +3,8 @@
 // rules are the readers' (LoadOptions): what cannot mean anything (an index out of range, a NaN)
 // is an error naming mesh and vertex or triangle; a degenerate triangle is skipped and reported
 // with the others of its mesh in one warning, or refused under strict.
+// Scene::set_mesh_lightmap_uvs(): a mesh's vertices split for lightmap UVs (lightmap/), checked
+// to be the same triangles, so its polygons stay as they are.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -189,6 +191,53 @@ std::vector<MeshId> Scene::add_group_meshes() {
     made.push_back(id);
   }
   return made;
+}
+
+void Scene::set_mesh_lightmap_uvs(MeshId id, const std::vector<std::uint32_t>& vertex_origin,
+                                  std::vector<std::uint32_t> indices, std::vector<glm::vec2> uv1) {
+  auto fail = [&](const std::string& problem) {
+    throw Error(ErrorCode::invalid_argument, "set_mesh_lightmap_uvs: mesh " + std::to_string(id) + ": " + problem);
+  };
+  if (id >= meshes_.size())
+    fail("does not exist (scene has " + std::to_string(meshes_.size()) + " meshes)");
+  const Mesh& old = meshes_[id];
+  const std::size_t count = vertex_origin.size();
+  if (indices.size() != old.indices.size())
+    fail(std::to_string(indices.size()) + " indices given, the mesh has " + std::to_string(old.indices.size()));
+  if (uv1.size() != count)
+    fail(std::to_string(uv1.size()) + " uv1 entries for " + std::to_string(count) + " new vertices");
+  if (count >= kNone) fail(std::to_string(count) + " new vertices exceed what 32-bit indices can address");
+  for (std::size_t v = 0; v < count; ++v) {
+    if (vertex_origin[v] >= old.positions.size())
+      fail("new vertex " + std::to_string(v) + " copies vertex " + std::to_string(vertex_origin[v]) +
+           ", out of range (" + std::to_string(old.positions.size()) + " vertices)");
+    if (!finite(uv1[v])) fail("uv1 of new vertex " + std::to_string(v) + " is NaN or infinite");
+  }
+  // The same triangles: each corner's new vertex copies the vertex it had.
+  for (std::size_t c = 0; c < indices.size(); ++c) {
+    if (indices[c] >= count)
+      fail("triangle " + std::to_string(c / 3) + ": index " + std::to_string(indices[c]) + " is out of range (" +
+           std::to_string(count) + " new vertices)");
+    if (vertex_origin[indices[c]] != old.indices[c])
+      fail("triangle " + std::to_string(c / 3) + ", corner " + std::to_string(c % 3) + ": new vertex " +
+           std::to_string(indices[c]) + " copies vertex " + std::to_string(vertex_origin[indices[c]]) +
+           ", the corner was vertex " + std::to_string(old.indices[c]));
+  }
+
+  // Built aside and moved in, so a throw above (or bad_alloc here) leaves the mesh unchanged.
+  std::vector<glm::vec3> positions(count), normals(old.normals.empty() ? 0 : count);
+  std::vector<glm::vec2> uv0(old.uv0.empty() ? 0 : count);
+  for (std::size_t v = 0; v < count; ++v) {
+    positions[v] = old.positions[vertex_origin[v]];
+    if (!normals.empty()) normals[v] = old.normals[vertex_origin[v]];
+    if (!uv0.empty()) uv0[v] = old.uv0[vertex_origin[v]];
+  }
+  Mesh& mesh = meshes_[id];
+  mesh.positions = std::move(positions);
+  mesh.normals = std::move(normals);
+  mesh.uv0 = std::move(uv0);
+  mesh.uv1 = std::move(uv1);
+  mesh.indices = std::move(indices);
 }
 
 }  // namespace v1

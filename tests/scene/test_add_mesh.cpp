@@ -221,3 +221,64 @@ TEST_SUITE("scene") {
     CHECK(scene.polygons()[0].area == doctest::Approx(1.5 * std::sqrt(3.0)).epsilon(1e-5));
   }
 }
+
+TEST_SUITE("scene") {
+  TEST_CASE("set_mesh_lightmap_uvs: split vertices copy their origin and a split of other triangles is refused") {
+    rad::Scene scene;
+    const test::InwardCube cube;
+    std::vector<glm::vec3> normals;
+    for (const glm::vec3& p : cube.corners) normals.push_back(glm::normalize(glm::vec3(0.5f) - p));
+    rad::MeshDesc desc = cube.desc(scene.add_material(rad::Material{}));
+    desc.normals = normals.data();
+    const rad::MeshId id = scene.add_mesh(desc);
+    const rad::Mesh before = scene.meshes()[id];
+    // The most split there is: one new vertex per corner.
+    const std::vector<std::uint32_t> origin = cube.indices;
+    std::vector<std::uint32_t> indices(36);
+    std::vector<glm::vec2> uv1(36);
+    for (std::uint32_t c = 0; c < 36; ++c) {
+      indices[c] = c;
+      uv1[c] = glm::vec2(float(c) / 36.0f, 0.5f);
+    }
+
+    auto refused = [&](std::uint32_t mesh, const std::vector<std::uint32_t>& o, const std::vector<std::uint32_t>& i,
+                       const std::vector<glm::vec2>& uv, const char* why) {
+      CAPTURE(why);
+      CHECK_THROWS_WITH_AS(scene.set_mesh_lightmap_uvs(mesh, o, i, uv), doctest::Contains(why), rad::Error);
+      CHECK(scene.meshes()[id].positions == before.positions);  // unchanged
+      CHECK(scene.meshes()[id].indices == before.indices);
+      CHECK(scene.meshes()[id].uv1.empty());
+    };
+    refused(3, origin, indices, uv1, "does not exist");
+    refused(id, origin, {0, 1, 2}, uv1, "3 indices given, the mesh has 36");
+    refused(id, origin, indices, {}, "0 uv1 entries for 36 new vertices");
+    std::vector<std::uint32_t> swapped = origin;
+    std::swap(swapped[0], swapped[1]);  // corners 0 and 1 are vertices 0 and 1
+    refused(id, swapped, indices, uv1, "triangle 0, corner 0: new vertex 0 copies vertex 1, the corner was vertex 0");
+    std::vector<std::uint32_t> beyond = indices;
+    beyond[5] = 36;
+    refused(id, origin, beyond, uv1, "triangle 1: index 36 is out of range");
+    std::vector<std::uint32_t> bad_origin = origin;
+    bad_origin[7] = 8;
+    refused(id, bad_origin, indices, uv1, "copies vertex 8, out of range");
+    std::vector<glm::vec2> nan = uv1;
+    nan[3].x = std::nanf("");
+    refused(id, origin, indices, nan, "uv1 of new vertex 3 is NaN");
+
+    const std::vector<rad::Polygon> polygons = scene.polygons();
+    scene.set_mesh_lightmap_uvs(id, origin, indices, uv1);
+    const rad::Mesh& after = scene.meshes()[id];
+    REQUIRE(after.positions.size() == 36);
+    REQUIRE(after.normals.size() == 36);
+    CHECK(after.uv0.empty());  // the mesh had none
+    CHECK(after.uv1 == uv1);
+    CHECK(after.indices == indices);
+    CHECK(after.triangle_polygon == before.triangle_polygon);
+    for (std::size_t c = 0; c < 36; ++c) {
+      CHECK(after.positions[c] == cube.corners[cube.indices[c]]);
+      CHECK(after.normals[c] == normals[cube.indices[c]]);
+    }
+    REQUIRE(scene.polygons().size() == polygons.size());
+    for (std::size_t p = 0; p < polygons.size(); ++p) CHECK(scene.polygons()[p].vertices == polygons[p].vertices);
+  }
+}
