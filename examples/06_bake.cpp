@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
   lo.gather_rays = 64;
   const rad::Lightmap floor_map = rad::bake_lightmap(scene, lit, level[0].id, lo);
   rad::write_exr(floor_map.image, folder / "floor_lightmap.exr");
-  rad::write_png(floor_map.image, folder / "floor_lightmap.png", rad::PngOptions{1.0f / 60.0f});
+  rad::write_png(floor_map.image, folder / "floor_lightmap.png", rad::PngOptions{1.0f / 4.0f});
   // The texel under the block's centre (1.8, 0, 1.8) is in its shadow.
   const int x = static_cast<int>((0.02f + 0.96f * 1.8f / 4.0f) * 256.0f), y = x;
   std::printf("floor lightmap %dx%d: %zu texels covered, %zu dilated, %.2f s; under the block %.2f, open floor %.2f "

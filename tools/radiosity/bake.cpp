@@ -3,6 +3,7 @@
 // where each went, at what resolution and density, in which units.
 #include "bake.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -33,7 +34,7 @@ struct BakeArgs {
   int dilation = rad::LightmapOptions{}.dilation;
   float texels_per_unit = 0.0f;
   std::string quantity = "irradiance";
-  float exposure = 1.0f;
+  float exposure = 0.0f;  ///< 0: automatic (the 99th percentile of the vertex values shown at 0.8)
 };
 
 rad::Quantity quantity_from_name(const std::string& name) {
@@ -120,8 +121,24 @@ int run_bake(const BakeArgs& a) {
     lo.threads = a.solve.threads;
     lo.seed = a.solve.seed;
     lo.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+    // Previews: one exposure for every mesh, so their brightness compares; automatic unless
+    // given, from the baked quantity on the meshes' vertices (cheap, before any texel is baked).
     rad::PngOptions po;
     po.exposure = a.exposure;
+    if (!(a.exposure > 0.0f)) {
+      std::vector<float> values;
+      for (rad::MeshId id = 0; id < scene.meshes().size(); ++id)
+        for (const rad::Rgb& v : sol.mesh_vertex_values(id, lo.quantity)) values.push_back(std::max({v.x, v.y, v.z}));
+      std::sort(values.begin(), values.end());
+      const float p99 = values.empty() ? 0.0f : values[values.size() * 99 / 100];
+      po.exposure = p99 > 0.0f ? 0.8f / p99 : 1.0f;
+      std::printf("preview exposure: %.4g (automatic: the 99th percentile of the vertex %s shows at 0.8; --exposure "
+                  "overrides)\n",
+                  po.exposure, a.quantity.c_str());
+    }
+    // A PLY colour shows B / pi; pi x exposure puts B on the lightmaps' scale.
+    rad::PngOptions ply_colours = po;
+    ply_colours.exposure = po.exposure * 3.14159265f;
 
     Json manifest;
     manifest["scene"] = a.solve.scene.empty() ? "cornell" : a.solve.scene;
@@ -162,7 +179,7 @@ int run_bake(const BakeArgs& a) {
       }
       if (a.vertex_colors) {
         const fs::path ply = fs::path(a.output) / (stem + ".ply");
-        rad::write_mesh_ply(scene, sol, id, ply, po);
+        rad::write_mesh_ply(scene, sol, id, ply, ply_colours);
         entry["ply"] = ply.filename().string();
       }
       meshes.push_back(entry);
@@ -208,9 +225,9 @@ Command add_bake_command(CLI::App& app) {
   cmd->add_option("--dilation", a.dilation, "Texels of gutter filled around each chart")
       ->check(in_range<int>(0, 64))
       ->capture_default_str();
-  cmd->add_option("--exposure", a.exposure, "PNG preview and PLY colour exposure (linear scale)")
-      ->check(any_number<float>())
-      ->capture_default_str();
+  cmd->add_option("--exposure", a.exposure,
+                  "Lightmap preview exposure (linear scale; PLY colours show B/pi at pi times it); default automatic")
+      ->check(positive<float>());
   add_solve_options(*cmd, a.solve);
   return Command{cmd, [args] { return run_bake(*args); }};
 }
