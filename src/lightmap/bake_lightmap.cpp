@@ -509,11 +509,11 @@ Lightmap bake_lightmap(const Scene& scene, const Solution& solution, const std::
     const std::uint32_t* tri = &m.indices[3 * static_cast<std::size_t>(s.triangle)];
     glm::vec3 point = s.bary.x * m.positions[tri[0]] + s.bary.y * m.positions[tri[1]] + s.bary.z * m.positions[tri[2]];
     // A texel on a chart border reads the triangle's edge, where another surface may meet it (a
-    // wall on a floor): gather rays from there would start behind that surface. A step towards
-    // the centroid, 0.1 % of the way or a few ray offsets, keeps the point inside.
+    // wall on a floor): gather rays from there would start behind that surface. A step of a few
+    // ray offsets towards the centroid keeps the point inside.
     const glm::vec3 centroid = (m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f;
     const float to_centroid = glm::length(centroid - point);
-    if (to_centroid > 0.0f) point += (centroid - point) * std::min(1.0f, std::max(1e-3f, 4.0f * epsilon / to_centroid));
+    if (to_centroid > 0.0f) point += (centroid - point) * std::min(1.0f, 4.0f * epsilon / to_centroid);
     const PolygonId polygon = m.triangle_polygon[s.triangle];
     const glm::vec3& n = scene.polygons()[polygon].normal;
     if (gather) {

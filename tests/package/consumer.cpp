@@ -1,5 +1,6 @@
 // Links the installed library, checks header/binary versions agree and runs a coarse Cornell box,
-// once by solve() and once relit through a kept Problem, and adds a host's indexed mesh.
+// once by solve() and once relit through a kept Problem, and adds a host's indexed mesh, makes
+// its lightmap UVs and bakes a lightmap.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -46,5 +47,21 @@ int main() {
   mesh.group = "quad";
   const radiosity::MeshId id = host.add_mesh(mesh);
   std::printf("consumer: mesh %u gave %zu polygons of total area %.3g\n", id, host.polygons().size(), host.total_area());
-  return host.polygons().size() == 2 && std::fabs(host.total_area() - 1.0) < 1e-6 ? 0 : 1;
+  if (!(host.polygons().size() == 2 && std::fabs(host.total_area() - 1.0) < 1e-6)) return 1;
+
+  // Lightmap UVs made for it, a lamp over it, and its lightmap: every covered texel lit.
+  const radiosity::LightmapUvs uvs = radiosity::generate_lightmap_uvs(host, id);
+  radiosity::Material lamp;
+  lamp.emission = radiosity::Rgb(10.0f);
+  radiosity::add_quad(host, {0.25f, 0.25f, 1.0f}, {0.0f, 0.5f, 0.0f}, {0.5f, 0.0f, 0.0f}, host.add_material(lamp));
+  const radiosity::Solution lit = radiosity::solve(host);
+  radiosity::LightmapOptions lo;
+  lo.width = lo.height = 64;
+  const radiosity::Lightmap map = radiosity::bake_lightmap(host, lit, id, lo);
+  float darkest = 1e30f;
+  for (std::size_t i = 0; i < map.state.size(); ++i)
+    if (map.state[i] == radiosity::TexelState::covered) darkest = std::fmin(darkest, map.image.pixels[i].y);
+  std::printf("consumer: lightmap of %zu charts, %zu texels covered, darkest %.3g W/m^2\n", uvs.chart_count,
+              map.covered, darkest);
+  return map.covered > 1000 && darkest > 0.0f ? 0 : 1;
 }
