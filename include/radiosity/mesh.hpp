@@ -1,6 +1,6 @@
 // The patch hierarchy: polygons meshed into patches, each patch the root of a quadtree of
 // elements. Transport is computed from elements (leaves) to patches; radiosity is constant per
-// element and interpolated to shared vertices for display.
+// element and interpolated to shared vertices for display, across the edges of a smooth surface.
 #pragma once
 
 #include <array>
@@ -17,13 +17,22 @@
 namespace radiosity {
 inline namespace v1 {
 
-/// How finely polygons are meshed. Areas are in scene units squared; 0 means "derive from the
-/// scene": max_patch_area = total area / 512 and max_element_area = max_patch_area / 4, which
-/// gives the default Cornell box a few hundred patches and a few thousand elements. A derived
-/// max_patch_area is raised to an explicit max_element_area that exceeds it.
+/// How finely polygons are meshed, and which of them share vertices. Areas are in scene units
+/// squared; 0 means "derive from the scene": max_patch_area = total area / 512 and
+/// max_element_area = max_patch_area / 4, which gives the default Cornell box a few hundred
+/// patches and a few thousand elements. A derived max_patch_area is raised to an explicit
+/// max_element_area that exceeds it.
 struct MeshOptions {
   float max_patch_area = 0.0f;
   float max_element_area = 0.0f;
+  /// Two triangles or quads that share an edge (the same two end points, bit for bit, in either
+  /// direction) share its vertices when they have the same material and group and their normals
+  /// are at most this many degrees apart, so vertex_values() is continuous across the triangles
+  /// of a smooth surface (a tessellated sphere, a host's indexed mesh) and broken at creases and
+  /// material changes. In [0, 180); 0 shares nothing between polygons. It changes only the
+  /// vertices, never patches or elements, so solves do not depend on it (adaptive subdivision
+  /// aside, which reads vertex values).
+  float crease_angle_deg = 30.0f;
 };
 
 /// A node of a patch's quadtree. Leaves carry the radiosity unknowns; an inner node's value is
@@ -54,8 +63,10 @@ struct Patch {
 };
 
 /// Patches, their element quadtrees and the vertices the elements share. Vertices are shared
-/// between neighbouring elements of one polygon (including across patch borders); polygons do
-/// not share vertices, so interpolation never blends across a crease or a material change.
+/// between neighbouring elements of one polygon (including across patch borders) and between
+/// smooth neighbouring polygons (MeshOptions::crease_angle_deg), so interpolation blends across
+/// the edges of a smooth surface but never across a crease or a material change. Polygons with
+/// more than four corners share nothing (their fan triangles do not share either).
 /// Thread safety: const member functions may be called concurrently; subdivide() needs exclusive access.
 class RADIOSITY_API PatchHierarchy {
  public:
@@ -66,7 +77,8 @@ class RADIOSITY_API PatchHierarchy {
   PatchHierarchy(PatchHierarchy&&) noexcept;
   PatchHierarchy& operator=(PatchHierarchy&&) noexcept;
   /// Meshes every polygon of `scene`. Throws Error{invalid_argument} if an area option is
-  /// negative or NaN, or if max_element_area > max_patch_area.
+  /// negative or NaN, if max_element_area > max_patch_area, or if crease_angle_deg is outside
+  /// [0, 180).
   PatchHierarchy(const Scene& scene, const MeshOptions& options);
 
   const std::vector<Patch>& patches() const { return patches_; }
@@ -97,9 +109,13 @@ class RADIOSITY_API PatchHierarchy {
   glm::vec3 sample_point(std::uint32_t element, glm::vec2 uv) const;
 
   /// Per-vertex values for smooth display from per-element values (indexed by element id; only
-  /// leaves are read): the area-weighted mean of the leaves around each vertex, then every
-  /// hanging (T-) vertex set to the linear interpolation along the coarser neighbour's edge, so
-  /// the interpolated field is continuous.
+  /// leaves are read): the area-weighted mean of the leaves around each vertex (over every
+  /// polygon that shares it), then every hanging (T-) vertex set to the linear interpolation
+  /// along the coarser neighbour's edge, so the interpolated field is continuous within a
+  /// polygon and across the edges it shares with smooth neighbours. Where two smooth
+  /// neighbours cut their edge into different numbers of patches (so its inner points are not
+  /// shared), the points both sides have are averaged over both and the others interpolated
+  /// between them, which keeps the field continuous there too.
   std::vector<Rgb> vertex_values(const std::vector<Rgb>& element_values) const;
 
   /// Fills inner nodes with the area-weighted mean of their children (leaves are read).
@@ -110,9 +126,14 @@ class RADIOSITY_API PatchHierarchy {
   std::uint32_t add_vertex(const glm::vec3& position, std::uint32_t edge_a, std::uint32_t edge_b);
   std::uint32_t midpoint(std::uint32_t a, std::uint32_t b);
   void add_patch(PolygonId polygon_id, const Polygon& polygon, const std::array<std::uint32_t, 4>& corners);
-  void mesh_quad(PolygonId polygon_id, const Polygon& polygon);
+  /// Meshing's view of which polygon corners and edges are shared (patch_hierarchy.cpp).
+  struct Weld;
+  void mesh_quad(PolygonId polygon_id, const Polygon& polygon, Weld& weld);
   void mesh_triangle(PolygonId polygon_id, const Polygon& polygon, const glm::vec3& p0, const glm::vec3& p1,
-                     const glm::vec3& p2);
+                     const glm::vec3& p2, Weld& weld);
+  /// Vertex ids for a welded polygon's lattice points (see patch_hierarchy.cpp).
+  void place_lattice(PolygonId polygon_id, const std::vector<glm::vec3>& positions, Weld& weld,
+                     std::vector<std::uint32_t>& ids);
 
   MeshOptions options_;
   std::vector<Patch> patches_;

@@ -1,5 +1,5 @@
-// Meshing of scene polygons into patches and element quadtrees, with shared vertices and
-// crack-free per-vertex interpolation.
+// Meshing of scene polygons into patches and element quadtrees, with vertices shared within a
+// polygon and across the smooth edges between polygons, and crack-free per-vertex interpolation.
 // Based on:
 //   M. F. Cohen, D. P. Greenberg, D. S. Immel & P. J. Brock, "An efficient radiosity approach for
 //     realistic image synthesis", IEEE Computer Graphics and Applications 6(3), 1986
@@ -9,19 +9,25 @@
 //     SIGGRAPH 1991 (shared vertices, T-vertices and their interpolation).
 //   M. F. Cohen & J. R. Wallace, "Radiosity and Realistic Image Synthesis", Academic Press 1993,
 //     ch. 8 (quadtree element meshes, vertex radiosities by area-weighted averaging).
+//   R. E. Tarjan, "Efficiency of a good but not linear set union algorithm", J. ACM 22(2), 1975
+//     (union-find, here over polygon corners joined by smooth edges).
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <numeric>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "radiosity/mesh.hpp"
 
+#include "core/assert.hpp"
 #include "core/sampling.hpp"
 
 namespace radiosity {
@@ -81,6 +87,56 @@ void check_area_option(float value, const char* field) {
                 std::string("MeshOptions::") + field + " must be >= 0 (0 derives it), got " + std::to_string(value));
 }
 
+void check_crease_option(float value) {
+  if (!(value >= 0.0f && value < 180.0f))
+    throw Error(ErrorCode::invalid_argument,
+                "MeshOptions::crease_angle_deg must be in [0, 180) degrees (0 shares no vertices between "
+                "polygons), got " + std::to_string(value));
+}
+
+// Welding compares positions bit for bit: a shared vertex then sits exactly where each polygon's
+// own corner or lattice point would have, so patches and elements (and every solve) do not
+// depend on what is shared.
+std::array<std::uint32_t, 3> position_bits(const glm::vec3& p) {
+  std::array<std::uint32_t, 3> bits{};
+  static_assert(sizeof(bits) == sizeof(glm::vec3), "glm::vec3 is three packed floats");
+  std::memcpy(bits.data(), &p, sizeof(bits));
+  return bits;
+}
+
+bool same_bits(const glm::vec3& a, const glm::vec3& b) { return position_bits(a) == position_bits(b); }
+
+// SplitMix64's finaliser: spreads the few bits in which neighbouring grid positions differ.
+std::uint64_t mix(std::uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+std::uint64_t position_hash(const glm::vec3& p) {
+  const std::array<std::uint32_t, 3> b = position_bits(p);
+  return mix(((static_cast<std::uint64_t>(b[0]) << 32) | b[1]) ^ mix(b[2]));
+}
+
+// Union-find with path halving; the smaller index becomes the root, so every class's root is
+// its first member whatever the order of the unions.
+std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
+  a = find_root(parent, a);
+  b = find_root(parent, b);
+  if (a < b) parent[b] = a;
+  else if (b < a) parent[a] = b;
+}
+
 }  // namespace
 
 struct PatchHierarchy::Edges {
@@ -88,7 +144,206 @@ struct PatchHierarchy::Edges {
   std::unordered_map<std::uint64_t, std::uint32_t> midpoints;
   /// For a midpoint vertex, the edge it splits (kNone for lattice and centre vertices).
   std::vector<std::array<std::uint32_t, 2>> vertex_edge;
+  /// Edges between smooth neighbours whose inner points are not shared (the two sides cut the
+  /// edge into different numbers of segments, or their lattice points round differently):
+  /// vertex_values() makes the field continuous along them. A seam is seam_sides[first ..
+  /// first + count); a side is {its first point in seam_points, its segment count n}, and its
+  /// n + 1 points run from the same end of the edge for every side of the seam.
+  struct Seam {
+    std::uint32_t first = 0, count = 0;
+  };
+  std::vector<Seam> seams;
+  std::vector<std::array<std::uint32_t, 2>> seam_sides;
+  std::vector<std::uint32_t> seam_points;
 };
+
+// Which polygon corners are one vertex and which polygon edges are one edge, found before
+// meshing; then, while meshing, the vertices made for them. Triangles and quads that share an
+// edge (the same two end positions, bit for bit) are smooth neighbours when they have the same
+// material and group and their normals are within the crease angle; union-find over the
+// (polygon, corner) pairs joined by smooth edges gives the corner classes, each one vertex.
+// An edge's inner lattice points are shared when the next polygon cuts it into the same number
+// of segments at the same positions; otherwise it gets a side of its own, and the edge becomes
+// a seam (Edges).
+struct PatchHierarchy::Weld {
+  /// One polygon's cut of a shared edge: `count` segments from vertex `start` to `end`, its
+  /// count - 1 inner points at inner[first_inner ..]; `next` is the edge's next side.
+  struct Side {
+    std::uint32_t start, end, count, first_inner, next;
+  };
+
+  /// Per polygon: the index of its corner 0 among all corners, kNone if it shares nothing
+  /// (more than four corners, or welding is off). Empty when welding is off.
+  std::vector<std::uint32_t> first_corner;
+  std::vector<std::uint32_t> root;    ///< per corner: the first corner of its class
+  std::vector<std::uint32_t> vertex;  ///< per class root: its vertex, once made
+  std::vector<std::uint32_t> edge;    ///< per corner c: the shared edge from c to the next corner, or kNone
+  std::uint32_t edge_count = 0;
+  std::vector<std::uint32_t> first_side;  ///< per shared edge: its first side, or kNone
+  std::vector<Side> sides;
+  std::vector<std::uint32_t> inner;
+
+  /// Scratch of the polygon being meshed: its lattice positions, their vertex ids, and the
+  /// lattice indices along each edge from corner c to corner c + 1 (along[along_start[c] ..
+  /// along_start[c + 1])).
+  std::vector<glm::vec3> positions;
+  std::vector<std::uint32_t> ids;
+  std::vector<std::uint32_t> along;
+  std::array<std::uint32_t, 5> along_start{};
+  std::uint32_t along_edges = 0;
+
+  Weld() = default;
+  Weld(const std::vector<Polygon>& polygons, float crease_angle_deg);
+
+  bool welded(PolygonId polygon) const { return !first_corner.empty() && first_corner[polygon] != kNone; }
+  /// Records the edges that ended up with more than one side in `edges`, as seams.
+  void make_seams(Edges& edges) const;
+};
+
+PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_angle_deg) {
+  // Number the corners of the triangles and quads; a fan polygon shares nothing (its triangles
+  // do not share vertices with each other either).
+  first_corner.assign(polygons.size(), kNone);
+  std::size_t corner_count = 0;
+  for (std::size_t p = 0; p < polygons.size(); ++p) {
+    const std::size_t n = polygons[p].vertices.size();
+    if (n != 3 && n != 4) continue;
+    first_corner[p] = static_cast<std::uint32_t>(corner_count);
+    corner_count += n;
+    if (corner_count >= kNone)
+      throw Error(ErrorCode::memory_budget, "PatchHierarchy: more polygon corners than 32-bit ids can index");
+  }
+  const auto count = static_cast<std::uint32_t>(corner_count);
+  std::vector<std::uint32_t> polygon_of(count);
+  for (std::size_t p = 0; p < polygons.size(); ++p)
+    if (first_corner[p] != kNone)
+      for (std::size_t c = 0; c < polygons[p].vertices.size(); ++c)
+        polygon_of[first_corner[p] + c] = static_cast<std::uint32_t>(p);
+  auto next_corner = [&](std::uint32_t c) {
+    const std::uint32_t p = polygon_of[c];
+    return c + 1 < first_corner[p] + polygons[p].vertices.size() ? c + 1 : first_corner[p];
+  };
+  auto position_of = [&](std::uint32_t c) -> const glm::vec3& {
+    return polygons[polygon_of[c]].vertices[c - first_corner[polygon_of[c]]];
+  };
+
+  // 1. Number the distinct positions, in an open-addressing hash table of corner indices (load
+  // at most 1/2), so that the rest compares small integers.
+  std::vector<std::uint32_t> position(count);
+  std::uint32_t distinct = 0;
+  {
+    std::size_t size = 16;
+    while (size < 2 * corner_count) size *= 2;
+    std::vector<std::uint32_t> table(size, kNone);  // a corner with that position
+    for (std::uint32_t c = 0; c < count; ++c) {
+      const glm::vec3& q = position_of(c);
+      std::size_t slot = static_cast<std::size_t>(position_hash(q)) & (size - 1);
+      while (table[slot] != kNone && !same_bits(position_of(table[slot]), q)) slot = (slot + 1) & (size - 1);
+      if (table[slot] == kNone) {
+        table[slot] = c;
+        position[c] = distinct++;
+      } else {
+        position[c] = position[table[slot]];
+      }
+    }
+  }
+
+  // 2. Group the edges by their two end positions: each edge goes into the bucket of its lower
+  // end, keyed by (upper end, corner) so that sorting a bucket brings an edge's polygons
+  // together in corner order (deterministic). O(corners) but for the sorts of buckets, which
+  // hold a vertex's few edges.
+  std::vector<std::uint32_t> bucket_start(static_cast<std::size_t>(distinct) + 1, 0);
+  for (std::uint32_t c = 0; c < count; ++c) {
+    const std::uint32_t a = position[c], b = position[next_corner(c)];
+    if (a != b) ++bucket_start[std::min(a, b) + 1];
+  }
+  std::partial_sum(bucket_start.begin(), bucket_start.end(), bucket_start.begin());
+  std::vector<std::uint64_t> bucket(bucket_start.back());
+  {
+    std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
+    for (std::uint32_t c = 0; c < count; ++c) {
+      const std::uint32_t a = position[c], b = position[next_corner(c)];
+      if (a != b) bucket[fill[std::min(a, b)]++] = (static_cast<std::uint64_t>(std::max(a, b)) << 32) | c;
+    }
+  }
+
+  // 3. Join the corners of smooth neighbours, and number each set of polygon edges joined by
+  // smoothness (usually a pair) as one shared edge.
+  const double cos_crease = std::cos(glm::radians(static_cast<double>(crease_angle_deg)));
+  auto smooth = [&](std::uint32_t p, std::uint32_t q) {
+    const Polygon &a = polygons[p], &b = polygons[q];
+    return p != q && a.material == b.material && a.group == b.group &&
+           static_cast<double>(glm::dot(a.normal, b.normal)) >= cos_crease;
+  };
+  root.resize(count);
+  std::iota(root.begin(), root.end(), 0u);
+  edge.assign(count, kNone);
+  std::vector<std::uint32_t> local, members, local_edge;
+  for (std::uint32_t v = 0; v < distinct; ++v) {
+    const auto begin = bucket.begin() + bucket_start[v], end = bucket.begin() + bucket_start[v + 1];
+    std::sort(begin, end);
+    for (auto run = begin; run != end;) {
+      auto run_end = run + 1;
+      while (run_end != end && (*run_end >> 32) == (*run >> 32)) ++run_end;
+      const auto r = static_cast<std::uint32_t>(run_end - run);
+      if (r >= 2) {
+        // Union-find among the run's edges too, for the rare edge with more than two polygons.
+        local.resize(r);
+        std::iota(local.begin(), local.end(), 0u);
+        for (std::uint32_t i = 0; i < r; ++i)
+          for (std::uint32_t j = i + 1; j < r; ++j) {
+            const auto ci = static_cast<std::uint32_t>(run[i]), cj = static_cast<std::uint32_t>(run[j]);
+            if (!smooth(polygon_of[ci], polygon_of[cj])) continue;
+            const std::uint32_t ni = next_corner(ci), nj = next_corner(cj);
+            if (position[ci] == position[cj]) {  // same direction (the polygons' orders disagree)
+              unite(root, ci, cj);
+              unite(root, ni, nj);
+            } else {  // opposite directions: consistently oriented neighbours
+              unite(root, ci, nj);
+              unite(root, ni, cj);
+            }
+            unite(local, i, j);
+          }
+        members.assign(r, 0);
+        local_edge.assign(r, kNone);
+        for (std::uint32_t i = 0; i < r; ++i) ++members[find_root(local, i)];
+        for (std::uint32_t i = 0; i < r; ++i) {
+          const std::uint32_t l = find_root(local, i);
+          if (members[l] < 2) continue;
+          if (local_edge[l] == kNone) local_edge[l] = edge_count++;
+          edge[static_cast<std::uint32_t>(run[i])] = local_edge[l];
+        }
+      }
+      run = run_end;
+    }
+  }
+  for (std::uint32_t c = 0; c < count; ++c) root[c] = find_root(root, c);
+  vertex = std::move(position);  // reuse the memory
+  std::fill(vertex.begin(), vertex.end(), kNone);
+  first_side.assign(edge_count, kNone);
+}
+
+void PatchHierarchy::Weld::make_seams(Edges& edges) const {
+  for (std::uint32_t e = 0; e < edge_count; ++e) {
+    const std::uint32_t head = first_side[e];
+    if (head == kNone || sides[head].next == kNone) continue;  // unused, or shared point for point
+    Edges::Seam seam;
+    seam.first = static_cast<std::uint32_t>(edges.seam_sides.size());
+    for (std::uint32_t s = head; s != kNone; s = sides[s].next) {
+      const Side& side = sides[s];
+      const bool forward = side.start == sides[head].start;
+      RADIOSITY_ASSERT(forward ? side.end == sides[head].end
+                               : side.start == sides[head].end && side.end == sides[head].start);
+      edges.seam_sides.push_back({static_cast<std::uint32_t>(edges.seam_points.size()), side.count});
+      edges.seam_points.push_back(forward ? side.start : side.end);
+      for (std::uint32_t m = 1; m < side.count; ++m)
+        edges.seam_points.push_back(inner[side.first_inner + (forward ? m : side.count - m) - 1]);
+      edges.seam_points.push_back(forward ? side.end : side.start);
+      ++seam.count;
+    }
+    edges.seams.push_back(seam);
+  }
+}
 
 PatchHierarchy::PatchHierarchy() : edges_(std::make_unique<Edges>()) {}
 PatchHierarchy::~PatchHierarchy() = default;
@@ -112,6 +367,7 @@ PatchHierarchy& PatchHierarchy::operator=(const PatchHierarchy& other) {
 PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) : PatchHierarchy() {
   check_area_option(options.max_patch_area, "max_patch_area");
   check_area_option(options.max_element_area, "max_element_area");
+  check_crease_option(options.crease_angle_deg);
   const double total_area = scene.total_area();
 
   // Derive what was left at 0. A derived patch limit never undercuts an explicit element limit:
@@ -140,20 +396,22 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
                     " elements would be created");
 
   const std::vector<Polygon>& polygons = scene.polygons();
+  Weld weld = options_.crease_angle_deg > 0.0f ? Weld(polygons, options_.crease_angle_deg) : Weld();
   for (PolygonId id = 0; id < polygons.size(); ++id) {
     const Polygon& polygon = polygons[id];
     const PolygonVertices& p = polygon.vertices;
     if (p.size() == 4) {
-      mesh_quad(id, polygon);
+      mesh_quad(id, polygon, weld);
     } else if (p.size() == 3) {
-      mesh_triangle(id, polygon, p[0], p[1], p[2]);
+      mesh_triangle(id, polygon, p[0], p[1], p[2], weld);
     } else {
       // A convex polygon with more vertices is a fan of triangles around vertex 0. Each triangle
       // gets its own lattice, so vertices are not shared across the fan diagonals: vertex values
-      // may be discontinuous there (the same as at a polygon border).
-      for (std::size_t i = 1; i + 1 < p.size(); ++i) mesh_triangle(id, polygon, p[0], p[i], p[i + 1]);
+      // may be discontinuous there (the same as at a crease). Such polygons are not welded.
+      for (std::size_t i = 1; i + 1 < p.size(); ++i) mesh_triangle(id, polygon, p[0], p[i], p[i + 1], weld);
     }
   }
+  weld.make_seams(*edges_);
 
   // Split each patch's root until every leaf fits max_element_area. Roots are visited in order
   // and their subtrees depth-first, so element ids and leaves() do not depend on anything else.
@@ -221,7 +479,7 @@ void PatchHierarchy::add_patch(PolygonId polygon_id, const Polygon& polygon,
   patches_.push_back(patch);
 }
 
-void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon) {
+void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon, Weld& weld) {
   const PolygonVertices& p = polygon.vertices;
   const glm::dvec3 p0(p[0]), p1(p[1]), p2(p[2]), p3(p[3]);
   // Bilinear map P(s,t) = (1-s)(1-t)p0 + s(1-t)p1 + st p2 + (1-s)t p3; for a planar convex quad
@@ -257,26 +515,45 @@ void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon) {
   }
 
   // Grid vertices, created once and shared by the patches around them.
-  const std::uint32_t base = static_cast<std::uint32_t>(vertices_.size());
+  std::vector<glm::vec3>& q = weld.positions;
+  q.clear();
   for (std::size_t j = 0; j <= nv; ++j)
     for (std::size_t i = 0; i <= nu; ++i) {
       // Use the input corners exactly so that patch borders on the polygon border are not moved.
-      glm::vec3 q;
-      if (i == 0 && j == 0) q = p[0];
-      else if (i == nu && j == 0) q = p[1];
-      else if (i == nu && j == nv) q = p[2];
-      else if (i == 0 && j == nv) q = p[3];
-      else q = glm::vec3(at(double(i) / double(nu), double(j) / double(nv)));
-      add_vertex(q, kNone, kNone);
+      if (i == 0 && j == 0) q.push_back(p[0]);
+      else if (i == nu && j == 0) q.push_back(p[1]);
+      else if (i == nu && j == nv) q.push_back(p[2]);
+      else if (i == 0 && j == nv) q.push_back(p[3]);
+      else q.push_back(glm::vec3(at(double(i) / double(nu), double(j) / double(nv))));
     }
-  auto vid = [&](std::size_t i, std::size_t j) { return base + static_cast<std::uint32_t>(j * (nu + 1) + i); };
+  auto index = [&](std::size_t i, std::size_t j) { return static_cast<std::uint32_t>(j * (nu + 1) + i); };
+  std::vector<std::uint32_t>& ids = weld.ids;
+  if (weld.welded(polygon_id)) {
+    // The four edges, each from its corner c to corner c + 1.
+    weld.along.clear();
+    weld.along_start[0] = 0;
+    for (std::size_t i = 0; i <= nu; ++i) weld.along.push_back(index(i, 0));
+    weld.along_start[1] = static_cast<std::uint32_t>(weld.along.size());
+    for (std::size_t j = 0; j <= nv; ++j) weld.along.push_back(index(nu, j));
+    weld.along_start[2] = static_cast<std::uint32_t>(weld.along.size());
+    for (std::size_t i = nu + 1; i-- > 0;) weld.along.push_back(index(i, nv));
+    weld.along_start[3] = static_cast<std::uint32_t>(weld.along.size());
+    for (std::size_t j = nv + 1; j-- > 0;) weld.along.push_back(index(0, j));
+    weld.along_start[4] = static_cast<std::uint32_t>(weld.along.size());
+    weld.along_edges = 4;
+    place_lattice(polygon_id, q, weld, ids);
+  } else {
+    ids.clear();
+    for (const glm::vec3& position : q) ids.push_back(add_vertex(position, kNone, kNone));
+  }
+  auto vid = [&](std::size_t i, std::size_t j) { return ids[index(i, j)]; };
   for (std::size_t j = 0; j < nv; ++j)
     for (std::size_t i = 0; i < nu; ++i)
       add_patch(polygon_id, polygon, {vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)});
 }
 
 void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon, const glm::vec3& p0,
-                                   const glm::vec3& p1, const glm::vec3& p2) {
+                                   const glm::vec3& p1, const glm::vec3& p2, Weld& weld) {
   const glm::dvec3 a(p0), b(p1), c(p2);
   const double area = triangle_area(a, b, c);
   // k x k similar sub-triangles, each of area area / k^2.
@@ -285,21 +562,36 @@ void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon,
   while (!fits(area / double(k * k), options_.max_patch_area)) ++k;
 
   // Lattice vertex (i, j), i + j <= k, at p0 + i/k (p1 - p0) + j/k (p2 - p0); row j holds k+1-j vertices.
-  const std::uint32_t base = static_cast<std::uint32_t>(vertices_.size());
+  std::vector<glm::vec3>& q = weld.positions;
+  q.clear();
   std::vector<std::uint32_t> row_start(k + 2);
-  std::uint32_t next = base;
   for (std::size_t j = 0; j <= k; ++j) {
-    row_start[j] = next;
+    row_start[j] = static_cast<std::uint32_t>(q.size());
     for (std::size_t i = 0; i + j <= k; ++i) {
-      glm::vec3 q;
-      if (i == 0 && j == 0) q = p0;
-      else if (i == k) q = p1;
-      else if (j == k) q = p2;
-      else q = glm::vec3(a + (double(i) / double(k)) * (b - a) + (double(j) / double(k)) * (c - a));
-      next = add_vertex(q, kNone, kNone) + 1;
+      if (i == 0 && j == 0) q.push_back(p0);
+      else if (i == k) q.push_back(p1);
+      else if (j == k) q.push_back(p2);
+      else q.push_back(glm::vec3(a + (double(i) / double(k)) * (b - a) + (double(j) / double(k)) * (c - a)));
     }
   }
-  auto vid = [&](std::size_t i, std::size_t j) { return row_start[j] + static_cast<std::uint32_t>(i); };
+  auto index = [&](std::size_t i, std::size_t j) { return row_start[j] + static_cast<std::uint32_t>(i); };
+  std::vector<std::uint32_t>& ids = weld.ids;
+  if (weld.welded(polygon_id)) {  // never a fan's triangle: fans are not welded
+    weld.along.clear();
+    weld.along_start[0] = 0;
+    for (std::size_t i = 0; i <= k; ++i) weld.along.push_back(index(i, 0));
+    weld.along_start[1] = static_cast<std::uint32_t>(weld.along.size());
+    for (std::size_t j = 0; j <= k; ++j) weld.along.push_back(index(k - j, j));
+    weld.along_start[2] = static_cast<std::uint32_t>(weld.along.size());
+    for (std::size_t j = k + 1; j-- > 0;) weld.along.push_back(index(0, j));
+    weld.along_start[3] = static_cast<std::uint32_t>(weld.along.size());
+    weld.along_edges = 3;
+    place_lattice(polygon_id, q, weld, ids);
+  } else {
+    ids.clear();
+    for (const glm::vec3& position : q) ids.push_back(add_vertex(position, kNone, kNone));
+  }
+  auto vid = [&](std::size_t i, std::size_t j) { return ids[index(i, j)]; };
   // "Up" triangles are translates of (p0, p1, p2), "down" ones are point reflections of it; both
   // keep the polygon's counter-clockwise orientation.
   for (std::size_t j = 0; j < k; ++j)
@@ -307,6 +599,56 @@ void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon,
       add_patch(polygon_id, polygon, {vid(i, j), vid(i + 1, j), vid(i, j + 1), kNone});
       if (i + j + 1 < k) add_patch(polygon_id, polygon, {vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1), kNone});
     }
+}
+
+void PatchHierarchy::place_lattice(PolygonId polygon_id, const std::vector<glm::vec3>& positions, Weld& weld,
+                                   std::vector<std::uint32_t>& ids) {
+  ids.assign(positions.size(), kNone);
+  const std::uint32_t first = weld.first_corner[polygon_id];
+  const std::uint32_t edge_count = weld.along_edges;
+  // Corners: one vertex per class, made by the first polygon that reaches it.
+  for (std::uint32_t c = 0; c < edge_count; ++c) {
+    const std::uint32_t at = weld.along[weld.along_start[c]];
+    std::uint32_t& v = weld.vertex[weld.root[first + c]];
+    if (v == kNone) v = add_vertex(positions[at], kNone, kNone);
+    RADIOSITY_ASSERT(same_bits(vertices_[v], positions[at]));
+    ids[at] = v;
+  }
+  // Inner points of each edge: the points of an earlier side with the same cut (reversed if it
+  // runs the other way), else new ones, which become a side of the edge.
+  for (std::uint32_t c = 0; c < edge_count; ++c) {
+    const std::uint32_t* points = weld.along.data() + weld.along_start[c];
+    const std::uint32_t n = weld.along_start[c + 1] - weld.along_start[c] - 1;  // segments
+    const std::uint32_t start = ids[points[0]], end = ids[points[n]];
+    const std::uint32_t shared = weld.edge[first + c];
+    bool found = false;
+    if (shared != kNone) {
+      for (std::uint32_t s = weld.first_side[shared]; s != kNone && !found; s = weld.sides[s].next) {
+        const Weld::Side& side = weld.sides[s];
+        if (side.count != n) continue;
+        RADIOSITY_ASSERT((side.start == start && side.end == end) || (side.start == end && side.end == start));
+        const bool forward = side.start == start;
+        auto inner = [&](std::uint32_t m) { return weld.inner[side.first_inner + (forward ? m : n - m) - 1]; };
+        found = true;
+        for (std::uint32_t m = 1; m < n && found; ++m) found = same_bits(vertices_[inner(m)], positions[points[m]]);
+        if (found)
+          for (std::uint32_t m = 1; m < n; ++m) ids[points[m]] = inner(m);
+      }
+    }
+    if (found) continue;
+    const auto first_inner = static_cast<std::uint32_t>(weld.inner.size());
+    for (std::uint32_t m = 1; m < n; ++m) {
+      ids[points[m]] = add_vertex(positions[points[m]], kNone, kNone);
+      if (shared != kNone) weld.inner.push_back(ids[points[m]]);
+    }
+    if (shared != kNone) {
+      weld.sides.push_back({start, end, n, first_inner, weld.first_side[shared]});
+      weld.first_side[shared] = static_cast<std::uint32_t>(weld.sides.size() - 1);
+    }
+  }
+  // The polygon's own inner points.
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (ids[i] == kNone) ids[i] = add_vertex(positions[i], kNone, kNone);
 }
 
 std::uint32_t PatchHierarchy::subdivide(std::uint32_t element) {
@@ -391,29 +733,95 @@ std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_v
       weight[e.corners[k]] += static_cast<double>(e.area);
     }
   }
+  // Seams (smooth neighbours whose edge points are not shared): with side counts n_s and g
+  // their gcd, every side has a point at each multiple of 1/g of the edge, the common knots.
+  // Those take the mean over all sides, as one shared vertex would.
+  const Edges& edges = *edges_;
+  auto seam_gcd = [&](const Edges::Seam& seam) {
+    std::uint32_t g = 0;
+    for (std::uint32_t s = seam.first; s < seam.first + seam.count; ++s) g = std::gcd(g, edges.seam_sides[s][1]);
+    return g;
+  };
+  for (const Edges::Seam& seam : edges.seams) {
+    const std::uint32_t g = seam_gcd(seam);
+    for (std::uint32_t m = 1; m < g; ++m) {
+      glm::dvec3 knot_sum(0.0);
+      double knot_weight = 0.0;
+      for (std::uint32_t s = seam.first; s < seam.first + seam.count; ++s) {
+        const std::uint32_t v = edges.seam_points[edges.seam_sides[s][0] + m * edges.seam_sides[s][1] / g];
+        knot_sum += sum[v];
+        knot_weight += weight[v];
+      }
+      for (std::uint32_t s = seam.first; s < seam.first + seam.count; ++s) {
+        const std::uint32_t v = edges.seam_points[edges.seam_sides[s][0] + m * edges.seam_sides[s][1] / g];
+        sum[v] = knot_sum;
+        weight[v] = knot_weight;
+      }
+    }
+  }
+
   std::vector<Rgb> out(vertices_.size(), Rgb(0.0f));
   for (std::size_t v = 0; v < vertices_.size(); ++v)
     if (weight[v] > 0.0) out[v] = Rgb(sum[v] / weight[v]);
+
+  // Every other point of a seam side, its lattice points and the midpoints subdivision made
+  // along it, gets the linear interpolation between the common knots around it: then each side
+  // is the same line between knots, the T-vertex rule below with the knots for the coarse edge's
+  // ends. (Seam points are never hanging unless two polygons share a side; then that rule gives
+  // them the same line.)
+  struct Span {
+    std::uint32_t a, b;
+    double ta, tb;  ///< along the edge, in segments of the side
+  };
+  std::vector<Span> spans;
+  for (const Edges::Seam& seam : edges.seams) {
+    const std::uint32_t g = seam_gcd(seam);
+    for (std::uint32_t s = seam.first; s < seam.first + seam.count; ++s) {
+      const std::uint32_t* points = edges.seam_points.data() + edges.seam_sides[s][0];
+      const std::uint32_t n = edges.seam_sides[s][1];
+      for (std::uint32_t i = 0; i < n; ++i) {
+        // Segment i lies between the knots at points lo n/g and (lo + 1) n/g.
+        const std::uint32_t lo = i * g / n;
+        const glm::dvec3 k0(out[points[lo * n / g]]), k1(out[points[(lo + 1) * n / g]]);
+        auto line = [&](double t) {
+          const double w = t * g / n - lo;
+          return Rgb((1.0 - w) * k0 + w * k1);
+        };
+        if (i * g % n != 0) out[points[i]] = line(i);
+        spans.push_back({points[i], points[i + 1], double(i), double(i + 1)});
+        while (!spans.empty()) {
+          const Span span = spans.back();
+          spans.pop_back();
+          const auto found = edges.midpoints.find(edge_key(span.a, span.b));
+          if (found == edges.midpoints.end()) continue;
+          const double t = 0.5 * (span.ta + span.tb);
+          out[found->second] = line(t);
+          spans.push_back({span.a, found->second, span.ta, t});
+          spans.push_back({found->second, span.b, t, span.tb});
+        }
+      }
+    }
+  }
 
   // T-vertices (Baum et al. 1991): a midpoint of a leaf's edge, and recursively any midpoint of
   // the halves of such an edge, lies on a coarse edge that interpolates only its two endpoints.
   // Setting each to the mean of the endpoints of the edge it splits makes both sides agree.
   std::vector<bool> hanging(vertices_.size(), false);
-  std::vector<std::array<std::uint32_t, 2>> edges;
+  std::vector<std::array<std::uint32_t, 2>> leaf_edges;
   for (const std::uint32_t id : leaves_) {
     const Element& e = elements_[id];
     const int n = e.corner_count();
     for (int k = 0; k < n; ++k) {
-      edges.push_back({e.corners[k], e.corners[(k + 1) % n]});
-      while (!edges.empty()) {
-        const std::array<std::uint32_t, 2> ab = edges.back();
-        edges.pop_back();
-        const auto found = edges_->midpoints.find(edge_key(ab[0], ab[1]));
-        if (found == edges_->midpoints.end() || hanging[found->second]) continue;
+      leaf_edges.push_back({e.corners[k], e.corners[(k + 1) % n]});
+      while (!leaf_edges.empty()) {
+        const std::array<std::uint32_t, 2> ab = leaf_edges.back();
+        leaf_edges.pop_back();
+        const auto found = edges.midpoints.find(edge_key(ab[0], ab[1]));
+        if (found == edges.midpoints.end() || hanging[found->second]) continue;
         const std::uint32_t m = found->second;
         hanging[m] = true;
-        edges.push_back({ab[0], m});
-        edges.push_back({m, ab[1]});
+        leaf_edges.push_back({ab[0], m});
+        leaf_edges.push_back({m, ab[1]});
       }
     }
   }
@@ -421,7 +829,7 @@ std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_v
   // endpoints of every hanging vertex, hanging or not, already hold their final values.
   for (std::size_t m = 0; m < vertices_.size(); ++m) {
     if (!hanging[m]) continue;
-    const std::array<std::uint32_t, 2>& ab = edges_->vertex_edge[m];
+    const std::array<std::uint32_t, 2>& ab = edges.vertex_edge[m];
     out[m] = 0.5f * (out[ab[0]] + out[ab[1]]);
   }
   return out;

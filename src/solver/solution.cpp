@@ -175,8 +175,10 @@ std::vector<Rgb> Solution::mesh_vertex_values(MeshId mesh, Quantity quantity) co
     double area = 0.0;
     for (std::uint32_t j = ranges[p].first; j < ranges[p].first + ranges[p].second; ++j)
       area += hierarchy_.patches()[j].area;
-    // Each corner of the triangle is the hierarchy vertex of its patches nearest to it (the
-    // corner itself, up to the rounding of the patch lattice).
+    // Each corner of the triangle is the hierarchy vertex of its patches at that position: the
+    // polygon's corners are the host's positions bit for bit, and the lattice keeps them, so
+    // the search stops at the exact one (nearest stays the rule should that ever change). A
+    // vertex shared with smooth neighbours has the same value from every triangle around it.
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = m.indices[3 * t + static_cast<std::size_t>(k)];
       std::uint32_t nearest = kNone;
@@ -192,6 +194,7 @@ std::vector<Rgb> Solution::mesh_vertex_values(MeshId mesh, Quantity quantity) co
             best = d2;
           }
         }
+        if (best == 0.0f) break;
       }
       sum[v] += area * glm::dvec3(at_vertex[nearest]);
       weight[v] += area;

@@ -85,6 +85,10 @@ void validate(const SolveOptions& o) {
   };
   check_area(o.mesh.max_patch_area, "max_patch_area");
   check_area(o.mesh.max_element_area, "max_element_area");
+  if (!(o.mesh.crease_angle_deg >= 0.0f && o.mesh.crease_angle_deg < 180.0f))
+    throw Error(ErrorCode::invalid_argument,
+                "mesh.crease_angle_deg must be in [0, 180) (0 = no vertices shared between polygons), got " +
+                    std::to_string(o.mesh.crease_angle_deg));
   if (o.adaptive.enabled) {
     if (!(o.adaptive.threshold > 0.0f && o.adaptive.threshold <= 1.0f))
       throw Error(ErrorCode::invalid_argument,

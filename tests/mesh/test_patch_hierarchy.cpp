@@ -13,6 +13,8 @@
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 
+#include "support/fields.hpp"
+
 using namespace radiosity;
 
 namespace {
@@ -68,31 +70,7 @@ struct Uniform {
   float operator()() { return static_cast<float>(engine() >> 8) * (1.0f / 16777216.0f); }
 };
 
-// Every vertex lying strictly inside a leaf's edge must carry the linear interpolation of the
-// edge's end values; then the piecewise-linear field on the finer side equals the coarse side's
-// linear one, i.e. there is no crack. Returns the largest deviation found.
-float largest_crack(const PatchHierarchy& h, const std::vector<Rgb>& vv) {
-  const auto& v = h.vertices();
-  float worst = 0.0f;
-  for (const std::uint32_t id : h.leaves()) {
-    const Element& e = h.element(id);
-    for (int k = 0; k < e.corner_count(); ++k) {
-      const std::uint32_t a = e.corners[k], b = e.corners[(k + 1) % e.corner_count()];
-      const glm::vec3 ab = v[b] - v[a];
-      const float len2 = glm::dot(ab, ab);
-      for (std::uint32_t m = 0; m < v.size(); ++m) {
-        if (m == a || m == b) continue;
-        const float t = glm::dot(v[m] - v[a], ab) / len2;
-        if (t <= 1e-4f || t >= 1.0f - 1e-4f) continue;
-        if (glm::length(v[a] + t * ab - v[m]) > 1e-5f * std::sqrt(len2)) continue;
-        const Rgb expected = (1.0f - t) * vv[a] + t * vv[b];
-        const Rgb d = glm::abs(expected - vv[m]);
-        worst = std::max({worst, d.x, d.y, d.z});
-      }
-    }
-  }
-  return worst;
-}
+using test::largest_crack;
 
 }  // namespace
 
