@@ -5,8 +5,6 @@
 // Usage: bench_add_mesh [TRIANGLES]   (default 1000000)
 // Prints the triangle count, each way's wall time and ns per triangle, their ratio, and the
 // resident memory the mesh's scene holds.
-#include <sys/resource.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,17 +13,12 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "bench_common.hpp"
+
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double peak_rss_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;
-}
+using bench::peak_rss_mib;
+using bench::seconds_since;
 
 }  // namespace
 

@@ -6,8 +6,6 @@
 // Usage: bench_bake [SIZE] [GATHER_RAYS]   (defaults 1024 and 64)
 // Prints the triangle count and, per stage, its wall time and the process's peak resident memory
 // after it; the gathered bake's cost relative to the interpolated one.
-#include <sys/resource.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,19 +15,14 @@
 #include <radiosity/lightmap.hpp>
 #include <radiosity/radiosity.hpp>
 
+#include "bench_common.hpp"
+
 namespace rad = radiosity;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double peak_rss_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;
-}
+using bench::peak_rss_mib;
+using bench::seconds_since;
 
 struct Level {
   std::vector<glm::vec3> positions;

@@ -12,6 +12,8 @@
 #include <radiosity/lightmap.hpp>
 #include <radiosity/radiosity.hpp>
 
+#include "support/scenes.hpp"
+
 namespace rad = radiosity;
 
 namespace {
@@ -28,17 +30,7 @@ struct Floor {
   Floor() {
     for (const glm::vec3& p : positions) uv1.push_back(kPad + (1.0f - 2.0f * kPad) * glm::vec2(p.x, p.y));
   }
-  rad::MeshDesc desc(rad::MaterialId m) const {
-    rad::MeshDesc d;
-    d.positions = positions.data();
-    d.vertex_count = positions.size();
-    d.indices = indices.data();
-    d.index_count = indices.size();
-    d.material = m;
-    d.uv1 = uv1.data();
-    d.group = "floor";
-    return d;
-  }
+  rad::MeshDesc desc(rad::MaterialId m) const { return test::mesh_desc(positions, indices, m, "floor", uv1); }
   /// The floor point under the centre of texel (x, y) of a size x size lightmap.
   static glm::vec3 point(int x, int y, int size) {
     const glm::vec2 uv((static_cast<float>(x) + 0.5f) / static_cast<float>(size),
@@ -213,14 +205,7 @@ TEST_SUITE("lightmap") {
       }
       indices.insert(indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     }
-    rad::MeshDesc d;
-    d.positions = positions.data();
-    d.vertex_count = positions.size();
-    d.indices = indices.data();
-    d.index_count = indices.size();
-    d.material = id;
-    d.uv1 = uv1.data();
-    const rad::MeshId mesh = scene.add_mesh(d);
+    const rad::MeshId mesh = scene.add_mesh(test::mesh_desc(positions, indices, id, "cube", uv1));
     rad::SolveOptions so;
     so.mesh.max_patch_area = 0.05f;
     so.form_factors.method = rad::FormFactorMethod::ray_cast;
@@ -285,14 +270,7 @@ TEST_SUITE("lightmap") {
     const std::vector<glm::vec3> positions{{0, 0, 0}, {1, 0, 0}, {1, 0.01f, 0}};
     const std::vector<glm::vec2> uv1{{0.0f, 0.0f}, {1.0f, 1.0f}, {1.0f - 0.1f / 32.0f, 1.0f}};
     const std::vector<std::uint32_t> indices{0, 1, 2};
-    rad::MeshDesc d;
-    d.positions = positions.data();
-    d.vertex_count = 3;
-    d.indices = indices.data();
-    d.index_count = 3;
-    d.material = id;
-    d.uv1 = uv1.data();
-    const rad::MeshId mesh = scene.add_mesh(d);
+    const rad::MeshId mesh = scene.add_mesh(test::mesh_desc(positions, indices, id, "sliver", uv1));
     const rad::Solution sol = rad::solve(scene);
     rad::LightmapOptions o;
     o.width = o.height = 32;

@@ -24,17 +24,7 @@ struct HostMesh {
   std::vector<std::uint32_t> indices{0, 1, 2, 0, 2, 3, 0, 1, 4};
   std::vector<glm::vec2> uv1{{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}};
 
-  rad::MeshDesc desc(rad::MaterialId material) const {
-    rad::MeshDesc d;
-    d.positions = positions.data();
-    d.vertex_count = positions.size();
-    d.indices = indices.data();
-    d.index_count = indices.size();
-    d.material = material;
-    d.group = "quad";
-    d.uv1 = uv1.data();
-    return d;
-  }
+  rad::MeshDesc desc(rad::MaterialId material) const { return test::mesh_desc(positions, indices, material, "quad", uv1); }
 };
 
 std::string error_of(rad::Scene& scene, const rad::MeshDesc& desc, bool strict = false) {

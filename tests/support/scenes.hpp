@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -36,6 +37,22 @@ inline rad::Scene closed_box(const rad::Material& m, glm::vec3 s = glm::vec3(1.0
   return scene;
 }
 
+/// A MeshDesc over the caller's arrays (which must outlive the add_mesh call), every triangle of
+/// `material`, with UV1 when `uv1` is not empty.
+inline rad::MeshDesc mesh_desc(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
+                               rad::MaterialId material, std::string_view group = {},
+                               const std::vector<glm::vec2>& uv1 = {}) {
+  rad::MeshDesc d;
+  d.positions = positions.data();
+  d.vertex_count = positions.size();
+  d.indices = indices.data();
+  d.index_count = indices.size();
+  d.material = material;
+  d.group = group;
+  d.uv1 = uv1.empty() ? nullptr : uv1.data();
+  return d;
+}
+
 /// The unit cube [0,1]^3 as an indexed triangle mesh facing inwards: 8 shared corners and 12
 /// triangles, each face counter-clockwise seen from inside, the z = 0 face first (triangles 0
 /// and 1).
@@ -46,16 +63,7 @@ struct InwardCube {
                                      3, 2, 6, 3, 6, 7, 0, 3, 7, 0, 7, 4, 1, 5, 6, 1, 6, 2};
 
   /// Its MeshDesc (the arrays stay this object's), every triangle of `material`, group "cube".
-  rad::MeshDesc desc(rad::MaterialId material) const {
-    rad::MeshDesc d;
-    d.positions = corners.data();
-    d.vertex_count = corners.size();
-    d.indices = indices.data();
-    d.index_count = indices.size();
-    d.material = material;
-    d.group = "cube";
-    return d;
-  }
+  rad::MeshDesc desc(rad::MaterialId material) const { return mesh_desc(corners, indices, material, "cube"); }
 };
 
 /// Howell C-11: parallel, directly opposed rectangles a x b at distance c.
