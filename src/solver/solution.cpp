@@ -1,3 +1,6 @@
+#include <cmath>
+#include <string>
+
 #include "radiosity/solver.hpp"
 
 namespace radiosity {
@@ -203,6 +206,58 @@ std::vector<Rgb> Solution::mesh_vertex_values(MeshId mesh, Quantity quantity) co
   std::vector<Rgb> out(m.positions.size(), Rgb(0.0f));
   for (std::size_t v = 0; v < out.size(); ++v)
     if (weight[v] > 0.0) out[v] = Rgb(sum[v] / weight[v]);
+  return out;
+}
+
+void Solution::set_light_groups(std::vector<LightGroupSolution> groups) {
+  const std::size_t n = hierarchy_.elements().size();
+  for (const LightGroupSolution& g : groups) {
+    auto check = [&](const std::vector<Rgb>& v, const char* what, bool may_be_empty) {
+      if (v.size() != n && !(may_be_empty && v.empty()))
+        throw Error(ErrorCode::invalid_argument, "Solution::set_light_groups: light group '" + g.name + "' has " +
+                                                     std::to_string(v.size()) + " " + what + " values for " +
+                                                     std::to_string(n) + " elements");
+    };
+    check(g.radiosity, "radiosity", false);
+    check(g.back_radiosity, "back radiosity", true);
+    check(g.irradiance, "irradiance", false);
+    check(g.direct_irradiance, "direct irradiance", false);
+  }
+  light_groups_ = std::move(groups);
+}
+
+Solution Solution::relight(const std::vector<Rgb>& weights) const {
+  if (weights.size() != light_groups_.size())
+    throw Error(ErrorCode::invalid_argument, "Solution::relight: " + std::to_string(weights.size()) +
+                                                 " weights for " + std::to_string(light_groups_.size()) +
+                                                 " light groups (solve with SolveOptions::separate_light_groups)");
+  for (std::size_t k = 0; k < weights.size(); ++k)
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(weights[k][c]))
+        throw Error(ErrorCode::invalid_argument,
+                    "Solution::relight: the weight of light group '" + light_groups_[k].name + "' is not finite");
+  const std::size_t n = hierarchy_.elements().size();
+  const bool backs = !back_radiosity_.empty();
+  std::vector<LightGroupSolution> scaled = light_groups_;
+  std::vector<Rgb> B(n, Rgb(0.0f)), back(backs ? n : 0, Rgb(0.0f)), H(n, Rgb(0.0f)), direct(n, Rgb(0.0f));
+  for (std::size_t k = 0; k < scaled.size(); ++k) {
+    LightGroupSolution& g = scaled[k];
+    const Rgb w = weights[k];
+    auto weigh = [&](std::vector<Rgb>& values, std::vector<Rgb>& sum) {
+      for (std::size_t e = 0; e < values.size(); ++e) {
+        values[e] *= w;
+        sum[e] += values[e];
+      }
+    };
+    weigh(g.radiosity, B);
+    if (backs && !g.back_radiosity.empty()) weigh(g.back_radiosity, back);
+    weigh(g.irradiance, H);
+    weigh(g.direct_irradiance, direct);
+  }
+  Solution out(PatchHierarchy(hierarchy_), std::move(B), groups_, status_, report_, Rgb(0.0f), {}, std::move(back),
+               std::move(H), std::move(direct));
+  out.meshes_ = meshes_;
+  out.light_groups_ = std::move(scaled);
   return out;
 }
 

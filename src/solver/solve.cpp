@@ -14,6 +14,7 @@
 #include "form_factors/pass1_material.hpp"
 #include "solver/system.hpp"
 #include "core/assert.hpp"
+#include "core/color.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -122,6 +123,9 @@ struct Problem::Impl {
   /// moved into the Solution (the facade's single solve: no copy).
   Solution solve(const std::vector<Rgb>* emission, bool last);
   Solution solve_once(const std::vector<Rgb>* emission, bool last);
+  /// Each light group's own solve (SolveOptions::separate_light_groups) on the current
+  /// hierarchy, without refinement; empty when one is cancelled.
+  std::vector<LightGroupSolution> solve_light_groups(const std::vector<Rgb>* emission);
 };
 
 Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), options(given) {
@@ -169,9 +173,41 @@ std::vector<SolvedMesh> solved_meshes(const Scene& scene) {
 }  // namespace
 
 Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
-  Solution solution = solve_once(emission, last);
+  // With light groups the hierarchy is needed after the joint solve, which therefore gets a copy.
+  const bool groups = options.separate_light_groups;
+  Solution solution = solve_once(emission, last && !groups);
+  if (groups && solution.status() != SolveStatus::cancelled) solution.set_light_groups(solve_light_groups(emission));
   solution.set_meshes(solved_meshes(scene));
   return solution;
+}
+
+std::vector<LightGroupSolution> Problem::Impl::solve_light_groups(const std::vector<Rgb>* emission) {
+  // Superposition: B is linear in E, so each group's solve with only its emitters on gives its
+  // share, and the shares add up to the joint solve. The matrix methods' rows and progressive
+  // refinement's columns are kept, so a group's solve is its sweeps (or its shots) only.
+  const std::vector<Polygon>& polygons = scene.polygons();
+  std::vector<char> emits(scene.groups().size(), 0);
+  for (PolygonId p = 0; p < polygons.size(); ++p)
+    if (detail::max_channel(detail::polygon_emission(scene, p, emission)) > 0.0f) emits[polygons[p].group] = 1;
+  // The joint solve refined the hierarchy; the groups are solved on it as it is.
+  struct KeepAdaptive {
+    SolveOptions& o;
+    AdaptiveOptions saved;
+    ~KeepAdaptive() { o.adaptive = saved; }
+  } keep{options, options.adaptive};
+  options.adaptive.enabled = false;
+  std::vector<LightGroupSolution> out;
+  std::vector<Rgb> group_emission(polygons.size());
+  for (GroupId g = 0; g < emits.size(); ++g) {
+    if (!emits[g]) continue;
+    for (PolygonId p = 0; p < polygons.size(); ++p)
+      group_emission[p] = polygons[p].group == g ? detail::polygon_emission(scene, p, emission) : Rgb(0.0f);
+    const Solution part = solve_once(&group_emission, false);
+    if (part.status() == SolveStatus::cancelled) return {};
+    out.push_back(LightGroupSolution{scene.groups()[g], part.radiosity(), part.back_radiosity(), part.irradiance(),
+                                     part.direct_irradiance()});
+  }
+  return out;
 }
 
 Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) {
