@@ -203,19 +203,29 @@ class RADIOSITY_API Solution {
   /// cancelled solve).
   std::vector<Rgb> element_values(Quantity quantity) const;
   /// The light groups solved on their own (SolveOptions::separate_light_groups), in the order of
-  /// the scene's groups; empty otherwise. Their radiosities add up to radiosity() within the
-  /// solver's tolerance.
-  const std::vector<LightGroupSolution>& light_groups() const { return light_groups_; }
-  /// Gives the solution its light groups (solve() does). Throws Error{invalid_argument} when an
-  /// array does not have one value per element (back_radiosity: or is empty).
+  /// the scene's groups, each as solved (weight 1); empty otherwise. A relit solution shares
+  /// them with the solution it came from. radiosity() is the sum over k of
+  /// light_group_weights()[k] x light_groups()[k].radiosity, within the solver's tolerance (and
+  /// so are irradiance(), back_radiosity() and direct_irradiance()).
+  const std::vector<LightGroupSolution>& light_groups() const;
+  /// The weight of each light group in this solution: 1 each for a solve, the weights given for
+  /// a relit one.
+  const std::vector<Rgb>& light_group_weights() const { return light_group_weights_; }
+  /// group_radiosity() of light group `light_group`'s contribution to this solution (its
+  /// weight times its radiosity). Throws Error{invalid_argument} for a light group out of range
+  /// or an unknown group.
+  Rgb light_group_radiosity(std::size_t light_group, std::string_view group) const;
+  /// Gives the solution its light groups at weight 1 (solve() does). Throws
+  /// Error{invalid_argument} when an array does not have one value per element (back_radiosity:
+  /// or is empty).
   void set_light_groups(std::vector<LightGroupSolution> groups);
-  /// The solution with light group k's contribution scaled by weights[k] (an RGB weight each: 0
-  /// switches a group off, 0.5 dims it, a colour tints it): radiosity, back radiosity,
-  /// irradiance and direct irradiance are the weighted sums of the groups', and so are its own
-  /// light_groups(), so relighting again starts from these. No solve: linear in elements x
-  /// groups (about 10 ms for 100k elements and 8 groups, bench_solvers --relight-groups). The
-  /// report and status are this solution's; the ambient term is dropped. Throws
-  /// Error{invalid_argument} unless there is one finite weight per light group.
+  /// The solution with light group k weighted by weights[k] (an RGB weight each: 0 switches a
+  /// group off, 0.5 dims it, a colour tints it): radiosity, back radiosity, irradiance and
+  /// direct irradiance are the weighted sums of the groups'. The weights are absolute (relighting
+  /// a relit solution weights the solved groups again, not the previous weights). No solve and
+  /// no copy of the groups: linear in elements x groups (bench_relight: about 10 ms for 100k
+  /// elements and 8 groups). The report and status are this solution's; the ambient term is
+  /// dropped. Throws Error{invalid_argument} unless there is one finite weight per light group.
   Solution relight(const std::vector<Rgb>& weights) const;
   /// The meshes of the solved scene, by MeshId.
   const std::vector<SolvedMesh>& meshes() const { return meshes_; }
@@ -238,7 +248,9 @@ class RADIOSITY_API Solution {
   std::vector<Rgb> irradiance_;
   std::vector<Rgb> direct_irradiance_;
   std::vector<SolvedMesh> meshes_;
-  std::vector<LightGroupSolution> light_groups_;
+  /// Shared between a solution and the solutions relit from it (immutable); null for none.
+  std::shared_ptr<const std::vector<LightGroupSolution>> light_groups_;
+  std::vector<Rgb> light_group_weights_;
 };
 
 /// Checks options; throws Error{invalid_argument} naming the first bad field.

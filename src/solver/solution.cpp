@@ -3,6 +3,8 @@
 
 #include "radiosity/solver.hpp"
 
+#include "core/parallel.hpp"
+
 namespace radiosity {
 inline namespace v1 {
 
@@ -85,6 +87,20 @@ Rgb Solution::group_radiosity(std::string_view group) const {
 Rgb Solution::group_back_radiosity(std::string_view group) const {
   const GroupId g = group_id(group);
   return back_radiosity_.empty() ? Rgb(0.0f) : group_mean(hierarchy_, back_radiosity_, g);
+}
+
+const std::vector<LightGroupSolution>& Solution::light_groups() const {
+  static const std::vector<LightGroupSolution> none;
+  return light_groups_ ? *light_groups_ : none;
+}
+
+Rgb Solution::light_group_radiosity(std::size_t light_group, std::string_view group) const {
+  if (light_group >= light_groups().size())
+    throw Error(ErrorCode::invalid_argument, "Solution::light_group_radiosity: light group " +
+                                                 std::to_string(light_group) + " does not exist (" +
+                                                 std::to_string(light_groups().size()) + " light groups)");
+  return light_group_weights_[light_group] *
+         group_mean(hierarchy_, (*light_groups_)[light_group].radiosity, group_id(group));
 }
 
 double Solution::group_area(std::string_view group) const {
@@ -223,41 +239,46 @@ void Solution::set_light_groups(std::vector<LightGroupSolution> groups) {
     check(g.irradiance, "irradiance", false);
     check(g.direct_irradiance, "direct irradiance", false);
   }
-  light_groups_ = std::move(groups);
+  light_group_weights_.assign(groups.size(), Rgb(1.0f));
+  light_groups_ = groups.empty() ? nullptr
+                                 : std::make_shared<const std::vector<LightGroupSolution>>(std::move(groups));
 }
 
 Solution Solution::relight(const std::vector<Rgb>& weights) const {
-  if (weights.size() != light_groups_.size())
+  const std::vector<LightGroupSolution>& groups = light_groups();
+  if (weights.size() != groups.size())
     throw Error(ErrorCode::invalid_argument, "Solution::relight: " + std::to_string(weights.size()) +
-                                                 " weights for " + std::to_string(light_groups_.size()) +
+                                                 " weights for " + std::to_string(groups.size()) +
                                                  " light groups (solve with SolveOptions::separate_light_groups)");
   for (std::size_t k = 0; k < weights.size(); ++k)
     for (int c = 0; c < 3; ++c)
       if (!std::isfinite(weights[k][c]))
         throw Error(ErrorCode::invalid_argument,
-                    "Solution::relight: the weight of light group '" + light_groups_[k].name + "' is not finite");
+                    "Solution::relight: the weight of light group '" + groups[k].name + "' is not finite");
   const std::size_t n = hierarchy_.elements().size();
   const bool backs = !back_radiosity_.empty();
-  std::vector<LightGroupSolution> scaled = light_groups_;
   std::vector<Rgb> B(n, Rgb(0.0f)), back(backs ? n : 0, Rgb(0.0f)), H(n, Rgb(0.0f)), direct(n, Rgb(0.0f));
-  for (std::size_t k = 0; k < scaled.size(); ++k) {
-    LightGroupSolution& g = scaled[k];
-    const Rgb w = weights[k];
-    auto weigh = [&](std::vector<Rgb>& values, std::vector<Rgb>& sum) {
-      for (std::size_t e = 0; e < values.size(); ++e) {
-        values[e] *= w;
-        sum[e] += values[e];
-      }
-    };
-    weigh(g.radiosity, B);
-    if (backs && !g.back_radiosity.empty()) weigh(g.back_radiosity, back);
-    weigh(g.irradiance, H);
-    weigh(g.direct_irradiance, direct);
-  }
+  // The weighted sums, elements split among threads; the groups are read, never copied.
+  auto weigh = [&](std::size_t begin, std::size_t end, std::vector<Rgb> LightGroupSolution::*field,
+                   std::vector<Rgb>& sum) {
+    for (std::size_t k = 0; k < groups.size(); ++k) {
+      const std::vector<Rgb>& from = groups[k].*field;
+      if (from.empty()) continue;
+      const Rgb w = weights[k];
+      for (std::size_t e = begin; e < end; ++e) sum[e] += w * from[e];
+    }
+  };
+  detail::parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
+    weigh(begin, end, &LightGroupSolution::radiosity, B);
+    weigh(begin, end, &LightGroupSolution::irradiance, H);
+    weigh(begin, end, &LightGroupSolution::direct_irradiance, direct);
+    if (backs) weigh(begin, end, &LightGroupSolution::back_radiosity, back);
+  });
   Solution out(PatchHierarchy(hierarchy_), std::move(B), groups_, status_, report_, Rgb(0.0f), {}, std::move(back),
                std::move(H), std::move(direct));
   out.meshes_ = meshes_;
-  out.light_groups_ = std::move(scaled);
+  out.light_groups_ = light_groups_;
+  out.light_group_weights_ = weights;
   return out;
 }
 

@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 #include <radiosity/radiosity.hpp>
 
 namespace rad = radiosity;
@@ -95,10 +99,14 @@ TEST_SUITE("solver") {
       const rad::Solution reference = problem.solve(emission);
       CHECK(relative_difference(relit.radiosity(), reference.radiosity()) < 1e-4);
       CHECK(relative_difference(relit.irradiance(), reference.irradiance()) < 1e-4);
-      // The relit solution's own groups are the weighted ones.
+      // The relit solution shares the solved groups and keeps the weights.
       REQUIRE(relit.light_groups().size() == 2);
-      CHECK(relative_difference(sum_of(relit.light_groups(), &rad::LightGroupSolution::radiosity), relit.radiosity()) <
-            1e-6);
+      CHECK(&relit.light_groups()[0] == &sol.light_groups()[0]);
+      CHECK(relit.light_group_weights()[1] == rad::Rgb(w));
+      CHECK(relit.light_group_radiosity(1, "floor").y ==
+            doctest::Approx(w * sol.light_group_radiosity(1, "floor").y).epsilon(1e-6));
+      // Weights are absolute: relighting the relit solution at 1, 1 gives the solve back.
+      CHECK(relative_difference(relit.relight({rad::Rgb(1.0f), rad::Rgb(1.0f)}).radiosity(), sol.radiosity()) < 1e-6);
       CHECK(relit.group_radiosity("floor").y == doctest::Approx(reference.group_radiosity("floor").y).epsilon(1e-4));
     }
     // A colour weight tints: doubling the ceiling light's red only.
@@ -108,6 +116,20 @@ TEST_SUITE("solver") {
     const rad::Rgb now = tinted.radiosity()[sol.hierarchy().patches().front().root];
     CHECK(now.x == doctest::Approx(base.x + ceiling_only.x).epsilon(1e-5));
     CHECK(now.y == doctest::Approx(base.y).epsilon(1e-5));
+  }
+
+  TEST_CASE("light groups: the stats JSON gives each light group's share of each group") {
+    const rad::Scene scene = two_lamps();
+    const rad::Solution sol = rad::solve(scene, options(rad::SolverMethod::gauss_seidel));
+    const std::filesystem::path path = std::filesystem::path(RADIOSITY_TEST_TMP) / "light_groups_stats.json";
+    rad::write_stats_json(sol, path);
+    const nlohmann::json j = nlohmann::json::parse(std::ifstream(path));
+    REQUIRE(j.contains("light_groups"));
+    CHECK(j["light_groups"].size() == 2);
+    double floor_green = 0.0;
+    for (const char* lg : {"light", "wall_lamp"}) floor_green += j["light_groups"][lg]["groups"]["floor"]["radiosity"][1].get<double>();
+    CHECK(floor_green == doctest::Approx(j["groups"]["floor"]["radiosity"][1].get<double>()).epsilon(1e-4));
+    CHECK(j["light_groups"]["wall_lamp"]["groups"]["floor"]["area"] == j["groups"]["floor"]["area"]);
   }
 
   TEST_CASE("light groups: adaptive subdivision refines once and the groups share its hierarchy") {
@@ -134,6 +156,7 @@ TEST_SUITE("solver") {
     REQUIRE(sol.light_groups().size() == 1);
     CHECK_THROWS_WITH_AS(sol.relight({rad::Rgb(NAN)}), doctest::Contains("'light' is not finite"), rad::Error);
     rad::Solution copy = sol.relight({rad::Rgb(1.0f)});
+    CHECK(copy.light_group_weights() == std::vector<rad::Rgb>{rad::Rgb(1.0f)});
     std::vector<rad::LightGroupSolution> bad = copy.light_groups();
     bad[0].irradiance.pop_back();
     CHECK_THROWS_WITH_AS(copy.set_light_groups(bad), doctest::Contains("irradiance values for"), rad::Error);

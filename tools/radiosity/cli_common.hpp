@@ -190,6 +190,7 @@ struct SolveArgs {
   int adaptive_passes = 3;
   bool strict = false;
   bool two_sided = false;
+  bool light_groups = false;
 };
 
 /// The estimator a `--form-factors` / `--method` name (as the CLI spells it) selects.
@@ -296,6 +297,9 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
       ->check(any_number<std::uint64_t>())
       ->capture_default_str();
   add_strict_flag(cmd, a.strict);
+  cmd.add_flag("--light-groups", a.light_groups,
+               "Also solve each emitting group's light on its own (one more solve each, same form factors): solve "
+               "prints and --stats writes each light group's share, render writes an EXR layer per light group");
   cmd.add_flag("--two-sided", a.two_sided,
                "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
                "models whose polygons face inconsistently or outwards");
@@ -318,6 +322,7 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.adaptive.enabled = a.adaptive;
   o.adaptive.threshold = a.adaptive_threshold;
   o.adaptive.max_passes = a.adaptive_passes;
+  o.separate_light_groups = a.light_groups;
   o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
   return o;
 }

@@ -102,6 +102,9 @@ int main(int argc, char** argv) {
                   .add(direct_only ? rad::RenderMode::two_pass : rad::RenderMode::automatic, "--direct-only")
                   .conflict;
     if (!conflict.empty()) return argument_error("render", conflict);
+    if (render_args.light_groups && requested.mode != rad::RenderMode::automatic &&
+        requested.mode != rad::RenderMode::radiosity)
+      return argument_error("render", "--light-groups needs --mode radiosity (or auto on a diffuse scene)");
   }
 
   return run_guarded([&] {
@@ -132,6 +135,10 @@ int main(int argc, char** argv) {
       // The pipeline: as asked, else the one the scene needs.
       const rad::RenderMode needed = rad::choose_render_mode(scene);
       const rad::RenderMode mode = requested.mode == rad::RenderMode::automatic ? needed : requested.mode;
+      if (render_args.light_groups && mode != rad::RenderMode::radiosity)
+        throw rad::Error(rad::ErrorCode::invalid_argument,
+                         "--light-groups: the scene needs the two-pass view (it has specular materials); light group "
+                         "layers are made by --mode radiosity only");
       std::string why = requested.mode == rad::RenderMode::automatic ? "automatic: " : requested.source;
       if (requested.mode == rad::RenderMode::automatic)
         why += mode == rad::RenderMode::radiosity  ? "every material is diffuse"
@@ -196,6 +203,13 @@ int main(int argc, char** argv) {
         ro.wireframe = wireframe;
         ro.ambient = ambient;
         image = rad::render(scene, sol, ro);
+        // One layer per light group: the display of that group's light alone.
+        for (std::size_t k = 0; k < sol.light_groups().size(); ++k) {
+          std::vector<rad::Rgb> weights(sol.light_groups().size(), rad::Rgb(0.0f));
+          weights[k] = rad::Rgb(1.0f);
+          rad::Image part = rad::render(scene, sol.relight(weights), ro);
+          image.layers.emplace_back("light_group_" + sol.light_groups()[k].name, std::move(part.pixels));
+        }
         bar.finish();
       }
       rad::write_exr(image, out);
@@ -227,6 +241,14 @@ int main(int argc, char** argv) {
         if (!sol.back_radiosity().empty() && (back.x > 0.0f || back.y > 0.0f || back.z > 0.0f))
           std::printf("  back B = (%.5g, %.5g, %.5g)", back.x, back.y, back.z);
         std::printf("\n");
+      }
+      // Each light group's share of each group (--light-groups).
+      for (std::size_t k = 0; k < sol.light_groups().size(); ++k) {
+        std::printf("light group %s:\n", sol.light_groups()[k].name.c_str());
+        for (const std::string& g : sol.groups()) {
+          const rad::Rgb b = sol.light_group_radiosity(k, g);
+          std::printf("  %-16s B = (%.5g, %.5g, %.5g)\n", g.c_str(), b.x, b.y, b.z);
+        }
       }
       if (!stats.empty()) {
         rad::write_stats_json(sol, stats, options, solve_args.scene.empty() ? "cornell-box" : solve_args.scene);

@@ -90,6 +90,18 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   for (const std::string& name : solution.groups())
     groups[name] = Json{{"radiosity", rgb(solution.group_radiosity(name))}, {"area", number(solution.group_area(name))}};
   j["groups"] = std::move(groups);
+  // Each light group's share of every group (SolveOptions::separate_light_groups).
+  if (!solution.light_groups().empty()) {
+    Json light_groups = Json::object();
+    for (std::size_t k = 0; k < solution.light_groups().size(); ++k) {
+      Json shares = Json::object();
+      for (const std::string& name : solution.groups())
+        shares[name] = Json{{"radiosity", rgb(solution.light_group_radiosity(k, name))},
+                            {"area", number(solution.group_area(name))}};
+      light_groups[solution.light_groups()[k].name] = Json{{"groups", std::move(shares)}};
+    }
+    j["light_groups"] = std::move(light_groups);
+  }
 
   j["timings"] = Json{{"meshing", number(r.seconds_meshing)},
                       {"form_factors", number(r.seconds_form_factors)},
