@@ -473,8 +473,13 @@ Lightmap bake_lightmap(const Scene& scene, const Solution& solution, const std::
         uv[k] = glm::vec2(c.x * static_cast<float>(W), c.y * static_cast<float>(H));
       }
       const glm::vec2 lo = glm::min(uv[0], glm::min(uv[1], uv[2])), hi = glm::max(uv[0], glm::max(uv[1], uv[2]));
-      const int x0 = std::max(0, static_cast<int>(std::floor(lo.x)) - 1), y0 = std::max(0, static_cast<int>(std::floor(lo.y)) - 1);
-      const int x1 = std::min(W - 1, static_cast<int>(std::floor(hi.x))), y1 = std::min(H - 1, static_cast<int>(std::floor(hi.y)));
+      // UVs outside [0, 1] (a host's tiling, or garbage) are clipped to the map before any
+      // conversion to int, which would overflow for huge values.
+      const glm::vec2 size(static_cast<float>(W), static_cast<float>(H));
+      const glm::vec2 first = glm::clamp(glm::floor(lo) - 1.0f, glm::vec2(0.0f), size - 1.0f);
+      const glm::vec2 last = glm::clamp(glm::floor(hi), glm::vec2(-1.0f), size - 1.0f);
+      const int x0 = static_cast<int>(first.x), y0 = static_cast<int>(first.y);
+      const int x1 = static_cast<int>(last.x), y1 = static_cast<int>(last.y);
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
           if (float(x + 1) < lo.x || float(x) > hi.x || float(y + 1) < lo.y || float(y) > hi.y) continue;

@@ -284,6 +284,15 @@ TEST_SUITE("lightmap") {
     }
     CHECK(map.covered >= 32);
     CHECK(map.covered <= 3 * 32);
+
+    // UVs far outside [0, 1] are clipped before any conversion to int, not a crash (float
+    // precision at 1e30 leaves the coverage test nothing it can tell; what is covered is inside).
+    rad::Scene far;
+    const std::vector<glm::vec2> huge{{-1e30f, 0.5f}, {1e30f, 0.5f}, {0.5f, 1e30f}};
+    const rad::MeshId far_mesh = far.add_mesh(test::mesh_desc(positions, indices, far.add_material(m), "far", huge));
+    const rad::Lightmap clipped = rad::bake_lightmap(far, rad::solve(far), far_mesh, o);
+    CHECK(clipped.image.pixels.size() == 32u * 32u);
+    CHECK(clipped.covered <= 32u * 32u);
   }
 
   TEST_CASE("bake_lightmap: final gather is bit-identical at 1 and 2 threads") {
