@@ -111,7 +111,10 @@ int run_bake(const BakeArgs& a) {
     print_estimator(sol, options);
     print_solve_warnings(scene, sol);
 
-    fs::create_directories(a.output);
+    std::error_code made;
+    fs::create_directories(a.output, made);
+    if (made)
+      throw rad::Error(rad::ErrorCode::io_error, "cannot create the output folder '" + a.output + "': " + made.message());
     rad::LightmapOptions lo;
     lo.width = lo.height = std::max(a.lightmap, 1);
     lo.quantity = quantity_from_name(a.quantity);
@@ -186,7 +189,10 @@ int run_bake(const BakeArgs& a) {
     }
     manifest["meshes"] = meshes;
     const fs::path manifest_path = fs::path(a.output) / "manifest.json";
-    std::ofstream(manifest_path) << manifest.dump(2) << "\n";
+    std::ofstream out(manifest_path);
+    out << manifest.dump(2) << "\n";
+    out.close();
+    if (!out) throw rad::Error(rad::ErrorCode::io_error, "cannot write '" + manifest_path.string() + "'");
     if (a.lightmap > 0)
       std::printf("lightmaps: %zu at %dx%d, %s%s, %.2f s\n", scene.meshes().size(), a.lightmap, a.lightmap,
                   a.quantity.c_str(), a.final_gather ? " (final gather)" : " (interpolated)", bake_seconds);
