@@ -162,6 +162,7 @@ class ProgressBar {
       case rad::Phase::solving: return "solving";
       case rad::Phase::refining: return "refining";
       case rad::Phase::rendering: return "rendering";
+      case rad::Phase::lights: return "lights";
     }
     return "";
   }
