@@ -236,6 +236,7 @@ bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& 
   std::vector<std::uint32_t> todo;
   for (std::uint32_t e : elements)
     if (!shot.done[e]) todo.push_back(e);
+  if (todo.empty()) return true;  // kept from an earlier solve: no time spent
   bool completed = true;
   if (!lights_.empty()) {
     std::vector<std::uint64_t> rays(todo.size(), 0);
