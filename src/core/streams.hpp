@@ -30,7 +30,6 @@ enum class Stream : std::uint64_t {
   // Lightmaps (key_a: the texel).
   lightmap_gather = 0x1a9e0000ull,       ///< a texel's hemisphere rays (final gather)
   lightmap_light = 0xb0000000000ull,     ///< + emitter: a texel's shadow rays to an emitting polygon
-  lightmap_sky = 0x1a9f0000ull,          ///< a texel's sky rays (final gather of the lights)
   // Lights that are not polygons (key_a: the element, or the pixel / element named).
   light_front = 0xc0000000000ull,        ///< + light: the first shot's rays from an element's front
   light_back = 0xc0100000000ull,         ///< + light: the same from an element's back
@@ -58,8 +57,8 @@ constexpr Range kRanges[] = {
     {stream_key(Stream::path), 1},                          {stream_key(Stream::two_pass_path), 1},
     {stream_key(Stream::two_pass_direct), 1},               {stream_key(Stream::photon), 1},
     {stream_key(Stream::lightmap_gather), 1},               {stream_key(Stream::lightmap_light), 1ull << 31},
-    {stream_key(Stream::lightmap_sky), 1},                  {stream_key(Stream::light_front), 1ull << 31},
-    {stream_key(Stream::light_back), 1ull << 31},           {stream_key(Stream::two_pass_sky), 1},
+    {stream_key(Stream::light_front), 1ull << 31},          {stream_key(Stream::light_back), 1ull << 31},
+    {stream_key(Stream::two_pass_sky), 1},
 };
 
 constexpr bool disjoint() {

@@ -116,8 +116,8 @@ bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::v
   return !occluders.occluded(origin, light_position - origin, 0.0f, kShadowEnd);
 }
 
-Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x,
-                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky) {
+Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                        float epsilon) {
   Rgb H(0.0f);
   const glm::vec3 origin = x + epsilon * n;
   for (const PreparedLight& l : lights.delta()) {
@@ -127,17 +127,26 @@ Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, co
     if (!(cos_x > 0.0f)) continue;
     if (unoccluded(occluders, origin, l.position, in)) H += in.irradiance * cos_x;
   }
-  if (lights.has_sky()) {
-    // Cosine-weighted: L cos / pdf = pi L.
-    glm::vec3 t, b;
-    tangent_frame(n, t, b);
-    const glm::vec3 local = cosine_hemisphere(u_sky);
-    const glm::vec3 w = glm::normalize(local.x * t + local.y * b + local.z * n);
-    const Rgb L = lights.sky_radiance(w);
-    if (L != Rgb(0.0f) && !occluders.occluded(origin, w, 0.0f, std::numeric_limits<float>::infinity()))
-      H += kPi * L;
-  }
   return H;
+}
+
+Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                      float epsilon, const glm::vec2& u_sky) {
+  if (!lights.has_sky()) return Rgb(0.0f);
+  // Cosine-weighted: L cos / pdf = pi L.
+  glm::vec3 t, b;
+  tangent_frame(n, t, b);
+  const glm::vec3 local = cosine_hemisphere(u_sky);
+  const glm::vec3 w = glm::normalize(local.x * t + local.y * b + local.z * n);
+  const Rgb L = lights.sky_radiance(w);
+  if (L == Rgb(0.0f) || occluders.occluded(x + epsilon * n, w, 0.0f, std::numeric_limits<float>::infinity()))
+    return Rgb(0.0f);
+  return kPi * L;
+}
+
+Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x,
+                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky) {
+  return delta_irradiance_at(lights, occluders, x, n, epsilon) + sky_irradiance_at(lights, occluders, x, n, epsilon, u_sky);
 }
 
 }  // namespace radiosity::detail

@@ -99,6 +99,16 @@ bool incidence(const PreparedLight& light, const glm::vec3& x, Incidence& out);
 bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::vec3& light_position,
                 const Incidence& in);
 
+/// The irradiance (W/m^2) at x, on the side its unit normal n faces, from the delta lights: each
+/// exactly, with a shadow ray from x lifted by `epsilon` along n. Thread safety: may be called
+/// concurrently.
+Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                        float epsilon);
+/// One-sample estimate of the irradiance at x from the skies: one cosine-weighted direction from
+/// `u_sky`, pi L V (unbiased); 0 without a sky. Thread safety: may be called concurrently.
+Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                      float epsilon, const glm::vec2& u_sky);
+
 /// One-sample estimate of the irradiance (W/m^2) that arrives at x, on the side its unit normal n
 /// faces, straight from the lights: every delta light exactly, with a shadow ray each (x lifted
 /// by `epsilon` along n), and the sky by one cosine-weighted direction from `u_sky` (pi L V:
