@@ -357,11 +357,15 @@ TEST_SUITE("solver") {
     light.position = {0.1f, 1.0f, 0.05f};
     light.intensity = 1.0f;
     scene.add_light(light);
+    for (rad::SolverMethod method : {rad::SolverMethod::gauss_seidel, rad::SolverMethod::progressive}) {
+    CAPTURE(static_cast<int>(method));
     rad::SolveOptions o;
+    o.method = method;
     o.mesh.max_patch_area = 0.25f;
     o.mesh.max_element_area = 1.0f / 16.0f;
     o.adaptive.enabled = true;
     o.adaptive.max_depth = 3;
+    o.tolerance = 1e-6;  // the matrix methods' H gathers the final B: they agree to the residual
     const rad::Solution sol = rad::solve(scene, o);
     const rad::PatchHierarchy& h = sol.hierarchy();
     CHECK(sol.report().refined_elements > 0);
@@ -389,12 +393,15 @@ TEST_SUITE("solver") {
       const bool edge = exact > 1e-9 && exact < 0.999 * unoccluded;
       (edge ? worst_edge : worst_lit) = std::max(edge ? worst_edge : worst_lit, std::fabs(H - exact) / unoccluded);
       if (h.element(e).depth > 0 && edge) ++deep;
+      // B = rho H on the new leaves too (the progressive gather gives them E + rho H).
+      CHECK(sol.radiosity()[e].x == doctest::Approx(0.5f * sol.irradiance()[e].x).epsilon(1e-4));
     }
     MESSAGE("adaptive: worst error " << worst_lit * 100 << " % (lit or dark leaves), " << worst_edge * 100
                                      << " % (leaves on the shadow edge) of the unoccluded irradiance");
     CHECK(deep > 0);  // the shadow edge's leaves are refined ones
     CHECK(worst_lit < 5e-3);
     CHECK(worst_edge < 0.05);
+    }
   }
 
   TEST_CASE("lights: the back of a two-sided or translucent sheet receives a light below it") {
@@ -455,5 +462,32 @@ TEST_SUITE("solver") {
     CHECK(lit.status() == rad::SolveStatus::converged);
     CHECK(lit.report().light_power.x > 0.0f);
     CHECK(lit.radiosity()[lit.hierarchy().leaves()[0]].x > 0.0f);
+  }
+
+  TEST_CASE("lights: cancelling the lights' first shot returns a cancelled solve and the next solve completes it") {
+    rad::Scene scene = plane_scene(2.0f);
+    rad::Light sky;
+    sky.type = rad::LightType::sky;
+    sky.intensity = 1.0f;
+    scene.add_light(sky);
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 0.01f;
+    bool cancel = true;
+    int light_reports = 0;
+    o.on_progress = [&](const rad::Progress& p) {
+      if (p.phase != rad::Phase::lights) return true;
+      ++light_reports;
+      return !cancel;
+    };
+    rad::Problem problem(scene, o);
+    const rad::Solution cancelled = problem.solve();
+    CHECK(cancelled.status() == rad::SolveStatus::cancelled);
+    CHECK(light_reports == 1);
+    cancel = false;
+    const rad::Solution done = problem.solve();
+    CHECK(done.status() == rad::SolveStatus::converged);
+    o.on_progress = nullptr;
+    const rad::Solution fresh = rad::solve(scene, o);
+    CHECK(done.radiosity() == fresh.radiosity());
   }
 }
