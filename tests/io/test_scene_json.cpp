@@ -292,7 +292,7 @@ TEST_CASE("JSON unknown keys - wrong types - missing fields and unknown names ar
               "scene.json: materials[0].reflectence: unknown key (expected one of: name, emission");
   check_error(with_materials(R"({"name": "m0", "brdf": {"type": "ward", "specular": 0.2, "alpah_x": 0.1, "alpha_y": 0.1}})"),
               ErrorCode::parse_error, "materials[0].brdf.alpah_x: unknown key");
-  check_error(R"({"version": 1, "surfaces": [], "lights": []})", ErrorCode::parse_error, "scene.json: lights: unknown key");
+  check_error(R"({"version": 1, "surfaces": [], "light": []})", ErrorCode::parse_error, "scene.json: light: unknown key");
   check_error(with_materials(R"({"name": "m0", "reflectance": "red"})"), ErrorCode::parse_error,
               "materials[0].reflectance: expected a number or an array of 3 numbers, got string");
   check_error(with_materials(R"({"name": "m0", "two_sided": 1})"), ErrorCode::parse_error,
@@ -402,6 +402,7 @@ TEST_CASE("the complete example of docs/SCENE_JSON.md loads") {
   const rad::Scene scene = rad::parse_scene_json(text.substr(start + 8, end - start - 8), dir, "SCENE_JSON.md");
   CHECK(scene.materials().size() == 5 + 2);
   for (const char* g : {"floor", "ceiling", "back", "light", "box", "ball", "plate"}) CHECK(scene.find_group(g).has_value());
+  CHECK(scene.lights().size() == 1);
   CHECK(scene.warnings().empty());
 }
 
