@@ -125,8 +125,7 @@ Rgb unoccluded_cell_irradiance(const PreparedLight& light, const glm::vec3* corn
 }
 
 LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads)
-    : scene_(scene),
-      hierarchy_(hierarchy),
+    : hierarchy_(hierarchy),
       lights_(scene.lights()),
       occluders_(RayScene::from_polygons(scene)),
       seed_(seed),

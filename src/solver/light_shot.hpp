@@ -68,7 +68,6 @@ class LightShooter {
   Rgb element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays) const;
 
  private:
-  const Scene& scene_;
   const PatchHierarchy& hierarchy_;
   SceneLights lights_;
   RayScene occluders_;
