@@ -298,7 +298,9 @@ class RADIOSITY_API Problem {
 /// from every surface (find_emitters_facing_away()), and, for a converged solve, a scene that
 /// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses
 /// more than half its emitted power (SolveReport::escaped_power): light that arrives at the
-/// back of a one-sided polygon is lost, so its polygons probably face outwards.
+/// back of a one-sided polygon is lost, so its polygons probably face outwards (not judged when
+/// the scene's lights reach surfaces: their reflected light leaves open scenes as a matter of
+/// course).
 /// The same as Problem(scene, options).solve(), without keeping the Problem.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});

@@ -231,7 +231,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
 
   if (system->emitted <= 0.0) {
     // Nothing emits and no light reaches a surface: B = 0 is the exact answer.
-    report.warnings.push_back(lights ? "nothing emits and the scene's lights reach no surface; every radiosity is 0"
+    report.warnings.push_back(lights ? "nothing emits and the scene's lights reach no surface (the back of a "
+                                       "one-sided polygon absorbs what reaches it: check the winding, or use "
+                                       "two-sided materials); every radiosity is 0"
                                      : "the scene emits no light; every radiosity is 0");
     std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
     std::vector<Rgb> no_direct = no_irradiance;
@@ -443,8 +445,12 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       ambient_elements[system->leaves[i]] = (system->reflectance[i] + system->transmittance[i]) * r.ambient;
     hierarchy.aggregate(ambient_elements);
   }
+  // The balance tells outward winding from an open scene only for the emitters' light: the
+  // lights' reflected light leaves open scenes (a sunlit courtyard) as a matter of course, and
+  // their light that meets the backs of one-sided polygons is not counted at all.
+  const bool balance_diagnoses = status == SolveStatus::converged && report.light_power == Rgb(0.0f);
   for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
-                                                       status == SolveStatus::converged, o.threads, emission))
+                                                       balance_diagnoses, o.threads, emission))
     report.warnings.push_back(std::move(w));
   return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements),
