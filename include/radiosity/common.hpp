@@ -50,7 +50,14 @@ class RADIOSITY_API Error : public std::runtime_error {
 class PatchHierarchy;  // mesh.hpp
 
 /// Stage of a long computation that a progress report refers to.
-enum class Phase { meshing, form_factors, solving, refining, rendering };
+enum class Phase {
+  meshing,
+  form_factors,
+  solving,
+  refining,
+  rendering,
+  lights,  ///< the first shot of the scene's lights (Light) onto the elements
+};
 
 /// Snapshot handed to a progress callback.
 struct Progress {

@@ -28,8 +28,10 @@ struct LightmapOptions {
   /// false: the solution's field interpolated at the texel's surface point (as render() shows
   /// it; shadows are as sharp as the elements). true: a gather per texel: the light straight
   /// from the emitters by the exact point-to-polygon factor times a visible fraction from
-  /// shadow rays (shadows sharp at texel resolution), plus the light reflected by the rest of
-  /// the scene from hemisphere rays that read pass 1's radiosity where they land. Only
+  /// shadow rays (shadows sharp at texel resolution) and from the point, spot and directional
+  /// lights by a shadow ray each, plus the light reflected by the rest of the scene from
+  /// hemisphere rays that read pass 1's radiosity where they land (a ray that leaves the
+  /// scene brings the sky's light, counted as direct). Only
   /// irradiance and its two parts can be gathered (radiosity is interpolated either way).
   bool final_gather = false;
   int gather_rays = 256;  ///< final gather: cosine-distributed hemisphere rays per texel, >= 1

@@ -57,9 +57,13 @@ RADIOSITY_API void validate(const PathTraceOptions& options);
 /// also sampled through the emitters' mirror images and MIS-weighted against BSDF sampling;
 /// other caustics (through glass, off several mirrors) are found by BSDF sampling alone and
 /// converge more slowly.
+/// The scene's lights (Scene::lights(), docs/LIGHTS.md): every non-delta vertex takes the direct
+/// light of each point, spot and directional light with one shadow ray apiece (delta lights:
+/// no MIS; their light reaching a diffuse surface only through mirrors or glass is not found),
+/// and a ray that leaves the scene sees the sky's radiance (found by BSDF sampling alone).
 /// Russian roulette after three scattering events, on the throughput with the refraction
 /// scales divided out. Pixels use counter-based random streams keyed by (seed, pixel), so the
-/// image is bit-identical at any thread count. A scene without emitters renders black.
+/// image is bit-identical at any thread count. A scene without emitters and lights renders black.
 ///
 /// Cost: about two rays per scattering event (timings in docs/PATH_TRACER.md). Noise falls as
 /// 1/sqrt(spp): the 64 x 64 Cornell box has

@@ -79,7 +79,8 @@ struct RenderOptions : ImageOptions {
 RADIOSITY_API void validate(const RenderOptions& options);
 
 /// Ray-casts the solution: each camera ray shows the interpolated vertex radiosity / pi of the
-/// element it hits (Gouraud-style, continuous across elements). Deterministic for a seed at any
+/// element it hits (Gouraud-style, continuous across elements); a ray that hits nothing shows
+/// the scene's sky (a LightType::sky light; black without one). Deterministic for a seed at any
 /// thread count. Throws Error{invalid_argument} for a non-positive size or spp, or a solution
 /// that was not made from this scene.
 RADIOSITY_API Image render(const Scene& scene, const Solution& solution, const RenderOptions& options = {});

@@ -26,6 +26,7 @@ using MaterialId = std::uint32_t;
 using GroupId = std::uint32_t;
 using PolygonId = std::uint32_t;
 using MeshId = std::uint32_t;
+using LightId = std::uint32_t;
 
 /// Surface description. The diffuse part (emission, reflectance, diffuse transmittance) drives
 /// radiosity; the specular parts are for the extended first pass and the ray-traced second pass.
@@ -138,6 +139,12 @@ struct LoadOptions {
   /// default grey; non-planar or non-convex faces are triangulated. true: each such problem
   /// is an Error naming the file and line instead, so a loaded scene has no warnings.
   bool strict = false;
+  /// The library is radiometric (Light): false (the default) reads light intensities as they
+  /// are written, W/sr for point and spot lights and W/m^2 for directional lights and skies.
+  /// true reads them as photometric, candela and lux, and divides by 683 lm/W
+  /// (photometric_to_radiometric()). Read by the JSON scene reader and the glTF reader
+  /// (KHR_lights_punctual); see docs/LIGHTS.md.
+  bool photometric = false;
 };
 
 /// An indexed triangle mesh as a host renderer holds it, in meshoptimizer's pointer-and-count
@@ -172,6 +179,63 @@ struct Mesh {
   PolygonRange polygons;               ///< the polygons of its triangles, consecutive (add_mesh())
 };
 
+/// What kind of light a Light is (docs/LIGHTS.md).
+enum class LightType {
+  point,        ///< an isotropic point at Light::position
+  spot,         ///< a point whose light is confined to a cone around Light::direction
+  directional,  ///< parallel light from infinitely far away along Light::direction (the sun)
+  sky,          ///< light from every direction above the horizon (the zenith is Light::direction)
+};
+
+/// The radiance distribution of a LightType::sky over its hemisphere.
+enum class SkyModel {
+  uniform,       ///< the same radiance L = E / pi from every direction above the horizon
+  /// The CIE standard overcast sky (Moon & Spencer 1942; CIE S 011/E:2003 type 16): a zenith
+  /// three times as bright as the horizon, L(theta) = Lz (1 + 2 cos theta) / 3 for theta from
+  /// the zenith, with E = 7 pi Lz / 9.
+  cie_overcast,
+};
+
+/// A light that is not a polygon: glTF KHR_lights_punctual's point, spot and directional lights
+/// and a sky. The library is radiometric: the units below are watts (W/sr, W/m^2 per scene
+/// unit^2, like Material::emission); LoadOptions::photometric converts candela and lux when a
+/// scene file is read. A light emits `intensity x color` per channel. Radiosity lights every
+/// element with it as the first shot (its direct irradiance by shadow rays), the renderers
+/// sample it directly; see docs/LIGHTS.md.
+/// Thread safety: a plain value.
+struct Light {
+  LightType type = LightType::point;
+  std::string name;         ///< for messages and per-light results; may be empty
+  /// The group of lights this one belongs to, for relighting by groups (a later step); empty
+  /// means a group of its own. Kept, not used by the solve yet.
+  std::string light_group;
+  Rgb color{1.0f};          ///< each channel finite and >= 0; multiplies intensity
+  /// point, spot: radiant intensity in W/sr (on the axis and inside the inner cone for a spot).
+  /// directional: irradiance in W/m^2 on a surface facing the light. sky: the irradiance in
+  /// W/m^2 that an unobstructed horizontal surface (facing the zenith) receives from the whole
+  /// sky. Finite and >= 0.
+  float intensity = 0.0f;
+  glm::vec3 position{0.0f};  ///< point, spot: where the light is (scene units); unused otherwise
+  /// spot, directional: the direction the light travels (spot: its axis); sky: the zenith.
+  /// Normalised by Scene::add_light(); (0, 0, 0) means the default: straight down (0, -1, 0)
+  /// for spot and directional lights, up (0, 1, 0) for a sky's zenith. Unused for a point.
+  glm::vec3 direction{0.0f};
+  /// spot: full intensity within inner_cone_deg of the axis, none beyond outer_cone_deg, and
+  /// between them the smooth falloff of KHR_lights_punctual: t = clamp((cos a - cos outer) /
+  /// (cos inner - cos outer), 0, 1), intensity x t^2 at angle a. 0 <= inner <= outer <= 90.
+  float inner_cone_deg = 0.0f;
+  float outer_cone_deg = 45.0f;
+  SkyModel sky = SkyModel::uniform;  ///< sky: its radiance distribution
+};
+
+/// Lumens per watt by which LoadOptions::photometric divides: the luminous efficacy of light
+/// at 555 nm, the definition of the candela (glTF's lights are in candela and lux).
+inline constexpr float kLumensPerWatt = 683.0f;
+
+/// A photometric light quantity (candela, lux) as the radiometric one the library uses (W/sr,
+/// W/m^2): value / 683 lm/W. Thread safety: pure.
+constexpr float photometric_to_radiometric(float photometric) { return photometric / kLumensPerWatt; }
+
 /// Pinhole camera. `fov_deg` is the vertical field of view in degrees.
 struct Camera {
   glm::vec3 eye{0.0f, 0.0f, 0.0f};
@@ -188,7 +252,7 @@ struct Bounds {
 };
 
 
-/// Polygons, materials, groups and a camera. Everything is validated on entry, so a Scene that
+/// Polygons, materials, groups, lights and a camera. Everything is validated on entry, so a Scene that
 /// exists is usable by every solver.
 /// Thread safety: const member functions may be called concurrently; mutation needs exclusive access.
 class RADIOSITY_API Scene {
@@ -252,6 +316,15 @@ class RADIOSITY_API Scene {
   /// second radiosity per element. Thread safety: mutates the scene.
   void make_two_sided();
 
+  /// Adds a light (Light) and returns its id, with `direction` normalised and its default
+  /// filled in. Throws Error{invalid_scene} naming the light (its name and id) and the field
+  /// for a NaN or infinite value, a negative intensity or colour channel, cones outside
+  /// 0 <= inner_cone_deg <= outer_cone_deg <= 90, or a direction that cannot be normalised.
+  /// Thread safety: mutates the scene.
+  LightId add_light(const Light& light);
+  /// The lights, by LightId.
+  const std::vector<Light>& lights() const { return lights_; }
+
   const std::vector<Material>& materials() const { return materials_; }
   const Material& material(MaterialId id) const { return materials_.at(id); }
   const std::vector<Polygon>& polygons() const { return polygons_; }
@@ -276,6 +349,7 @@ class RADIOSITY_API Scene {
   std::vector<Material> materials_;
   std::vector<Polygon> polygons_;
   std::vector<Mesh> meshes_;
+  std::vector<Light> lights_;
   std::vector<std::string> groups_;
   std::optional<Camera> camera_;
   std::vector<std::string> warnings_;

@@ -70,7 +70,7 @@ enum class SolveStatus { converged, iteration_cap, cancelled };
 enum class Quantity {
   radiosity,            ///< B: the light leaving the surface, emission included
   irradiance,           ///< H: the light arriving, before the reflectance (what lightmaps store)
-  direct_irradiance,    ///< the part of H that came straight from the emitters
+  direct_irradiance,    ///< the part of H that came straight from the emitters and the lights
   indirect_irradiance,  ///< H minus its direct part: light reflected at least once
 };
 
@@ -100,7 +100,13 @@ struct SolveReport {
   /// passages the solution carries between diffuse surfaces (0: classic radiosity). The
   /// two-pass compositor reads it so that its photon map leaves those paths out.
   std::uint32_t specular_depth = 0;
-  Rgb emitted_power{0.0f};               ///< sum A E, W per channel
+  /// sum A E over the emitting sides plus light_power, W per channel: the scene's lights count
+  /// with the power they put onto the surfaces (docs/LIGHTS.md).
+  Rgb emitted_power{0.0f};
+  /// The part of emitted_power that the lights (Scene::lights()) deliver straight onto the
+  /// surfaces: sum over sides of A H_light, W per channel. Light that misses every surface, or
+  /// reaches only the back of a one-sided polygon, is not counted.
+  Rgb light_power{0.0f};
   Rgb absorbed_power{0.0f};              ///< sum A (1 - rho) H, where H is the irradiance
   /// Power that left the scene: emitted minus absorbed, W per channel (>= 0 up to solver
   /// tolerance): through openings, into the sky, or onto the backs of one-sided polygons.
@@ -108,6 +114,9 @@ struct SolveReport {
   double seconds_meshing = 0.0;
   double seconds_form_factors = 0.0;
   double seconds_solving = 0.0;
+  /// The lights' first shot: every element in the first solve of a Problem, the new elements
+  /// of adaptive subdivision; 0 when the values were kept from an earlier solve.
+  double seconds_lights = 0.0;
   std::vector<std::string> warnings;
 };
 
@@ -156,15 +165,17 @@ class RADIOSITY_API Solution {
   /// one-sided opaque elements. Empty when the scene has no translucent or two-sided material:
   /// every back is black.
   const std::vector<Rgb>& back_radiosity() const { return back_radiosity_; }
-  /// Irradiance H (W/m^2) arriving at the front of each element id from every surface, before
+  /// Irradiance H (W/m^2) arriving at the front of each element id from every surface and light, before
   /// the element's own reflectance: B = E + rho H (+ tau H' for a translucent one, H' its back's).
   /// What a lightmap stores, and defined where a channel of rho is 0 (where (B - E) / rho is
   /// not). Inner nodes hold the area-weighted mean of their children. Empty only for a Solution
   /// constructed without it; solve() always fills it (zero when nothing emits).
   const std::vector<Rgb>& irradiance() const { return irradiance_; }
-  /// The part of irradiance() that arrives straight from the emitters, per element id: sum over
-  /// targets t of F(e -> t) E_t. irradiance() minus it is the indirect part, light that has
-  /// been reflected (or transmitted) at least once. Empty for a cancelled solve.
+  /// The part of irradiance() that arrives straight from the emitters and the lights, per
+  /// element id: sum over targets t of F(e -> t) E_t plus the lights' first shot (the element's
+  /// mean irradiance from Scene::lights(), by shadow rays; docs/LIGHTS.md). irradiance() minus
+  /// it is the indirect part, light that has been reflected (or transmitted) at least once.
+  /// Empty for a cancelled solve.
   const std::vector<Rgb>& direct_irradiance() const { return direct_irradiance_; }
   /// back_radiosity() per vertex for display (empty when it is empty); no ambient term.
   std::vector<Rgb> vertex_back_radiosity() const;
@@ -261,7 +272,10 @@ RADIOSITY_API void validate(const SolveOptions& options);
 /// visibility) and the form factors the matrix methods have computed. Solving it again, with the
 /// materials' emission or with other emission per polygon (relighting, light groups, a lamp
 /// switched off), reuses all of that: a matrix method's second solve costs its sweeps only. The
-/// estimator is made on the first solve that has something to emit. Progressive refinement
+/// estimator is made on the first solve that has something to emit. The lights' first shot
+/// (their direct irradiance on every element, docs/LIGHTS.md) is computed by the first solve of
+/// a scene with lights and kept: a relit solve(polygon_emission) keeps the lights shining and
+/// changes the polygons' emission only. Progressive refinement
 /// keeps the columns it shot (within SolveOptions::memory_budget_bytes), so a relit solve
 /// computes only the columns of patches not shot before.
 ///
@@ -307,7 +321,8 @@ class RADIOSITY_API Problem {
   /// Throws Error{invalid_argument} unless there is one finite, non-negative value per polygon.
   /// The Monte Carlo estimator gives its exact emitter factors (FormFactorOptions::
   /// exact_emitters) to the patches that emit in the scene's materials; newly emitting patches
-  /// are counted by its hemisphere rays: unbiased, but their direct light is noisier.
+  /// are counted by its hemisphere rays: unbiased, but their direct light is noisier. The
+  /// scene's lights shine as in solve() (their first shot is kept from an earlier solve).
   Solution solve(const std::vector<Rgb>& polygon_emission);
 
  private:
@@ -320,13 +335,17 @@ class RADIOSITY_API Problem {
 /// options or when the matrix methods would exceed memory_budget_bytes (the message gives the
 /// size and suggests progressive or a coarser mesh), and Error{invalid_scene} naming two
 /// polygons for coincident or interpenetrating surfaces (find_overlaps(); checked when the form
-/// factors are set up, so a scene that emits nothing returns B = 0 without the check). A cancelled solve returns the last
+/// factors are set up, so a scene that emits nothing returns B = 0 without the check; a scene with
+/// lights (Scene::lights()) is solved even when no polygon emits: the lights are the first shot,
+/// docs/LIGHTS.md). A cancelled solve returns the last
 /// consistent estimate with status cancelled.
 /// Light that leaves the scene is diagnosed in SolveReport::warnings: emitters that face away
 /// from every surface (find_emitters_facing_away()), and, for a converged solve, a scene that
 /// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses
 /// more than half its emitted power (SolveReport::escaped_power): light that arrives at the
-/// back of a one-sided polygon is lost, so its polygons probably face outwards.
+/// back of a one-sided polygon is lost, so its polygons probably face outwards (not judged when
+/// the scene's lights reach surfaces: their reflected light leaves open scenes as a matter of
+/// course).
 /// The same as Problem(scene, options).solve(), without keeping the Problem.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});

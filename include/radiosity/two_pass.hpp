@@ -102,7 +102,8 @@ RADIOSITY_API void validate(const TwoPassOptions& options);
 /// The image is radiance in W/(m^2 sr), same camera model as render(). Its layers (in this
 /// order; each is a sum over camera rays, weighted by the path throughput, box-filtered):
 /// - "direct": at the first surface a camera ray hits, its emission E/pi plus the light it
-///   reflects diffusely that came straight from the emitters (DiffuseShading::pass1: the direct
+///   reflects diffusely that came straight from the emitters and the scene's lights
+///   (Scene::lights(); a camera ray that hits nothing shows the sky here) (DiffuseShading::pass1: the direct
 ///   part of pass 1's radiosity, estimated per element with shadow rays and interpolated like
 ///   the radiosity, capped at pass 1's value; final_gather: shadow rays at the hit point);
 /// - "indirect": at that first surface, pass 1's radiosity minus its direct part, over pi:
@@ -116,7 +117,8 @@ RADIOSITY_API void validate(const TwoPassOptions& options);
 /// DiffuseShading::pass1, the image equals render() with the same size, spp, camera, seed and
 /// ambient setting. A material with its own Material::brdf cannot be split into a diffuse and a
 /// specular part: pass 2 samples all of it. The approximations (pass 1 carries no diffuse ->
-/// specular -> diffuse light, glass is opaque to pass 1, ...) are listed in docs/TWO_PASS.md.
+/// specular -> diffuse light, glass is opaque to pass 1, no caustic photons from Light
+/// sources, ...) are listed in docs/TWO_PASS.md and docs/LIGHTS.md.
 ///
 /// Throws Error{invalid_argument} as validate() does or when `pass1` was not solved from
 /// `scene`, Error{internal} if Embree fails; an exception thrown by on_progress propagates.

@@ -30,6 +30,10 @@ enum class Stream : std::uint64_t {
   // Lightmaps (key_a: the texel).
   lightmap_gather = 0x1a9e0000ull,       ///< a texel's hemisphere rays (final gather)
   lightmap_light = 0xb0000000000ull,     ///< + emitter: a texel's shadow rays to an emitting polygon
+  // Lights that are not polygons (key_a: the element, or the pixel / element named).
+  light_front = 0xc0000000000ull,        ///< + light: the first shot's rays from an element's front
+  light_back = 0xc0100000000ull,         ///< + light: the same from an element's back
+  two_pass_sky = 0xd1ec7001ull,          ///< per element: sky rays of the direct part of pass 1
 };
 
 /// The key of `stream`, `offset` into its range.
@@ -39,7 +43,7 @@ constexpr std::uint64_t stream_key(Stream stream, std::uint64_t offset = 0) {
 
 namespace streams {
 
-/// How far each stream's offsets reach: targets and lights below 2^31, chunks below 2^32,
+/// How far each stream's offsets reach: targets, emitters and lights below 2^31, chunks below 2^32,
 /// hemicube samples below 2^16; the rest take none.
 struct Range {
   std::uint64_t first, span;
@@ -53,6 +57,8 @@ constexpr Range kRanges[] = {
     {stream_key(Stream::path), 1},                          {stream_key(Stream::two_pass_path), 1},
     {stream_key(Stream::two_pass_direct), 1},               {stream_key(Stream::photon), 1},
     {stream_key(Stream::lightmap_gather), 1},               {stream_key(Stream::lightmap_light), 1ull << 31},
+    {stream_key(Stream::light_front), 1ull << 31},          {stream_key(Stream::light_back), 1ull << 31},
+    {stream_key(Stream::two_pass_sky), 1},
 };
 
 constexpr bool disjoint() {

@@ -25,6 +25,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/color.hpp"
+#include "core/constants.hpp"
 #include "core/frame.hpp"
 #include "core/rng.hpp"
 #include "core/sampling.hpp"
@@ -32,6 +33,7 @@
 #include "form_factors/visibility.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
+#include "scene/lights.hpp"
 #include "image/image_loop.hpp"
 #include "radiosity/form_factors.hpp"
 #include "radiosity/lightmap.hpp"
@@ -252,7 +254,8 @@ class FinalGather {
         options_(options),
         epsilon_(epsilon),
         front_(solution.vertex_radiosity()),
-        back_(solution.vertex_back_radiosity()) {
+        back_(solution.vertex_back_radiosity()),
+        lights_(scene.lights()) {
     const std::vector<Polygon>& polygons = scene.polygons();
     for (PolygonId p = 0; p < polygons.size(); ++p) {
       const Material& m = scene.material(polygons[p].material);
@@ -269,6 +272,8 @@ class FinalGather {
   Light at(const glm::vec3& x, const glm::vec3& n, std::uint64_t texel) const {
     Light out;
     const std::vector<PolygonId> exact = direct_exact(x, n, texel, out.direct);
+    // Point, spot and directional lights (Scene::lights()) exactly, a shadow ray each.
+    if (!lights_.delta().empty()) out.direct += detail::delta_irradiance_at(lights_, leaves_, x, n, epsilon_);
 
     // Hemisphere rays, cosine-distributed: H = pi * mean(L) = mean(B) over the hits.
     const auto rays = static_cast<std::uint32_t>(options_.gather_rays);
@@ -293,7 +298,11 @@ class FinalGather {
                       hits.data(), found.data());
     Rgb direct(0.0f), indirect(0.0f);
     for (std::uint32_t r = 0; r < rays; ++r) {
-      if (!found[r]) continue;
+      if (!found[r]) {
+        // Into the sky: its light is direct, pi L per cosine-weighted ray.
+        if (lights_.has_sky()) direct += detail::kPi * lights_.sky_radiance(glm::normalize(direction[r]));
+        continue;
+      }
       const detail::RayScene::Hit& hit = hits[r];
       const bool front = glm::dot(h_.normal(hit.id), direction[r]) < 0.0f;
       if (!front && back_.empty()) continue;
@@ -366,6 +375,7 @@ class FinalGather {
   float epsilon_;
   std::vector<Rgb> front_, back_;  ///< pass 1's radiosity per hierarchy vertex
   std::vector<Emitter> emitters_;
+  detail::SceneLights lights_;
 };
 
 /// Fills `rings` rings of empty texels around the covered ones, each with the mean of its

@@ -39,6 +39,7 @@
 #include "image/camera.hpp"
 #include "image/image_loop.hpp"
 #include "image/image_options.hpp"
+#include "scene/lights.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -132,6 +133,7 @@ class PathTracer {
       : options_(options),
         camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
         rays_(detail::RayScene::from_polygons(scene)),
+        lights_(scene.lights()),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
     // Each material's model is built once here; the render only reads it.
     for (const Material& m : scene.materials()) shading_.push_back(make_shading(m));
@@ -240,7 +242,11 @@ class PathTracer {
     float tnear = 0.0f;
     for (int depth = 0;; ++depth) {
       const auto hit = rays_.intersect(origin, dir, tnear, std::numeric_limits<float>::infinity());
-      if (!hit) break;
+      if (!hit) {
+        // Escaped: the sky's radiance in full. It is not light-sampled, so no MIS weight.
+        if (lights_.has_sky()) L += beta * lights_.sky_radiance(dir);
+        break;
+      }
       const Surface& s = surfaces_[hit->id];
       const Shading& sh = shading_[s.material];
       // One-sided surfaces: the back of a polygon absorbs, as in the radiosity solver.
@@ -285,6 +291,7 @@ class PathTracer {
         const glm::vec3 n = front ? s.normal : -s.normal;  // a two-sided back reflects like a front
         const glm::vec3 offset_origin = x + epsilon_ * n;
         if (!emitters_.empty()) L += beta * direct_light(x, offset_origin, n, sh.reflectance, rng);
+        if (!lights_.delta().empty()) L += beta * sh.reflectance * (kInvPi * delta_irradiance(x, offset_origin, n));
         if (sample_mirrors) {
           const Rgb f = sh.reflectance * kInvPi;
           L += beta * mirror_light(x, n, rng, [&](const glm::vec3& wi, float& pdf, float& cos_x) {
@@ -357,6 +364,7 @@ class PathTracer {
     };
     const bool has_lobe = p_translucent > 0.0f || !sh.model_delta;
     if (!emitters_.empty() && has_lobe) L += beta * direct_light(x, s.normal, rng, bsdf);
+    if (!lights_.delta().empty() && has_lobe) L += beta * delta_light(x, s.normal, bsdf);
     const bool mirrors_sampled_here = sample_mirrors && has_lobe;
     if (mirrors_sampled_here) L += beta * mirror_light(x, s.normal, rng, bsdf);
 
@@ -530,6 +538,36 @@ class PathTracer {
     return c.f * light.emission * (kInvPi * c.cos_x / pdf_light * power_heuristic(pdf_light, c.pdf_bounce));
   }
 
+  /// The irradiance at x (offset to `offset_origin` along the unit normal n) from the point,
+  /// spot and directional lights, each with a shadow ray. Delta lights cannot be hit by a
+  /// bounce, so this is their whole contribution: no MIS.
+  Rgb delta_irradiance(const glm::vec3& x, const glm::vec3& offset_origin, const glm::vec3& n) const {
+    Rgb E(0.0f);
+    for (const detail::PreparedLight& l : lights_.delta()) {
+      detail::Incidence in;
+      if (!detail::incidence(l, x, in)) continue;
+      const float cos_x = glm::dot(n, in.wi);
+      if (cos_x > 0.0f && detail::unoccluded(rays_, offset_origin, l.position, in)) E += in.irradiance * cos_x;
+    }
+    return E;
+  }
+
+  /// The same for a surface with a model: f(wi) E_l cos_x for each delta light, the shadow ray
+  /// from the side of x that wi leaves from (a translucent surface is lit from behind too).
+  template <class Bsdf>
+  Rgb delta_light(const glm::vec3& x, const glm::vec3& normal, const Bsdf& bsdf) const {
+    Rgb out(0.0f);
+    for (const detail::PreparedLight& l : lights_.delta()) {
+      detail::Incidence in;
+      if (!detail::incidence(l, x, in)) continue;
+      float pdf = 0.0f, cos_x = 0.0f;
+      const Rgb f = bsdf(in.wi, pdf, cos_x);
+      if (!(max_component(f) > 0.0f)) continue;
+      if (detail::unoccluded(rays_, offset_towards(x, normal, in.wi), l.position, in)) out += f * in.irradiance * cos_x;
+    }
+    return out;
+  }
+
   /// Light that reaches x by one reflection in a plain planar mirror, sampled through the
   /// emitters' mirror images (the virtual sources of Wallace, Cohen & Greenberg 1987): a mirror
   /// face chosen uniformly, a point y on an emitter as in direct_light(), and the direction to
@@ -581,6 +619,7 @@ class PathTracer {
   const PathTraceOptions& options_;
   detail::PinholeCamera camera_;
   detail::RayScene rays_;
+  detail::SceneLights lights_;  ///< Scene::lights(): delta lights sampled at every vertex, the sky seen by escaping rays
   int g_;
   float epsilon_ = 0.0f;
   std::vector<Surface> surfaces_;

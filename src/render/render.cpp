@@ -1,7 +1,8 @@
 // Ray-cast display of a radiosity solution: the view pass of the method in its simplest form.
 // Each pixel averages stratified camera rays; a ray that hits a leaf element shows the
 // element's vertex radiosity interpolated at the hit point, divided by pi (a Lambertian
-// surface's radiance).
+// surface's radiance); a ray that hits nothing sees the sky (a LightType::sky light), as in the
+// other two renderers.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -18,6 +19,7 @@
 #include "image/image_loop.hpp"
 #include "image/image_options.hpp"
 #include "radiosity/render.hpp"
+#include "scene/lights.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -44,6 +46,7 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
   const detail::RayScene rays = detail::RayScene::from_leaves(hierarchy);
   const std::vector<Rgb> vertex_B = solution.vertex_radiosity(options.ambient);
   const std::vector<Rgb> vertex_back = solution.vertex_back_radiosity();  // empty: every back is black
+  const detail::SceneLights lights(scene.lights());  // a ray that hits nothing sees the sky
 
   // spp rounded up to a square for a jittered g x g grid per pixel.
   const int g = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9));
@@ -69,7 +72,7 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
 
   auto shade = [&](const glm::vec3& dir) -> Rgb {
     auto hit = rays.intersect(camera.eye, dir, 0.0f, std::numeric_limits<float>::infinity());
-    if (!hit) return Rgb(0.0f);
+    if (!hit) return lights.sky_radiance(dir);
     // One-sided surfaces: the back of a polygon sends nothing, unless it is translucent.
     const bool front = glm::dot(hierarchy.normal(hit->id), dir) < 0.0f;
     if (!front && vertex_back.empty()) return Rgb(0.0f);

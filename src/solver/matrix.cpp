@@ -25,7 +25,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   const RadiositySystem& sys = ctx.system;
   const std::size_t m = sys.unknowns(), n = sys.patches();
   SolverResult result;
-  result.B = B0.empty() ? sys.emission : B0;
+  result.B = B0.empty() ? sys.source : B0;
   result.H.assign(m, Rgb(0.0f));
 
   // Which sides still need a row (unknowns, fronts first), and where it goes.
@@ -121,9 +121,10 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   std::vector<const FactorVector*> row_of(m);
   for (std::size_t u = 0; u < m; ++u) row_of[u] = &store.rows[slot_of(u)];
   auto row = [&](std::size_t i) -> const FactorVector& { return *row_of[i]; };
-  // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp); opaque sides have no twin.
+  // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp; E_u with the lights' first shot); opaque
+  // sides have no twin.
   auto radiosity = [&](std::size_t i, const Rgb& h) {
-    Rgb b = sys.emission[i] + sys.reflectance[i] * h;
+    Rgb b = sys.source[i] + sys.reflectance[i] * h;
     if (sys.twin[i] != kNone) b += sys.transmittance[i] * result.H[sys.twin[i]];
     return b;
   };

@@ -31,12 +31,12 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   const RadiositySystem& sys = ctx.system;
   const std::size_t m = sys.unknowns(), n = sys.patches();
   SolverResult result;
-  result.B = sys.emission;
+  result.B = sys.source;
   result.H.assign(m, Rgb(0.0f));
 
-  // Unshot radiosity per patch starts as the patch's mean emission.
+  // Unshot radiosity per patch starts as the patch's mean emission (with the lights' first shot).
   std::vector<Rgb> unshot;
-  sys.patch_means(sys.emission, unshot);
+  sys.patch_means(sys.source, unshot);
 
   // Columns are kept once computed while they fit the memory budget: a patch is usually shot
   // several times, and recomputing its column is the whole cost of a step.

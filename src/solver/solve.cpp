@@ -12,6 +12,7 @@
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
 #include "form_factors/pass1_material.hpp"
+#include "solver/light_shot.hpp"
 #include "solver/system.hpp"
 #include "core/assert.hpp"
 #include "core/color.hpp"
@@ -26,7 +27,8 @@ using detail::seconds_since;
 constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
 
 /// Direct irradiance per front unknown, H_d(u) = sum over targets t of F(u -> t) E_t with E_t
-/// the target's mean emission: the light that arrives straight from the emitters. The matrix
+/// the target's mean emission, plus the lights' first shot H_light(u): the light that arrives
+/// straight from the emitters and the lights. The matrix
 /// methods have every row in `store`; progressive refinement takes the emitting targets'
 /// columns, from `columns` when it holds them for these leaves, else from the estimator.
 std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const FormFactorEstimator& estimator,
@@ -35,11 +37,13 @@ std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const For
   std::vector<Rgb> patch_E;
   sys.patch_means(sys.emission, patch_E);
   std::vector<Rgb> out(sys.fronts(), Rgb(0.0f));
+  if (!sys.light.empty())
+    for (std::size_t u = 0; u < sys.fronts(); ++u) out[u] = sys.light[u];
   if (!progressive) {
     for (std::size_t u = 0; u < sys.fronts(); ++u) {
       const std::uint32_t slot = store.slot[sys.element(u)];
       RADIOSITY_ASSERT(slot != kNone);  // solve_matrix() made a row for every unknown
-      out[u] = store.rows[slot].dot(patch_E);
+      out[u] += store.rows[slot].dot(patch_E);
     }
     return out;
   }
@@ -117,6 +121,10 @@ struct Problem::Impl {
   std::unique_ptr<FormFactorEstimator> estimator;  ///< made by the first solve with emission
   detail::MatrixStore store;                       ///< the matrix methods' rows, kept
   detail::ColumnStore columns;                     ///< progressive refinement's columns, kept
+  /// The lights' first shot (made by the first solve of a scene with lights) and its values per
+  /// element, kept: the lights and the geometry do not change between solves.
+  std::unique_ptr<detail::LightShooter> light_shooter;
+  detail::LightShot light_shot;
 
   Impl(const Scene& s, const SolveOptions& options);
   /// One solve; `emission` per polygon or null (the materials'). With `last` the hierarchy is
@@ -126,7 +134,16 @@ struct Problem::Impl {
   /// Each light group's own solve (SolveOptions::separate_light_groups) on the current
   /// hierarchy, without refinement; empty when one is cancelled.
   std::vector<LightGroupSolution> solve_light_groups(const std::vector<Rgb>* emission);
+  /// The lights' first shot for `elements` that lack it; false when cancelled.
+  bool shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate);
 };
+
+bool Problem::Impl::shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate) {
+  if (scene.lights().empty()) return true;
+  if (!light_shooter)
+    light_shooter = std::make_unique<detail::LightShooter>(scene, hierarchy, options.seed, options.threads);
+  return light_shooter->shoot(elements, light_shot, gate);
+}
 
 Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), options(given) {
   validate(given);
@@ -225,7 +242,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   auto result_hierarchy = [&] { return last ? std::move(hierarchy) : PatchHierarchy(hierarchy); };
 
   const bool translucency = o.form_factors.diffuse_transmission;
-  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy, translucency, emission);
+  const bool lights = !scene.lights().empty();
+  const detail::LightShot* light_shot_of = lights ? &light_shot : nullptr;
   std::vector<Rgb> B_elements(hierarchy.elements().size(), Rgb(0.0f));
   // Per element id, with diffuse transmission: the backs' radiosity (empty without).
   std::vector<Rgb> B_back(translucency ? hierarchy.elements().size() : 0, Rgb(0.0f));
@@ -240,9 +258,23 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
                     std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));
   }
 
+  // The lights' first shot (once per Problem): their direct irradiance on every element.
+  const double light_seconds = light_shot.seconds;
+  const bool shot = shoot_lights(hierarchy.leaves(), gate);
+  report.seconds_lights = light_shot.seconds - light_seconds;
+  if (!shot) {
+    std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
+    return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
+                    std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));
+  }
+  std::optional<detail::RadiositySystem> system(std::in_place, scene, hierarchy, translucency, emission, light_shot_of);
+
   if (system->emitted <= 0.0) {
-    // Nothing emits: B = 0 is the exact answer.
-    report.warnings.push_back("the scene emits no light; every radiosity is 0");
+    // Nothing emits and no light reaches a surface: B = 0 is the exact answer.
+    report.warnings.push_back(lights ? "nothing emits and the scene's lights reach no surface (the back of a "
+                                       "one-sided polygon absorbs what reaches it: check the winding, or use "
+                                       "two-sided materials); every radiosity is 0"
+                                     : "the scene emits no light; every radiosity is 0");
     std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
     std::vector<Rgb> no_direct = no_irradiance;
     return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::converged,
@@ -272,9 +304,10 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   auto H_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? H_elements : H_back)[system->element(u)]; };
   auto keep = [&](const detail::SolverResult& res) {
     resize();
+    // The solvers' irradiance is from surfaces; the lights' first shot arrives as well.
     for (std::size_t i = 0; i < system->unknowns(); ++i) {
       B_of(i) = res.B[i];
-      H_of(i) = res.H[i];
+      H_of(i) = system->light.empty() ? res.H[i] : res.H[i] + system->light[i];
     }
     report.iterations += res.iterations;
     report.residual = res.residual;
@@ -322,7 +355,25 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       }
       report.refined_elements += split.size();
       report.refinement_passes = pass;
-      system.emplace(scene, hierarchy, translucency, emission);
+      // The new leaves' share of the lights (their parents' values averaged them).
+      const double before = light_shot.seconds;
+      const bool lit = shoot_lights(created, gate);
+      report.seconds_lights += light_shot.seconds - before;
+      if (!lit) {
+        // Cancelled: the parents' values stand for their children in this solution's balance
+        // (a later solve computes them).
+        for (std::uint32_t c : created) {
+          const std::uint32_t parent = hierarchy.element(c).parent;
+          light_shot.done[c] = 0;
+          light_shot.front[c] = light_shot.front[parent];
+          light_shot.back[c] = light_shot.back[parent];
+        }
+      }
+      system.emplace(scene, hierarchy, translucency, emission, light_shot_of);
+      if (!lit) {
+        status = SolveStatus::cancelled;
+        break;
+      }
       Progress p{Phase::refining, static_cast<double>(pass) / o.adaptive.max_passes, pass, report.residual};
       if (!gate.report(p, true)) {
         status = SolveStatus::cancelled;
@@ -363,19 +414,20 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
         };
         for (std::size_t k = 0; k < created.size(); ++k) H_elements[created[k]] = gather(rows[k]);
         for (std::size_t k = 0; k < backs.size(); ++k) H_back[backs[k]] = gather(back_rows[k]);
-        auto front_emission = [&](std::uint32_t c) -> const Rgb& {
-          return detail::polygon_emission(scene, hierarchy.patches()[hierarchy.element(c).patch].polygon, emission);
-        };
+        // The system's source is E_c (with the lights' first shot, rho and tau of it).
         for (std::uint32_t c : created) {
-          const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
-          B_elements[c] = front_emission(c) + mat.reflectance * H_elements[c];
+          const std::uint32_t u = hierarchy.leaf_index(c);
+          B_elements[c] = system->source[u] + system->reflectance[u] * H_elements[c];
         }
         for (std::uint32_t c : backs) {
-          const Material& mat = scene.material(hierarchy.patches()[hierarchy.element(c).patch].material);
-          const Rgb tau = mat.diffuse_transmittance;
-          B_elements[c] += tau * H_back[c];
-          B_back[c] = detail::pass1_back_emission(mat, front_emission(c)) + detail::pass1_back_reflectance(mat) * H_back[c] +
-                      tau * H_elements[c];
+          const std::uint32_t u = hierarchy.leaf_index(c), back = system->twin[u];
+          B_elements[c] += system->transmittance[u] * H_back[c];
+          B_back[c] = system->source[back] + system->reflectance[back] * H_back[c] +
+                      system->transmittance[back] * H_elements[c];
+        }
+        if (!system->light.empty()) {
+          for (std::uint32_t c : created) H_elements[c] += system->light[hierarchy.leaf_index(c)];
+          for (std::uint32_t c : backs) H_back[c] += system->light[system->twin[hierarchy.leaf_index(c)]];
         }
       }
     }
@@ -388,10 +440,15 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // With extended form factors the light that a mirror, window or glass passes on is counted
   // where it lands, so it is not absorbed at the specular surface, on either side (pass1_* are
   // channel means).
-  glm::dvec3 emitted(0.0), absorbed(0.0);
+  // The lights count as emitted with the power they put onto the sides (docs/LIGHTS.md).
+  glm::dvec3 emitted(0.0), absorbed(0.0), lit(0.0);
   for (std::size_t i = 0; i < system->unknowns(); ++i) {
     const double a = system->area[i];
     emitted += a * glm::dvec3(system->emission[i]);
+    if (!system->light.empty()) {
+      lit += a * glm::dvec3(system->light[i]);
+      emitted += a * glm::dvec3(system->light[i]);
+    }
     double passed_on = 0.0;
     if (o.form_factors.specular_depth > 0) {
       const Material& m = scene.material(hierarchy.patches()[hierarchy.element(system->element(i)).patch].material);
@@ -404,6 +461,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
                 glm::dvec3(H_of(i));
   }
   report.emitted_power = Rgb(emitted);
+  report.light_power = Rgb(lit);
   report.absorbed_power = Rgb(absorbed);
   report.escaped_power = Rgb(emitted - absorbed);
   // What arrived straight from the emitters; not for a cancelled solve, which may lack rows.
@@ -427,8 +485,12 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       ambient_elements[system->leaves[i]] = (system->reflectance[i] + system->transmittance[i]) * r.ambient;
     hierarchy.aggregate(ambient_elements);
   }
+  // The balance tells outward winding from an open scene only for the emitters' light: the
+  // lights' reflected light leaves open scenes (a sunlit courtyard) as a matter of course, and
+  // their light that meets the backs of one-sided polygons is not counted at all.
+  const bool balance_diagnoses = status == SolveStatus::converged && report.light_power == Rgb(0.0f);
   for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
-                                                       status == SolveStatus::converged, o.threads, emission))
+                                                       balance_diagnoses, o.threads, emission))
     report.warnings.push_back(std::move(w));
   return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements),

@@ -3,11 +3,12 @@
 #include "form_factors/estimators.hpp"
 #include "form_factors/pass1_material.hpp"
 #include "scene/emission.hpp"
+#include "core/assert.hpp"
 
 namespace radiosity::detail {
 
 RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission,
-                                 const std::vector<Rgb>* polygon_emission)
+                                 const std::vector<Rgb>* polygon_emission, const LightShot* lights)
     : leaves(hierarchy.leaves()) {
   const std::size_t m = leaves.size(), n = hierarchy.patches().size();
   // Back targets first, numbered as the estimators number them, so each back unknown knows its target.
@@ -44,6 +45,21 @@ RadiositySystem::RadiositySystem(const Scene& scene, const PatchHierarchy& hiera
                                                                     polygon_emission));
     add(back_target[e.patch], e.area, E, pass1_back_reflectance(mat), mat.diffuse_transmittance, i);
     emitted += static_cast<double>(e.area) * (E.x + E.y + E.z);
+  }
+  if (lights != nullptr) {
+    light.resize(area.size());
+    for (std::size_t u = 0; u < area.size(); ++u) {
+      RADIOSITY_ASSERT(element(u) < lights->front.size());
+      light[u] = lights->of(element(u), u >= m);
+    }
+    source.resize(area.size());
+    for (std::size_t u = 0; u < area.size(); ++u) {
+      source[u] = emission[u] + reflectance[u] * light[u];
+      if (twin[u] != kNone) source[u] += transmittance[u] * light[twin[u]];
+      emitted += static_cast<double>(area[u]) * (static_cast<double>(light[u].x) + light[u].y + light[u].z);
+    }
+  } else {
+    source = emission;
   }
   glm::dvec3 mean(0.0);
   for (std::size_t u = 0; u < area.size(); ++u)

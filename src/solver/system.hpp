@@ -11,6 +11,7 @@
 #include "radiosity/scene.hpp"
 #include "radiosity/solver.hpp"
 #include "core/progress.hpp"
+#include "solver/light_shot.hpp"
 
 namespace radiosity::detail {
 
@@ -31,14 +32,26 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
 /// what it reflects plus what its other side receives and transmits. The back of a one-sided
 /// material reflects nothing (rho 0), as in the path tracer; a two-sided one reflects like the
 /// front. Emission leaves the front only.
+///
+/// The scene's lights (Light) are the first shot: each side's direct irradiance from them,
+/// H_light (solver/light_shot.hpp), is reflected and transmitted like any received light, so
+/// the solvers start from and add `source` = E + rho H_light + tau H_light(twin) where they
+/// would use E, and report the irradiance from surfaces only (solve() adds H_light).
 struct RadiositySystem {
   std::vector<std::uint32_t> leaves;  ///< element ids of the fronts: the estimators' element list
   std::vector<float> area;            ///< per unknown
   std::vector<Rgb> emission, reflectance, transmittance;  ///< per unknown; tau = 0 when opaque
+  /// Per unknown: the lights' direct irradiance H_light, W/m^2; empty when the scene has no lights.
+  std::vector<Rgb> light;
+  /// Per unknown: what the solvers emit, E + rho H_light + tau H_light(twin); `emission` when
+  /// there are no lights.
+  std::vector<Rgb> source;
   std::vector<std::uint32_t> patch;   ///< per unknown: its target (patch, or patches() + k for a back)
   std::vector<std::uint32_t> twin;    ///< per unknown: the other side's unknown, or kNone (opaque)
   std::vector<float> patch_area;      ///< per target
-  double emitted = 0.0;               ///< sum_e A_e (E_r + E_g + E_b), the residual's denominator
+  /// sum_u A_u (E_r + E_g + E_b + H_light,r + H_light,g + H_light,b), the residual's
+  /// denominator: the lights count with the power they put onto the surfaces.
+  double emitted = 0.0;
   /// 1 / (1 - area-weighted mean of rho + tau over the sides), per channel: the
   /// interreflection factor of the ambient term (Cohen et al. 1988, eq. 6).
   Rgb interreflection{1.0f};
@@ -46,8 +59,9 @@ struct RadiositySystem {
 
   /// `diffuse_transmission`: give translucent and two-sided patches (pass1_has_back()) their backs.
   /// `polygon_emission`: one value per polygon in place of the materials' emission, or null.
+  /// `lights`: the lights' first shot, computed for every leaf (and back), or null for none.
   RadiositySystem(const Scene& scene, const PatchHierarchy& hierarchy, bool diffuse_transmission,
-                  const std::vector<Rgb>* polygon_emission = nullptr);
+                  const std::vector<Rgb>* polygon_emission = nullptr, const LightShot* lights = nullptr);
   std::size_t unknowns() const { return area.size(); }
   std::size_t fronts() const { return leaves.size(); }
   std::size_t patches() const { return patch_area.size(); }  ///< targets, backs included

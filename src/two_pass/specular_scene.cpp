@@ -27,7 +27,7 @@ namespace {
 }  // namespace
 
 SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy)
-    : hierarchy_(&hierarchy), rays_(RayScene::from_leaves(hierarchy)) {
+    : hierarchy_(&hierarchy), rays_(RayScene::from_leaves(hierarchy)), lights_(scene.lights()) {
   const auto& polygons = scene.polygons();
   for (const Patch& p : hierarchy.patches())
     if (p.polygon >= polygons.size())

@@ -17,6 +17,7 @@
 #include "radiosity/common.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
+#include "scene/lights.hpp"
 
 namespace radiosity::detail {
 
@@ -64,6 +65,9 @@ class SpecularScene {
   PolygonId polygon_of_element(std::uint32_t element) const { return element_polygon_[element]; }
   bool has_specular() const { return has_specular_; }
   bool has_emitters() const { return !emitters_.empty(); }
+  /// The scene's lights (Scene::lights()): point, spot and directional lights and skies.
+  const SceneLights& lights() const { return lights_; }
+  bool has_lights() const { return !lights_.empty(); }
   /// Sum over emitters of E * A per channel, W.
   Rgb emitted_power() const { return emitted_power_; }
   /// Ray offset: far above float rounding at the scene's scale, far below any feature.
@@ -78,6 +82,21 @@ class SpecularScene {
   /// choice, u-values from `rng_value()` (a callable returning floats in [0,1)).
   template <typename Uniform>
   Rgb direct_irradiance(const glm::vec3& x, const glm::vec3& n, int samples, Uniform&& rng_value) const;
+
+  /// Estimate of the irradiance (W/m^2) at `x` (unit normal `n`) straight from the lights:
+  /// each delta light exactly with a shadow ray, the sky by one cosine-weighted ray from
+  /// `u_sky` (light_irradiance_at()).
+  Rgb light_irradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec2& u_sky) const {
+    return light_irradiance_at(lights_, rays_, x, n, epsilon_, u_sky);
+  }
+  /// The delta lights' part of it (no random numbers).
+  Rgb delta_light_irradiance(const glm::vec3& x, const glm::vec3& n) const {
+    return delta_irradiance_at(lights_, rays_, x, n, epsilon_);
+  }
+  /// The sky's part of it, one cosine-weighted ray from `u_sky`.
+  Rgb sky_light_irradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec2& u_sky) const {
+    return sky_irradiance_at(lights_, rays_, x, n, epsilon_, u_sky);
+  }
 
  private:
   Rgb direct_irradiance_one(const glm::vec3& x, const glm::vec3& n, float u_emitter, const glm::vec2& u_point) const;
@@ -94,6 +113,7 @@ class SpecularScene {
   std::vector<PolygonId> element_polygon_;
   std::vector<Emitter> emitters_;
   DiscreteDistribution emitter_choice_;  ///< over emitters_, by power summed over channels
+  SceneLights lights_;
   Rgb emitted_power_{0.0f};
   float epsilon_ = 0.0f;
   bool has_specular_ = false;

@@ -28,6 +28,7 @@
 
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
+#include "core/sampling.hpp"
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/streams.hpp"
@@ -112,9 +113,11 @@ class TwoPassRenderer {
 
  private:
   /// Per vertex, the part of pass 1's radiosity that is emission plus directly reflected light:
-  /// per leaf element E + rho * (mean direct irradiance over the element, by stratified shadow
-  /// rays), interpolated to the vertices like the radiosity, and capped at the radiosity so the
-  /// indirect remainder is never negative (the two estimates differ by the solver's error).
+  /// per leaf element E + rho * (mean direct irradiance over the element from the emitters and
+  /// the lights, by stratified shadow rays; the sky's directions stratified too and paired with
+  /// the points by a random permutation), interpolated to the vertices like the radiosity, and
+  /// capped at the radiosity so the indirect remainder is never negative (the two estimates
+  /// differ by the solver's error).
   std::vector<Rgb> direct_part_of_pass1() const {
     const PatchHierarchy& h = scene_.hierarchy();
     std::vector<Rgb> element_direct(h.elements().size(), Rgb(0.0f));
@@ -125,14 +128,27 @@ class TwoPassRenderer {
         const std::uint32_t e = leaves[i];
         const detail::SplitSurface& s = scene_.surface(scene_.polygon_of_element(e));
         Rgb H(0.0f);
-        if (max_channel(s.diffuse) > 0.0f && scene_.has_emitters()) {
+        if (max_channel(s.diffuse) > 0.0f && (scene_.has_emitters() || scene_.has_lights())) {
           detail::Rng rng(options_.seed, e, detail::stream_key(detail::Stream::two_pass_direct));
           auto uniform = [&rng] { return rng.uniform(); };
+          thread_local std::vector<glm::vec2> sky_u;
+          const bool sky = scene_.lights().has_sky();
+          if (sky) {
+            detail::Rng sky_rng(options_.seed, e, detail::stream_key(detail::Stream::two_pass_sky));
+            sky_u.resize(static_cast<std::size_t>(n) * n);
+            detail::stratified(static_cast<std::uint32_t>(n * n), sky_rng, true, sky_u.data());
+            for (std::size_t k = sky_u.size(); k > 1; --k) std::swap(sky_u[k - 1], sky_u[sky_rng.next() % k]);
+          }
           for (int a = 0; a < n; ++a)
             for (int b = 0; b < n; ++b) {
               const glm::vec2 u = rng.uniform2();
               const glm::vec2 uv((static_cast<float>(a) + u.x) / n, (static_cast<float>(b) + u.y) / n);
-              H += scene_.direct_irradiance(h.sample_point(e, uv), s.normal, 1, uniform);
+              const glm::vec3 x = h.sample_point(e, uv);
+              H += scene_.direct_irradiance(x, s.normal, 1, uniform);
+              if (scene_.has_lights()) {
+                H += scene_.delta_light_irradiance(x, s.normal);
+                if (sky) H += scene_.sky_light_irradiance(x, s.normal, sky_u[static_cast<std::size_t>(a) * n + b]);
+              }
             }
           H /= static_cast<float>(n * n);
         }
@@ -142,6 +158,18 @@ class TwoPassRenderer {
     std::vector<Rgb> direct = h.vertex_values(element_direct);
     for (std::size_t v = 0; v < direct.size(); ++v) direct[v] = glm::min(direct[v], vertex_B_[v]);
     return direct;
+  }
+
+  /// Final gather of the lights at x: the delta lights exactly, the sky by gather_samples
+  /// cosine-weighted rays.
+  Rgb gathered_light(const glm::vec3& x, const glm::vec3& n, detail::Rng& rng) const {
+    Rgb H = scene_.delta_light_irradiance(x, n);
+    if (scene_.lights().has_sky()) {
+      Rgb sky(0.0f);
+      for (int k = 0; k < options_.gather_samples; ++k) sky += scene_.sky_light_irradiance(x, n, rng.uniform2());
+      H += sky / static_cast<float>(options_.gather_samples);
+    }
+    return H;
   }
 
   /// A ray's hit with what shading needs.
@@ -249,7 +277,10 @@ class TwoPassRenderer {
   void trace_specular(const glm::vec3& origin, const glm::vec3& dir, const Rgb& beta, int depth, float caustic_weight,
                       detail::Rng& rng, Radiance& out) const {
     SurfaceHit h;
-    if (!intersect(origin, dir, h)) return;
+    if (!intersect(origin, dir, h)) {
+      out.layer[kSpecular] += beta * scene_.lights().sky_radiance(dir);  // the sky, seen in a mirror
+      return;
+    }
     const detail::SplitSurface& s = *h.surface;
     if (h.front) {
       if (s.uses_pass1) {
@@ -269,16 +300,21 @@ class TwoPassRenderer {
   Radiance camera_ray(const glm::vec3& dir, const Strata& strata, detail::Rng& rng) const {
     Radiance out;
     SurfaceHit h;
-    if (!intersect(camera_.eye, dir, h)) return out;
+    if (!intersect(camera_.eye, dir, h)) {
+      out.layer[kDirect] = scene_.lights().sky_radiance(dir);  // the sky, as render() shows it
+      return out;
+    }
     const detail::SplitSurface& s = *h.surface;
     if (h.front) {
       if (s.uses_pass1) {
         const Rgb direct_part = interpolate(vertex_direct_, h);
         if (options_.diffuse == DiffuseShading::final_gather) {
           auto uniform = [&rng] { return rng.uniform(); };
-          const Rgb H =
-              max_channel(s.diffuse) > 0.0f ? scene_.direct_irradiance(h.x, s.normal, options_.gather_samples, uniform)
-                                            : Rgb(0.0f);
+          Rgb H(0.0f);
+          if (max_channel(s.diffuse) > 0.0f) {
+            H = scene_.direct_irradiance(h.x, s.normal, options_.gather_samples, uniform);
+            if (scene_.has_lights()) H += gathered_light(h.x, s.normal, rng);
+          }
           out.layer[kDirect] = (s.emission + s.diffuse * H) * kInvPi;
         } else {
           out.layer[kDirect] = direct_part * kInvPi;

@@ -292,7 +292,7 @@ TEST_CASE("JSON unknown keys - wrong types - missing fields and unknown names ar
               "scene.json: materials[0].reflectence: unknown key (expected one of: name, emission");
   check_error(with_materials(R"({"name": "m0", "brdf": {"type": "ward", "specular": 0.2, "alpah_x": 0.1, "alpha_y": 0.1}})"),
               ErrorCode::parse_error, "materials[0].brdf.alpah_x: unknown key");
-  check_error(R"({"version": 1, "surfaces": [], "lights": []})", ErrorCode::parse_error, "scene.json: lights: unknown key");
+  check_error(R"({"version": 1, "surfaces": [], "light": []})", ErrorCode::parse_error, "scene.json: light: unknown key");
   check_error(with_materials(R"({"name": "m0", "reflectance": "red"})"), ErrorCode::parse_error,
               "materials[0].reflectance: expected a number or an array of 3 numbers, got string");
   check_error(with_materials(R"({"name": "m0", "two_sided": 1})"), ErrorCode::parse_error,
@@ -402,6 +402,7 @@ TEST_CASE("the complete example of docs/SCENE_JSON.md loads") {
   const rad::Scene scene = rad::parse_scene_json(text.substr(start + 8, end - start - 8), dir, "SCENE_JSON.md");
   CHECK(scene.materials().size() == 5 + 2);
   for (const char* g : {"floor", "ceiling", "back", "light", "box", "ball", "plate"}) CHECK(scene.find_group(g).has_value());
+  CHECK(scene.lights().size() == 1);
   CHECK(scene.warnings().empty());
 }
 
@@ -430,3 +431,81 @@ TEST_CASE("the JSON Cornell box solves to the built-in Cornell box's group radio
 }
 
 }  // TEST_SUITE("io")
+
+namespace {
+
+/// A scene document with the given lights array and one floor quad.
+std::string with_lights(const std::string& lights) {
+  return R"({"version": 1, "materials": [{"name": "m0"}], "lights": [)" + lights +
+         R"(], "surfaces": [{"type": "quad", "origin": [0,0,0], "edge_u": [0,0,1], "edge_v": [1,0,0], "material": "m0"}]})";
+}
+
+}  // namespace
+
+TEST_CASE("JSON lights of every type are read with their units - and as candela and lux under photometric") {
+  const std::string doc = with_lights(R"(
+    {"type": "point", "name": "bulb", "position": [1, 2, 3], "intensity": 683, "color": [1, 0.5, 0.25], "light_group": "ceiling"},
+    {"type": "spot", "position": [0, 3, 0], "direction": [0, -2, 0], "intensity": 10, "inner_cone_deg": 15, "outer_cone_deg": 30},
+    {"type": "directional", "name": "sun", "direction": [1, -1, 0], "intensity": 100000},
+    {"type": "sky", "intensity": 20000, "model": "cie_overcast", "zenith": [0, 0, 1], "comment": "z up"},
+    {"type": "sky", "intensity": 5})");
+  const rad::Scene scene = rad::parse_scene_json(doc, {});
+  REQUIRE(scene.lights().size() == 5);
+  const rad::Light& bulb = scene.lights()[0];
+  CHECK(bulb.type == rad::LightType::point);
+  CHECK(bulb.name == "bulb");
+  CHECK(bulb.light_group == "ceiling");
+  CHECK(bulb.intensity == 683.0f);  // W/sr, as written
+  CHECK(bulb.color == Rgb(1.0f, 0.5f, 0.25f));
+  CHECK(bulb.position == glm::vec3(1, 2, 3));
+  const rad::Light& spot = scene.lights()[1];
+  CHECK(spot.type == rad::LightType::spot);
+  CHECK(spot.direction == glm::vec3(0, -1, 0));  // normalised
+  CHECK(spot.inner_cone_deg == 15.0f);
+  CHECK(spot.outer_cone_deg == 30.0f);
+  CHECK(scene.lights()[2].type == rad::LightType::directional);
+  CHECK(scene.lights()[2].direction.x == doctest::Approx(std::sqrt(0.5)));
+  CHECK(scene.lights()[3].sky == rad::SkyModel::cie_overcast);
+  CHECK(scene.lights()[3].direction == glm::vec3(0, 0, 1));
+  CHECK(scene.lights()[4].sky == rad::SkyModel::uniform);
+  CHECK(scene.lights()[4].direction == glm::vec3(0, 1, 0));  // the default zenith
+
+  rad::LoadOptions photometric;
+  photometric.photometric = true;
+  const rad::Scene lux = rad::parse_scene_json(doc, {}, "scene.json", photometric);
+  CHECK(lux.lights()[0].intensity == doctest::Approx(1.0f));            // 683 cd
+  CHECK(lux.lights()[2].intensity == doctest::Approx(146.413f));        // 100 klx of sun
+  CHECK(lux.lights()[3].intensity == doctest::Approx(20000.0f / 683.0f));
+}
+
+TEST_CASE("JSON lights with bad values - keys or types are errors naming their place") {
+  check_error(with_lights(R"({"type": "point", "intensity": 1})"), ErrorCode::parse_error,
+              "scene.json: lights[0].position: missing (required)");
+  check_error(with_lights(R"({"type": "point", "position": [0,1,0], "intensity": -1})"), ErrorCode::invalid_scene,
+              "lights[0].intensity: must be >= 0");
+  check_error(with_lights(R"({"type": "sky", "intensity": 1}, {"type": "directional", "intensity": 1, "position": [0,1,0], "direction": [0,-1,0]})"),
+              ErrorCode::parse_error, "lights[1].position: unknown key (expected one of: type, name, light_group, color, intensity, direction)");
+  check_error(with_lights(R"({"type": "area", "intensity": 1})"), ErrorCode::parse_error,
+              "lights[0].type: unknown light type 'area' (expected point, spot, directional or sky)");
+  check_error(with_lights(R"({"type": "sky", "intensity": 1, "model": "clear"})"), ErrorCode::parse_error,
+              "lights[0].model: unknown sky model 'clear'");
+  check_error(with_lights(R"({"type": "spot", "position": [0,1,0], "direction": [0,-1,0], "intensity": 1, "inner_cone_deg": 40, "outer_cone_deg": 30})"),
+              ErrorCode::invalid_scene, "lights[0].inner_cone_deg: cones must satisfy 0 <= inner_cone_deg <= outer_cone_deg <= 90");
+  check_error(with_lights(R"({"type": "directional", "direction": [0,0,0], "intensity": 1})"), ErrorCode::invalid_scene,
+              "lights[0].direction: must not be [0, 0, 0]");
+  check_error(with_lights(R"({"type": "point", "position": [0,1,0], "intensity": 1, "color": [1, -1, 1]})"),
+              ErrorCode::invalid_scene, "lights[0].color: each channel must be >= 0");
+  check_error(with_lights(R"({"type": "point", "position": [0,1,0], "intensity": 1e39})"), ErrorCode::invalid_scene,
+              "lights[0].intensity: must be a finite number within float range");
+  check_error(R"({"version": 1, "lights": {}, "materials": [{"name": "m0"}], "surfaces": [{"type": "quad", "origin": [0,0,0], "edge_u": [0,0,1], "edge_v": [1,0,0], "material": "m0"}]})",
+              ErrorCode::parse_error, "scene.json: lights: expected an array");
+}
+
+TEST_CASE("JSON lights light the scene they are read with") {
+  const rad::Scene scene = rad::parse_scene_json(with_lights(R"({"type": "point", "position": [0.5, 1, 0.5], "intensity": 2})"), {});
+  const rad::Solution sol = rad::solve(scene);
+  CHECK(sol.report().light_power.x > 0.0f);
+  // The unit floor under a point light 1 above its centre subtends 4 asin(a^2 / (a^2 + 4 d^2)) =
+  // 4 asin(1/5) sr.
+  CHECK(sol.report().light_power.x == doctest::Approx(2.0 * 4.0 * std::asin(0.2)).epsilon(1e-5));
+}

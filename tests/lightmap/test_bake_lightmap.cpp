@@ -174,6 +174,43 @@ TEST_SUITE("lightmap") {
     CHECK(worst < 0.05);
   }
 
+  TEST_CASE("bake_lightmap: a floor under a point light and a uniform sky bakes I cos / r^2 + E") {
+    rad::Scene scene;
+    Floor mesh;
+    rad::Material white;
+    white.reflectance = rad::Rgb(0.5f);
+    const rad::MeshId floor = scene.add_mesh(mesh.desc(scene.add_material(white)));
+    rad::Light lamp, sky;
+    lamp.intensity = 2.0f;
+    lamp.position = {0.4f, 0.6f, 0.5f};
+    sky.type = rad::LightType::sky;
+    sky.direction = {0.0f, 0.0f, 1.0f};  // the floor's up
+    sky.intensity = 3.0f;
+    scene.add_light(lamp);
+    scene.add_light(sky);
+    const rad::Solution sol = rad::solve(scene, fine_solve());
+    for (bool gather : {false, true}) {
+      CAPTURE(gather);
+      rad::LightmapOptions o;
+      o.width = o.height = 32;
+      o.final_gather = gather;
+      o.gather_rays = 16;
+      const rad::Lightmap map = rad::bake_lightmap(scene, sol, floor, o);
+      double worst = 0.0;
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+          const glm::vec3 p = Floor::point(x, y, 32);
+          if (std::min({p.x, p.y, 1.0f - p.x, 1.0f - p.y}) < 0.05f) continue;
+          const glm::vec3 d = lamp.position - p;
+          const double expected = lamp.intensity * d.z / std::pow(glm::dot(d, d), 1.5) + sky.intensity;
+          worst = std::max(worst, std::abs(map.image.at(x, y).x - expected) / expected);
+        }
+      MESSAGE("largest relative error, " << (gather ? "final gather: " : "interpolated: ") << worst);
+      // Gathered: the point light exact at the texel's point, every sky ray escapes (pi L = E).
+      CHECK(worst < (gather ? 1e-3 : 0.01));
+    }
+  }
+
   TEST_CASE("bake_lightmap: a furnace cube whose faces are separate charts has no dark seams after dilation") {
     // An inward cube of 24 vertices (each face its own 4), every face a chart in a 3 x 2 grid of
     // 16 x 16 texel cells with the chart inset by 2 texels.

@@ -111,4 +111,28 @@ double leaf_mean(const rad::Solution& sol, const rad::Scene& scene, const std::s
   return area > 0.0 ? sum / area : 0.0;
 }
 
+/// A room [0,1]^3 of inward-facing walls whose ceiling has a square hole [0.3, 0.7]^2 (a
+/// window: four ceiling quads around it), with a camera inside at the front wall looking at the
+/// floor and the far walls. Groups "floor" (reflectance `floor`), "ceiling", "left", "right",
+/// "back", "front" (reflectance 0.6). No light: the caller adds one.
+inline rad::Scene window_room(rad::Rgb floor = rad::Rgb(0.7f, 0.5f, 0.3f)) {
+  rad::Scene scene;
+  rad::Material wall, ground;
+  wall.reflectance = rad::Rgb(0.6f);
+  ground.reflectance = floor;
+  const rad::MaterialId w = scene.add_material(wall), f = scene.add_material(ground);
+  rad::add_quad(scene, {0, 0, 0}, {0, 0, 1}, {1, 0, 0}, f, "floor");   // facing +y
+  rad::add_quad(scene, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, w, "left");    // +x
+  rad::add_quad(scene, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, w, "right");   // -x
+  rad::add_quad(scene, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}, w, "back");    // -z
+  rad::add_quad(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, w, "front");   // +z
+  // The ceiling (facing -y) around the window.
+  rad::add_quad(scene, {0, 1, 0}, {1, 0, 0}, {0, 0, 0.3f}, w, "ceiling");
+  rad::add_quad(scene, {0, 1, 0.7f}, {1, 0, 0}, {0, 0, 0.3f}, w, "ceiling");
+  rad::add_quad(scene, {0, 1, 0.3f}, {0.3f, 0, 0}, {0, 0, 0.4f}, w, "ceiling");
+  rad::add_quad(scene, {0.7f, 1, 0.3f}, {0.3f, 0, 0}, {0, 0, 0.4f}, w, "ceiling");
+  scene.set_camera(rad::Camera{{0.5f, 0.55f, 0.03f}, {0.5f, 0.3f, 1.0f}, {0, 1, 0}, 80.0f});
+  return scene;
+}
+
 }  // namespace test

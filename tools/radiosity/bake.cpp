@@ -73,7 +73,7 @@ double texel_density(const rad::Mesh& m, int size) {
 int run_bake(const BakeArgs& a) {
   return run_guarded([&] {
     ProgressBar bar;
-    rad::Scene scene = load(a.solve.scene, a.solve.strict, a.solve.two_sided);
+    rad::Scene scene = load(a.solve.scene, a.solve.strict, a.solve.two_sided, a.solve.photometric);
     print_warnings(scene.warnings());
     // Surfaces that came as polygons (OBJ faces, JSON shapes, the built-in scenes) are baked per
     // group, as meshes welded at shared corners.

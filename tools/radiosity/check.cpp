@@ -20,6 +20,7 @@ struct CheckArgs {
   std::string scene;
   std::string format = "text";
   bool strict = false;
+  bool photometric = false;
   bool two_sided = false;
   float max_patch_area = 0.0f, max_element_area = 0.0f;
 };
@@ -50,7 +51,7 @@ struct Estimate {
 
 struct CheckResult {
   std::string scene;
-  std::size_t polygons = 0, materials = 0, emitters = 0, groups = 0;
+  std::size_t polygons = 0, materials = 0, emitters = 0, lights = 0, groups = 0;
   double area = 0.0;
   std::vector<std::string> warnings;
   std::vector<rad::PolygonOverlap> overlaps;
@@ -113,7 +114,8 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     r.error = "the scene has no polygons";
     return r;
   }
-  if (r.emitters == 0) r.warnings.push_back("the scene emits no light; every radiosity is 0");
+  r.lights = scene.lights().size();
+  if (r.emitters == 0 && r.lights == 0) r.warnings.push_back("the scene emits no light; every radiosity is 0");
   r.overlaps = rad::find_overlaps(scene);
   for (const rad::PolygonOverlap& o : r.overlaps) {
     (o.kind == rad::OverlapKind::coincident ? r.coincident : r.interpenetrating) += 1;
@@ -159,8 +161,8 @@ std::string mib(std::size_t bytes) {
 
 void print_text(const CheckResult& r, const rad::Scene& scene) {
   std::printf("scene: %s\n", r.scene.c_str());
-  std::printf("polygons: %zu\nmaterials: %zu\nemitters: %zu\ngroups: %zu\narea: %.6g\n", r.polygons, r.materials,
-              r.emitters, r.groups, r.area);
+  std::printf("polygons: %zu\nmaterials: %zu\nemitters: %zu\nlights: %zu\ngroups: %zu\narea: %.6g\n", r.polygons,
+              r.materials, r.emitters, r.lights, r.groups, r.area);
   std::printf("warnings: %zu\n", r.warnings.size());
   for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
   // Contact (a box on a floor, a prop sunk into it) is lit correctly; only z-fighting is a problem.
@@ -201,6 +203,7 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
   j["polygons"] = r.polygons;
   j["materials"] = r.materials;
   j["emitters"] = r.emitters;
+  j["lights"] = r.lights;
   j["groups"] = r.groups;
   j["area"] = r.area;
   j["warnings"] = r.warnings;
@@ -244,7 +247,7 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
 
 int run_check(const CheckArgs& a) {
   return run_guarded([&] {
-    const rad::Scene scene = load(a.scene, a.strict, a.two_sided);
+    const rad::Scene scene = load(a.scene, a.strict, a.two_sided, a.photometric);
     const CheckResult r = check_scene(a, scene);
     if (a.format == "json")
       print_json(r, scene);
@@ -268,6 +271,7 @@ Command add_check_command(CLI::App& app) {
   cmd->add_option("scene", a.scene, kSceneHelp);
   cmd->add_option("--format", a.format, "Output format")->check(CLI::IsMember({"text", "json"}))->capture_default_str();
   add_strict_flag(*cmd, a.strict);
+  add_photometric_flag(*cmd, a.photometric);
   cmd->add_flag("--two-sided", a.two_sided, "Make every material two-sided, as render and solve --two-sided do");
   cmd->add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(non_negative<float>());

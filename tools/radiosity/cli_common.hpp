@@ -162,6 +162,7 @@ class ProgressBar {
       case rad::Phase::solving: return "solving";
       case rad::Phase::refining: return "refining";
       case rad::Phase::rendering: return "rendering";
+      case rad::Phase::lights: return "lights";
     }
     return "";
   }
@@ -189,6 +190,7 @@ struct SolveArgs {
   float adaptive_threshold = 0.3f;
   int adaptive_passes = 3;
   bool strict = false;
+  bool photometric = false;
   bool two_sided = false;
   bool light_groups = false;
 };
@@ -255,6 +257,13 @@ inline void add_strict_flag(CLI::App& cmd, bool& strict) {
                "short faces, reflectance >= 1, a missing material): exit 1 naming file and line");
 }
 
+/// Adds `--photometric` (every command that loads a scene has it).
+inline void add_photometric_flag(CLI::App& cmd, bool& photometric) {
+  cmd.add_flag("--photometric", photometric,
+               "Read light intensities in the scene file as candela (point, spot) and lux (directional, sky) and "
+               "divide by 683 lm/W; without it they are W/sr and W/m^2 as written (the library is radiometric)");
+}
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
@@ -300,6 +309,7 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_flag("--light-groups", a.light_groups,
                "Also solve each emitting group's light on its own (one more solve each, same form factors): solve "
                "prints and --stats writes each light group's share, render writes an EXR layer per light group");
+  add_photometric_flag(cmd, a.photometric);
   cmd.add_flag("--two-sided", a.two_sided,
                "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
                "models whose polygons face inconsistently or outwards");
@@ -334,21 +344,23 @@ constexpr const char* kSceneHelp =
 
 /// A built-in scene by name, else the OBJ or JSON file at `path`, read strictly when `strict`
 /// (LoadOptions::strict: what the readers would fix with a warning is an error; built-in scenes
-/// have nothing to fix).
-inline rad::Scene load(const std::string& path, bool strict = false) {
+/// have nothing to fix), its light intensities photometric when `photometric`
+/// (LoadOptions::photometric).
+inline rad::Scene load(const std::string& path, bool strict = false, bool photometric = false) {
   if (path.empty() || path == "cornell" || path == "cornell-box") return rad::cornell_box();
   if (path == "cornell-specular") return rad::cornell_box_specular();
   if (path == "cornell-mirror") return rad::cornell_box_specular(rad::CornellSpecular::mirror);
   if (path == "cornell-glass") return rad::cornell_box_specular(rad::CornellSpecular::glass);
   rad::LoadOptions options;
   options.strict = strict;
+  options.photometric = photometric;
   return rad::load_scene(path, options);
 }
 
 /// load(), then every material two-sided when `two_sided` (`--two-sided`: models with
 /// unreliable winding; Scene::make_two_sided()).
-inline rad::Scene load(const std::string& path, bool strict, bool two_sided) {
-  rad::Scene scene = load(path, strict);
+inline rad::Scene load(const std::string& path, bool strict, bool two_sided, bool photometric) {
+  rad::Scene scene = load(path, strict, photometric);
   if (two_sided) scene.make_two_sided();
   return scene;
 }
@@ -379,7 +391,11 @@ inline void print_summary(const rad::Solution& sol) {
   // Power over the three channels; what escaped as a share of what was emitted.
   const double emitted = double(r.emitted_power.x) + double(r.emitted_power.y) + double(r.emitted_power.z);
   const double escaped = double(r.escaped_power.x) + double(r.escaped_power.y) + double(r.escaped_power.z);
-  if (emitted > 0.0)
+  const double lit = double(r.light_power.x) + double(r.light_power.y) + double(r.light_power.z);
+  if (emitted > 0.0 && lit > 0.0)
+    std::printf("power: emitted %.6g W (%.6g W of it from the lights), escaped %.1f %% (left the scene)\n", emitted, lit,
+                100.0 * escaped / emitted);
+  else if (emitted > 0.0)
     std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
 }
 

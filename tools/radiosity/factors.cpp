@@ -27,6 +27,7 @@ struct FactorsArgs {
   unsigned threads = 0;
   float max_patch_area = 0.0f, max_element_area = 0.0f;
   bool strict = false;
+  bool photometric = false;
 };
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -40,7 +41,7 @@ std::vector<std::string> split_list(const std::string& s) {
 
 int run_factors(const FactorsArgs& a) {
   return run_guarded([&] {
-    rad::Scene scene = load(a.scene, a.strict);
+    rad::Scene scene = load(a.scene, a.strict, a.photometric);
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
     o.form_factors.method = form_factor_method(a.method);
@@ -112,6 +113,7 @@ Command add_factors_command(CLI::App& app) {
   cmd->add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
       ->check(non_negative<float>());
   add_strict_flag(*cmd, a.strict);
+  add_photometric_flag(*cmd, a.photometric);
   return Command{cmd, [args] { return run_factors(*args); }};
 }
 

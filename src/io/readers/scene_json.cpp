@@ -1,5 +1,5 @@
 // The JSON scene format (docs/SCENE_JSON.md): materials with any reflection model of brdf.hpp,
-// explicit polygons, the shape helpers of scene.hpp, OBJ includes and a camera.
+// explicit polygons, the shape helpers of scene.hpp, OBJ includes, lights and a camera.
 //
 // nlohmann-json parses the text; this file walks the document and checks every value itself, so
 // that each error names the document path of the offending value ("materials[2].brdf.alpha_x")
@@ -236,6 +236,7 @@ class SceneReader {
   std::shared_ptr<const Brdf> brdf(const json& j, const std::string& loc, Rgb& diffuse) const;
   void camera(const json& j, Scene& scene) const;
   void materials(const json& j, Scene& scene);
+  void lights(const json& j, Scene& scene) const;
   void surface(const json& j, const std::string& loc, Scene& scene) const;
   glm::mat4 transform(const json& j, const std::string& loc) const;
   MaterialId material_ref(const json& obj, const std::string& loc) const;
@@ -373,6 +374,79 @@ void SceneReader::camera(const json& j, Scene& scene) const {
     scene.set_camera(c);
   } catch (const Error& e) {
     rethrow(e, loc);
+  }
+}
+
+void SceneReader::lights(const json& j, Scene& scene) const {
+  expect_type(j, "lights", j.is_array(), "an array");
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string loc = index_path("lights", i);
+    const json& l = j[i];
+    expect_type(l, loc, l.is_object(), "an object");
+    const std::string type = string(require(l, loc, "type"), key_path(loc, "type"));
+    Light light;
+    // Each type takes only the keys that mean something for it, so a misplaced one is an error.
+    if (type == "point") {
+      light.type = LightType::point;
+      object(l, loc, {"type", "name", "light_group", "color", "intensity", "position"});
+    } else if (type == "spot") {
+      light.type = LightType::spot;
+      object(l, loc, {"type", "name", "light_group", "color", "intensity", "position", "direction", "inner_cone_deg",
+                      "outer_cone_deg"});
+    } else if (type == "directional") {
+      light.type = LightType::directional;
+      object(l, loc, {"type", "name", "light_group", "color", "intensity", "direction"});
+    } else if (type == "sky") {
+      light.type = LightType::sky;
+      object(l, loc, {"type", "name", "light_group", "color", "intensity", "zenith", "model"});
+    } else {
+      fail(ErrorCode::parse_error, key_path(loc, "type"),
+           "unknown light type '" + type + "' (expected point, spot, directional or sky)");
+    }
+    if (const json* n = find(l, "name")) light.name = string(*n, key_path(loc, "name"));
+    if (const json* g = find(l, "light_group")) light.light_group = string(*g, key_path(loc, "light_group"));
+    if (const json* c = find(l, "color")) {
+      light.color = colour(*c, key_path(loc, "color"));
+      if (light.color.x < 0.0f || light.color.y < 0.0f || light.color.z < 0.0f)
+        fail(ErrorCode::invalid_scene, key_path(loc, "color"), "each channel must be >= 0 (got " + rgb_text(light.color) + ")");
+    }
+    // Radiometric as written (W/sr, W/m^2); candela and lux with LoadOptions::photometric.
+    light.intensity = non_negative(require(l, loc, "intensity"), key_path(loc, "intensity"));
+    if (options_.photometric) light.intensity = photometric_to_radiometric(light.intensity);
+    if (light.type == LightType::point || light.type == LightType::spot)
+      light.position = vec3(require(l, loc, "position"), key_path(loc, "position"));
+    auto unit = [&](const char* key, bool required) {
+      const json* d = required ? &require(l, loc, key) : find(l, key);
+      if (!d) return;
+      light.direction = vec3(*d, key_path(loc, key));
+      if (light.direction == glm::vec3(0.0f)) fail(ErrorCode::invalid_scene, key_path(loc, key), "must not be [0, 0, 0]");
+    };
+    if (light.type == LightType::spot || light.type == LightType::directional) unit("direction", true);
+    if (light.type == LightType::sky) unit("zenith", false);
+    if (light.type == LightType::spot) {
+      if (const json* c = find(l, "inner_cone_deg")) light.inner_cone_deg = number(*c, key_path(loc, "inner_cone_deg"));
+      if (const json* c = find(l, "outer_cone_deg")) light.outer_cone_deg = number(*c, key_path(loc, "outer_cone_deg"));
+      if (!(light.inner_cone_deg >= 0.0f && light.inner_cone_deg <= light.outer_cone_deg &&
+            light.outer_cone_deg <= 90.0f))
+        fail(ErrorCode::invalid_scene, key_path(loc, find(l, "inner_cone_deg") ? "inner_cone_deg" : "outer_cone_deg"),
+             "cones must satisfy 0 <= inner_cone_deg <= outer_cone_deg <= 90 (got " + number_text(light.inner_cone_deg) +
+                 " and " + number_text(light.outer_cone_deg) + ")");
+    }
+    if (const json* m = find(l, "model")) {
+      const std::string model = string(*m, key_path(loc, "model"));
+      if (model == "uniform")
+        light.sky = SkyModel::uniform;
+      else if (model == "cie_overcast")
+        light.sky = SkyModel::cie_overcast;
+      else
+        fail(ErrorCode::parse_error, key_path(loc, "model"),
+             "unknown sky model '" + model + "' (expected uniform or cie_overcast)");
+    }
+    try {
+      scene.add_light(light);
+    } catch (const Error& e) {
+      rethrow(e, loc);
+    }
   }
 }
 
@@ -603,7 +677,7 @@ void SceneReader::surface(const json& j, const std::string& loc, Scene& scene) c
 }
 
 Scene SceneReader::read(const json& root) {
-  object(root, "", {"version", "camera", "materials", "surfaces"});
+  object(root, "", {"version", "camera", "materials", "surfaces", "lights"});
   const json& version = require(root, "", "version");
   if (!version.is_number_integer() || version.get<long long>() != kFormatVersion)
     fail(ErrorCode::parse_error, "version",
@@ -615,6 +689,7 @@ Scene SceneReader::read(const json& root) {
   for (std::size_t i = 0; i < surfaces.size(); ++i) surface(surfaces[i], index_path("surfaces", i), scene);
   if (scene.polygons().empty()) fail(ErrorCode::invalid_scene, "surfaces", "the scene has no polygons");
   if (const json* c = find(root, "camera")) camera(*c, scene);
+  if (const json* l = find(root, "lights")) lights(*l, scene);
   warnings_.move_to(scene);
   return scene;
 }

@@ -85,6 +85,7 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   j["emitted_power"] = rgb(r.emitted_power);
   j["absorbed_power"] = rgb(r.absorbed_power);
   j["escaped_power"] = rgb(r.escaped_power);
+  j["light_power"] = rgb(r.light_power);
 
   Json groups = Json::object();
   for (const std::string& name : solution.groups())
@@ -105,7 +106,8 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
 
   j["timings"] = Json{{"meshing", number(r.seconds_meshing)},
                       {"form_factors", number(r.seconds_form_factors)},
-                      {"solving", number(r.seconds_solving)}};
+                      {"solving", number(r.seconds_solving)},
+                      {"lights", number(r.seconds_lights)}};
   Json history = Json::array();
   for (double v : r.residual_history) history.push_back(number(v));
   j["residual_history"] = std::move(history);

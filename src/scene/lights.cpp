@@ -1,0 +1,152 @@
+// The lights' radiometry (see lights.hpp for the sources): spot falloff, sky radiance and its
+// closed-form irradiance, and the one-point estimate the renderers share.
+#include "scene/lights.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/assert.hpp"
+#include "core/constants.hpp"
+#include "core/frame.hpp"
+#include "core/sampling.hpp"
+#include "geometry/ray_scene.hpp"
+
+namespace radiosity::detail {
+
+namespace {
+
+/// Shadow rays to a point light stop this fraction of the segment short of it (visibility.hpp's
+/// convention), so a light that sits on a surface is not hidden by that surface.
+constexpr float kShadowEnd = 1.0f - 1e-4f;
+
+PreparedLight prepare(const Light& l, LightId id) {
+  PreparedLight p;
+  p.type = l.type;
+  p.power = l.intensity * l.color;
+  p.position = l.position;
+  p.direction = l.direction;
+  p.id = id;
+  if (l.type == LightType::spot) {
+    p.cos_inner = std::cos(glm::radians(l.inner_cone_deg));
+    p.cos_outer = std::cos(glm::radians(l.outer_cone_deg));
+    // KHR_lights_punctual's form, including its floor on the denominator.
+    p.spot_scale = 1.0f / std::max(0.001f, p.cos_inner - p.cos_outer);
+    p.spot_offset = -p.cos_outer * p.spot_scale;
+  }
+  if (l.type == LightType::sky) {
+    p.sky = l.sky;
+    // E = integral of L cos over the hemisphere: pi L for the uniform sky; for the overcast
+    // sky Lz / 3 (pi + 2 (2 pi / 3)) = 7 pi Lz / 9.
+    p.zenith_radiance = l.sky == SkyModel::uniform ? p.power * kInvPi : p.power * (9.0f / (7.0f * kPi));
+  }
+  return p;
+}
+
+}  // namespace
+
+float PreparedLight::falloff(const glm::vec3& w) const {
+  if (type != LightType::spot) return 1.0f;
+  const float c = glm::dot(w, direction);
+  // Exactly 1 inside the inner cone and 0 outside the outer one, also where glTF's floor on the
+  // denominator (inner and outer nearly equal) would leave the inner cone below 1.
+  if (c >= cos_inner) return 1.0f;
+  if (c <= cos_outer) return 0.0f;
+  const float t = std::clamp(c * spot_scale + spot_offset, 0.0f, 1.0f);
+  return t * t;
+}
+
+Rgb PreparedLight::sky_radiance(const glm::vec3& from) const {
+  const float c = glm::dot(from, direction);
+  if (!(c > 0.0f)) return Rgb(0.0f);
+  return sky == SkyModel::uniform ? zenith_radiance : zenith_radiance * ((1.0f + 2.0f * c) / 3.0f);
+}
+
+Rgb PreparedLight::sky_irradiance(const glm::vec3& n) const {
+  // b: angle between the plane's normal and the zenith. Over the lune where both hemispheres
+  // overlap, integral of (w.n) = pi (1 + cos b) / 2 and integral of (w.z)(w.n) =
+  // 2/3 ((pi - b) cos b + sin b).
+  const double c = std::clamp(static_cast<double>(glm::dot(n, direction)), -1.0, 1.0);
+  const double b = std::acos(c), s = std::sqrt(std::max(0.0, 1.0 - c * c));
+  const double pi = 3.14159265358979323846;
+  const double first = 0.5 * pi * (1.0 + c);
+  if (sky == SkyModel::uniform) return zenith_radiance * static_cast<float>(first);
+  const double second = 2.0 / 3.0 * ((pi - b) * c + s);
+  return zenith_radiance * static_cast<float>((first + 2.0 * second) / 3.0);
+}
+
+SceneLights::SceneLights(const std::vector<Light>& lights) {
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const PreparedLight p = prepare(lights[i], static_cast<LightId>(i));
+    all_.push_back(p);
+    (p.delta() ? delta_ : skies_).push_back(p);
+  }
+}
+
+Rgb SceneLights::sky_radiance(const glm::vec3& from) const {
+  Rgb L(0.0f);
+  for (const PreparedLight& s : skies_) L += s.sky_radiance(from);
+  return L;
+}
+
+bool incidence(const PreparedLight& light, const glm::vec3& x, Incidence& out) {
+  if (light.type == LightType::directional) {
+    out.wi = -light.direction;
+    out.distance = std::numeric_limits<float>::infinity();
+    out.irradiance = light.power;
+    return light.power != Rgb(0.0f);
+  }
+  RADIOSITY_ASSERT(light.type == LightType::point || light.type == LightType::spot);
+  const glm::vec3 d = light.position - x;
+  const float r2 = glm::dot(d, d);
+  if (!(r2 > 0.0f)) return false;
+  out.distance = std::sqrt(r2);
+  out.wi = d / out.distance;
+  const float t = light.falloff(-out.wi);
+  if (!(t > 0.0f)) return false;
+  out.irradiance = light.power * (t / r2);
+  return light.power != Rgb(0.0f);
+}
+
+bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::vec3& light_position,
+                const Incidence& in) {
+  if (std::isinf(in.distance)) return !occluders.occluded(origin, in.wi, 0.0f, std::numeric_limits<float>::infinity());
+  return !occluders.occluded(origin, light_position - origin, 0.0f, kShadowEnd);
+}
+
+Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                        float epsilon) {
+  Rgb H(0.0f);
+  const glm::vec3 origin = x + epsilon * n;
+  for (const PreparedLight& l : lights.delta()) {
+    Incidence in;
+    if (!incidence(l, x, in)) continue;
+    const float cos_x = glm::dot(n, in.wi);
+    if (!(cos_x > 0.0f)) continue;
+    if (unoccluded(occluders, origin, l.position, in)) H += in.irradiance * cos_x;
+  }
+  return H;
+}
+
+Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                      float epsilon, const glm::vec2& u_sky) {
+  if (!lights.has_sky()) return Rgb(0.0f);
+  // Cosine-weighted: L cos / pdf = pi L.
+  glm::vec3 t, b;
+  tangent_frame(n, t, b);
+  const glm::vec3 local = cosine_hemisphere(u_sky);
+  const glm::vec3 w = glm::normalize(local.x * t + local.y * b + local.z * n);
+  const Rgb L = lights.sky_radiance(w);
+  if (L == Rgb(0.0f) || occluders.occluded(x + epsilon * n, w, 0.0f, std::numeric_limits<float>::infinity()))
+    return Rgb(0.0f);
+  return kPi * L;
+}
+
+Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x,
+                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky) {
+  return delta_irradiance_at(lights, occluders, x, n, epsilon) + sky_irradiance_at(lights, occluders, x, n, epsilon, u_sky);
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,119 @@
+// The scene's lights (Light: point, spot, directional, sky) as every stage evaluates them: the
+// radiosity first shot (solver/light_shot.cpp), the path tracer, the two-pass view, render()'s
+// background and the lightmap's final gather all read them through this one header, so the
+// three images and the solve see the same lights. Private to the library.
+// Based on:
+//   The Khronos Group, "KHR_lights_punctual" glTF 2.0 extension (2018): the units of point, spot
+//     and directional lights and the spot's smooth angular falloff.
+//   P. Moon & D. E. Spencer, "Illumination from a non-uniform sky", Illuminating Engineering 37,
+//     1942; CIE S 011/E:2003, "Spatial distribution of daylight - CIE standard general sky"
+//     (type 16, the overcast sky L(theta) = Lz (1 + 2 cos theta) / 3).
+//   J. Arvo, "Applications of irradiance tensors to the simulation of non-Lambertian phenomena",
+//     SIGGRAPH 1995 (moments of the cosine over the lune where two hemispheres overlap: the
+//     closed forms of sky_irradiance()).
+//   A. van Oosterom & J. Strackee, "The solid angle of a plane triangle", IEEE Trans. Biomed.
+//     Eng. 30(2), 1983 (an isotropic point's irradiance integrated over a polygon is I times
+//     the solid angle the polygon subtends).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "radiosity/scene.hpp"
+
+namespace radiosity::detail {
+
+class RayScene;
+
+/// One light with its constants worked out once.
+struct PreparedLight {
+  LightType type = LightType::point;
+  /// intensity x color: W/sr (point, spot), W/m^2 (directional, the sky's horizontal irradiance).
+  Rgb power{0.0f};
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< unit: where the light travels; a sky's zenith
+  /// Spot falloff as KHR_lights_punctual writes it: t = clamp(cos a * scale + offset, 0, 1).
+  float cos_outer = 0.0f, spot_scale = 1.0f, spot_offset = 0.0f;
+  float cos_inner = 1.0f;
+  SkyModel sky = SkyModel::uniform;
+  /// sky: the radiance at the zenith, W/(m^2 sr): E / pi (uniform) or 9 E / (7 pi) (CIE overcast).
+  Rgb zenith_radiance{0.0f};
+  LightId id = 0;  ///< its index in Scene::lights()
+
+  bool delta() const { return type != LightType::sky; }
+  /// Spot falloff in [0, 1] for light leaving along the unit direction w (1 for a point light).
+  float falloff(const glm::vec3& w) const;
+  /// A sky's radiance arriving from the unit direction `from` (towards the sky), 0 below the horizon.
+  Rgb sky_radiance(const glm::vec3& from) const;
+  /// A sky's irradiance on an unoccluded plane facing the unit normal n (closed forms: the
+  /// uniform sky E (1 + cos b) / 2, the overcast sky with Arvo's lune moments, b the angle
+  /// between n and the zenith). E itself for n = zenith.
+  Rgb sky_irradiance(const glm::vec3& n) const;
+};
+
+/// Light from a delta light (point, spot, directional) arriving at a point.
+struct Incidence {
+  glm::vec3 wi{0.0f};  ///< unit, from the point towards the light
+  /// Distance to the light; infinity for a directional light.
+  float distance = std::numeric_limits<float>::infinity();
+  /// Irradiance on a surface facing the light (the cosine at the receiver not applied):
+  /// I t / r^2 for a point or spot (t the falloff), E for a directional light.
+  Rgb irradiance{0.0f};
+};
+
+/// The scene's lights, split into delta lights and skies.
+/// Thread safety: immutable after construction.
+class SceneLights {
+ public:
+  SceneLights() = default;
+  explicit SceneLights(const std::vector<Light>& lights);
+
+  bool empty() const { return delta_.empty() && skies_.empty(); }
+  bool has_sky() const { return !skies_.empty(); }
+  /// Point, spot and directional lights, in Scene::lights() order.
+  const std::vector<PreparedLight>& delta() const { return delta_; }
+  const std::vector<PreparedLight>& skies() const { return skies_; }
+  /// Every light, in Scene::lights() order.
+  const std::vector<PreparedLight>& all() const { return all_; }
+
+  /// The skies' radiance arriving from the unit direction `from`, W/(m^2 sr) (0 without a sky).
+  Rgb sky_radiance(const glm::vec3& from) const;
+
+ private:
+  std::vector<PreparedLight> all_, delta_, skies_;
+};
+
+/// Where delta light `light` lies from x and what it delivers there, before the cosine and the
+/// shadow ray; false when it sends nothing towards x (outside a spot's cone, zero intensity, x at
+/// the light).
+bool incidence(const PreparedLight& light, const glm::vec3& x, Incidence& out);
+
+/// True when nothing in `occluders` lies between `origin` (a point already lifted off its
+/// surface) and the light of `in`: for a point or spot up to just short of the light (the
+/// shadow-ray convention of visibility.hpp, tfar = 1 - 1e-4 of the segment), for a directional
+/// light or a sky direction to infinity.
+bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::vec3& light_position,
+                const Incidence& in);
+
+/// The irradiance (W/m^2) at x, on the side its unit normal n faces, from the delta lights: each
+/// exactly, with a shadow ray from x lifted by `epsilon` along n. Thread safety: may be called
+/// concurrently.
+Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                        float epsilon);
+/// One-sample estimate of the irradiance at x from the skies: one cosine-weighted direction from
+/// `u_sky`, pi L V (unbiased); 0 without a sky. Thread safety: may be called concurrently.
+Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
+                      float epsilon, const glm::vec2& u_sky);
+
+/// One-sample estimate of the irradiance (W/m^2) that arrives at x, on the side its unit normal n
+/// faces, straight from the lights: every delta light exactly, with a shadow ray each (x lifted
+/// by `epsilon` along n), and the sky by one cosine-weighted direction from `u_sky` (pi L V:
+/// unbiased). Thread safety: may be called concurrently.
+Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x,
+                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky);
+
+}  // namespace radiosity::detail
