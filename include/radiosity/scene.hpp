@@ -206,8 +206,9 @@ enum class SkyModel {
 struct Light {
   LightType type = LightType::point;
   std::string name;         ///< for messages and per-light results; may be empty
-  /// The group of lights this one belongs to, for relighting by groups (a later step); empty
-  /// means a group of its own. Kept, not used by the solve yet.
+  /// The light group this light belongs to (SolveOptions::separate_light_groups,
+  /// Solution::relight()); empty means its own, named after the light. A light group named like
+  /// a group of emitting polygons shares their weight.
   std::string light_group;
   Rgb color{1.0f};          ///< each channel finite and >= 0; multiplies intensity
   /// point, spot: radiant intensity in W/sr (on the axis and inside the inner cone for a spot).

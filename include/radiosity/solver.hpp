@@ -57,7 +57,9 @@ struct SolveOptions {
   /// Also solve each light group's contribution on its own (one more solve per group, sharing
   /// the form factors and the hierarchy), kept in the Solution (Solution::light_groups()) so
   /// that Solution::relight() recombines them for any weights without solving. The light group
-  /// of an emitting polygon is its group (Scene::groups()). Adaptive subdivision refines on the
+  /// of an emitting polygon is its group (Scene::groups()); a Light's is Light::light_group, or
+  /// its name when that is empty, or "light N" (N its index) without either; a light group of
+  /// the same name as a polygon group joins it. Adaptive subdivision refines on the
   /// joint solve only; the groups are solved on its final hierarchy.
   bool separate_light_groups = false;
   ProgressFn on_progress;        ///< optional; return false to cancel

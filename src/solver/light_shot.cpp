@@ -137,7 +137,8 @@ LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, 
     patch_has_back_[p] = pass1_has_back(scene.material(hierarchy.patches()[p].material)) ? 1 : 0;
 }
 
-Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays) const {
+Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays,
+                                     const std::vector<char>* only) const {
   const Element& el = hierarchy_.element(e);
   const int count = el.corner_count();
   glm::vec3 corners[4];
@@ -150,6 +151,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
 
   Rgb H(0.0f);
   for (const PreparedLight& light : lights_.all()) {
+    if (only && !(*only)[light.id]) continue;
     const Rgb unoccluded = unoccluded_cell_irradiance(light, corners, count, el.area, n);
     if (!(unoccluded.x > 0.0f || unoccluded.y > 0.0f || unoccluded.z > 0.0f)) continue;
     Rng rng(seed_, e, stream_key(back_side ? Stream::light_back : Stream::light_front, light.id));
@@ -226,7 +228,8 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
   return H;
 }
 
-bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& shot, ProgressGate& gate) const {
+bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& shot, ProgressGate& gate,
+                         const std::vector<char>* only) const {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t count = hierarchy_.elements().size();
   shot.front.resize(count, Rgb(0.0f));
@@ -244,8 +247,8 @@ bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& 
       parallel_for(threads_, end - begin, 8, [&](std::size_t lo, std::size_t hi) {
         for (std::size_t i = begin + lo; i < begin + hi; ++i) {
           const std::uint32_t e = todo[i];
-          shot.front[e] = element_irradiance(e, false, rays[i]);
-          if (patch_has_back_[hierarchy_.element(e).patch]) shot.back[e] = element_irradiance(e, true, rays[i]);
+          shot.front[e] = element_irradiance(e, false, rays[i], only);
+          if (patch_has_back_[hierarchy_.element(e).patch]) shot.back[e] = element_irradiance(e, true, rays[i], only);
           shot.done[e] = 1;
         }
       });

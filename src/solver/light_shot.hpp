@@ -61,11 +61,16 @@ class LightShooter {
   /// and its back where its patch has one (pass1_has_back()). Reports Phase::lights through
   /// `gate` between blocks of elements; returns false when cancelled (elements done so far
   /// keep their values). Deterministic: each element side and light draws from its own stream.
-  bool shoot(const std::vector<std::uint32_t>& elements, LightShot& shot, ProgressGate& gate) const;
+  /// With `only` (one flag per Scene::lights() entry) just the flagged lights shine: a light
+  /// group's share (SolveOptions::separate_light_groups). Each light's value per element side is
+  /// the same whatever else shines (its own random stream), so the shares add up to the whole.
+  bool shoot(const std::vector<std::uint32_t>& elements, LightShot& shot, ProgressGate& gate,
+             const std::vector<char>* only = nullptr) const;
 
   /// The mean irradiance over one side of element `e` (unit normal `n` of that side) from
-  /// every light; `rays` counts the shadow rays.
-  Rgb element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays) const;
+  /// every light (or those flagged in `only`); `rays` counts the shadow rays.
+  Rgb element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays,
+                         const std::vector<char>* only = nullptr) const;
 
  private:
   const PatchHierarchy& hierarchy_;

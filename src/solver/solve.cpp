@@ -125,6 +125,8 @@ struct Problem::Impl {
   /// element, kept: the lights and the geometry do not change between solves.
   std::unique_ptr<detail::LightShooter> light_shooter;
   detail::LightShot light_shot;
+  /// During a light group's solve: that group's lights alone (solve_light_groups()).
+  const detail::LightShot* group_light_shot = nullptr;
 
   Impl(const Scene& s, const SolveOptions& options);
   /// One solve; `emission` per polygon or null (the materials'). With `last` the hierarchy is
@@ -199,29 +201,65 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
 }
 
 std::vector<LightGroupSolution> Problem::Impl::solve_light_groups(const std::vector<Rgb>* emission) {
-  // Superposition: B is linear in E, so each group's solve with only its emitters on gives its
-  // share, and the shares add up to the joint solve. The matrix methods' rows and progressive
-  // refinement's columns are kept, so a group's solve is its sweeps (or its shots) only.
+  // Superposition: B is linear in the sources, so each group's solve with only its emitters and
+  // lights on gives its share, and the shares add up to the joint solve. The matrix methods'
+  // rows and progressive refinement's columns are kept, so a group's solve is its sweeps (or
+  // its shots) only; a group's lights are shot again on their own (each light's value is the
+  // same as in the joint shot: its own random stream).
   const std::vector<Polygon>& polygons = scene.polygons();
+  const std::vector<Light>& lights = scene.lights();
+  struct Group {
+    std::string name;
+    std::vector<char> polygons;  // per GroupId of the scene: its emitting polygons shine
+    std::vector<char> lights;    // per light
+  };
+  std::vector<Group> groups;
+  auto group_named = [&](const std::string& name) -> Group& {
+    for (Group& g : groups)
+      if (g.name == name) return g;
+    groups.push_back(Group{name, std::vector<char>(scene.groups().size(), 0), std::vector<char>(lights.size(), 0)});
+    return groups.back();
+  };
+  // Emitting polygons by their group, in scene order; then the lights by their light group
+  // (else their name, else "light N"), joining a polygon group of the same name.
   std::vector<char> emits(scene.groups().size(), 0);
   for (PolygonId p = 0; p < polygons.size(); ++p)
     if (detail::max_channel(detail::polygon_emission(scene, p, emission)) > 0.0f) emits[polygons[p].group] = 1;
+  for (GroupId g = 0; g < emits.size(); ++g)
+    if (emits[g]) group_named(scene.groups()[g]).polygons[g] = 1;
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    const Light& l = lights[k];
+    group_named(!l.light_group.empty() ? l.light_group : !l.name.empty() ? l.name : "light " + std::to_string(k))
+        .lights[k] = 1;
+  }
+
   // The joint solve refined the hierarchy; the groups are solved on it as it is.
   struct KeepAdaptive {
     SolveOptions& o;
     AdaptiveOptions saved;
-    ~KeepAdaptive() { o.adaptive = saved; }
-  } keep{options, options.adaptive};
+    const detail::LightShot*& group_shot;
+    ~KeepAdaptive() {
+      o.adaptive = saved;
+      group_shot = nullptr;
+    }
+  } keep{options, options.adaptive, group_light_shot};
   options.adaptive.enabled = false;
+  detail::ProgressGate gate(options.on_progress);
   std::vector<LightGroupSolution> out;
   std::vector<Rgb> group_emission(polygons.size());
-  for (GroupId g = 0; g < emits.size(); ++g) {
-    if (!emits[g]) continue;
+  detail::LightShot shot;
+  for (const Group& g : groups) {
     for (PolygonId p = 0; p < polygons.size(); ++p)
-      group_emission[p] = polygons[p].group == g ? detail::polygon_emission(scene, p, emission) : Rgb(0.0f);
+      group_emission[p] = g.polygons[polygons[p].group] ? detail::polygon_emission(scene, p, emission) : Rgb(0.0f);
+    if (!lights.empty()) {
+      shot = detail::LightShot{};
+      if (!light_shooter && !shoot_lights({}, gate)) return {};  // makes the shooter
+      if (!light_shooter->shoot(hierarchy.leaves(), shot, gate, &g.lights)) return {};
+      group_light_shot = &shot;
+    }
     const Solution part = solve_once(&group_emission, false);
     if (part.status() == SolveStatus::cancelled) return {};
-    out.push_back(LightGroupSolution{scene.groups()[g], part.radiosity(), part.back_radiosity(), part.irradiance(),
+    out.push_back(LightGroupSolution{g.name, part.radiosity(), part.back_radiosity(), part.irradiance(),
                                      part.direct_irradiance()});
   }
   return out;
@@ -243,7 +281,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
 
   const bool translucency = o.form_factors.diffuse_transmission;
   const bool lights = !scene.lights().empty();
-  const detail::LightShot* light_shot_of = lights ? &light_shot : nullptr;
+  const detail::LightShot* light_shot_of = !lights ? nullptr : group_light_shot ? group_light_shot : &light_shot;
   std::vector<Rgb> B_elements(hierarchy.elements().size(), Rgb(0.0f));
   // Per element id, with diffuse transmission: the backs' radiosity (empty without).
   std::vector<Rgb> B_back(translucency ? hierarchy.elements().size() : 0, Rgb(0.0f));
@@ -260,7 +298,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
 
   // The lights' first shot (once per Problem): their direct irradiance on every element.
   const double light_seconds = light_shot.seconds;
-  const bool shot = shoot_lights(hierarchy.leaves(), gate);
+  const bool shot = group_light_shot != nullptr || shoot_lights(hierarchy.leaves(), gate);
   report.seconds_lights = light_shot.seconds - light_seconds;
   if (!shot) {
     std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));

@@ -118,6 +118,47 @@ TEST_SUITE("solver") {
     CHECK(now.y == doctest::Approx(base.y).epsilon(1e-5));
   }
 
+  TEST_CASE("light groups: lights join them - a point light in the lamp group and a bulb of its own add up and switch off") {
+    // The Cornell box's light, a point light in the group "light" (it joins the ceiling lamp's
+    // group) and a bulb of its own, added last so that the other light keeps its index (and so
+    // its random stream) in the scene without the bulb.
+    auto scene_with = [](bool point_on) {
+      rad::Scene scene = rad::cornell_box();
+      rad::Light second;
+      second.type = rad::LightType::point;
+      second.name = "second";
+      second.light_group = "light";
+      second.intensity = 1e4f;
+      second.color = rad::Rgb(0.2f, 0.4f, 1.0f);
+      second.position = {400.0f, 200.0f, 300.0f};
+      scene.add_light(second);
+      if (point_on) {
+        rad::Light bulb;
+        bulb.type = rad::LightType::point;
+        bulb.name = "bulb";
+        bulb.intensity = 2e4f;
+        bulb.position = {150.0f, 300.0f, 250.0f};
+        scene.add_light(bulb);
+      }
+      return scene;
+    };
+    const rad::Scene scene = scene_with(true);
+    const rad::Solution sol = rad::solve(scene, options(rad::SolverMethod::gauss_seidel));
+    REQUIRE(sol.light_groups().size() == 2);
+    CHECK(sol.light_groups()[0].name == "light");
+    CHECK(sol.light_groups()[1].name == "bulb");
+    CHECK(relative_difference(sum_of(sol.light_groups(), &rad::LightGroupSolution::radiosity), sol.radiosity()) < 1e-4);
+    CHECK(relative_difference(sum_of(sol.light_groups(), &rad::LightGroupSolution::direct_irradiance),
+                              sol.direct_irradiance()) < 1e-4);
+    // The bulb switched off equals the scene without it (lights do not change the form factors).
+    rad::SolveOptions plain = options(rad::SolverMethod::gauss_seidel);
+    plain.separate_light_groups = false;
+    const rad::Solution without = rad::solve(scene_with(false), plain);
+    const rad::Solution off = sol.relight({rad::Rgb(1.0f), rad::Rgb(0.0f)});
+    CHECK(relative_difference(off.radiosity(), without.radiosity()) < 1e-4);
+    CHECK(relative_difference(off.irradiance(), without.irradiance()) < 1e-4);
+  }
+
   TEST_CASE("light groups: the stats JSON gives each light group's share of each group") {
     const rad::Scene scene = two_lamps();
     const rad::Solution sol = rad::solve(scene, options(rad::SolverMethod::gauss_seidel));
