@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "io/readers/material_mapping.hpp"
+#include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
 #include "io/readers/readers.hpp"
 #include "radiosity/brdf.hpp"
@@ -55,18 +56,8 @@ std::string at(const fs::path& file, std::size_t line) { return loc(file, line) 
 }
 
 std::string read_text(const fs::path& path, const char* what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw Error(ErrorCode::file_not_found,
-                std::string("load_scene: cannot open ") + what + " '" + path.string() +
-                    (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot open ") + what + " '" + path.string() + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot read ") + what + " '" + path.string() + "'");
+  std::string s = read_file(path, what);
   // A UTF-8 byte order mark would hide the first statement.
-  std::string s = text.str();
   if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.erase(0, 3);
   return s;
 }
