@@ -6,6 +6,7 @@
 #include "io/readers/material_mapping.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 #include <glm/common.hpp>
 
@@ -13,6 +14,23 @@
 #include "io/readers/reader_warnings.hpp"
 
 namespace radiosity::detail {
+
+std::string describe(const Rgb& c) {
+  std::ostringstream s;
+  s << '(' << c.x << ", " << c.y << ", " << c.z << ')';
+  return s.str();
+}
+
+Rgb clamp_colour(Rgb c, float upper, float at_or_above, ReaderWarnings& warnings, std::string_view kind,
+                 const std::string& where, const std::string& what, const char* meaning, const char* range) {
+  Rgb out = c;
+  for (int i = 0; i < 3; ++i) out[i] = c[i] < 0.0f ? 0.0f : c[i] >= at_or_above ? upper : c[i];
+  if (out != c)
+    warnings.forgive(kind, ErrorCode::invalid_scene, where,
+                     what + " " + describe(c) + " is " + meaning + " and must be " + range + " per channel",
+                     "clamped to " + describe(out));
+  return out;
+}
 
 std::shared_ptr<const Brdf> albedo_mixture(float a, float b,
                                            const std::function<std::shared_ptr<const Brdf>(float)>& build_first,
@@ -35,6 +53,11 @@ void set_dielectric(Material& m, Rgb transmittance, float ior, Rgb reflection_ti
         return std::shared_ptr<const Brdf>(make_dielectric(ior, glm::min(transmittance * scale, Rgb(1.0f)),
                                                            glm::min(reflection_tint * scale, Rgb(1.0f))));
       });
+}
+
+void set_transmission(Material& m, Rgb base, float transmission, float ior) {
+  m.reflectance = base * (1.0f - transmission);
+  set_dielectric(m, base * transmission, ior, Rgb(1.0f));
 }
 
 void set_metallic_roughness(Material& m, Rgb base, float metallic, float roughness, float ior) {

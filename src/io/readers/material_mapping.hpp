@@ -8,11 +8,24 @@
 
 #include <functional>
 #include <memory>
+#include <string>
+#include <string_view>
 
+#include "io/readers/reader_warnings.hpp"
 #include "radiosity/brdf.hpp"
 #include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
+
+/// "(r, g, b)", how the readers' messages show a colour.
+std::string describe(const Rgb& c);
+
+/// `c` with every channel below 0 raised to 0, and those at or above `at_or_above` set to
+/// `upper` (a diffuse colour of 1 is clamped to kMaxForgivenAlbedo, 0.995 kept). A change is
+/// forgiven (kind `kind`, at `where`) as "<what> (r, g, b) is <meaning> and must be <range>
+/// per channel; clamped to (r', g', b')": an Error{invalid_scene} under strict.
+Rgb clamp_colour(Rgb c, float upper, float at_or_above, ReaderWarnings& warnings, std::string_view kind,
+                 const std::string& where, const std::string& what, const char* meaning, const char* range);
 
 /// f = (1 - w) first + w second with the two parts' albedos `a` and `b` kept (w = b / (a + b));
 /// `build_first(scale)` and `build_second(scale)` make the parts with their coefficients
@@ -28,6 +41,12 @@ std::shared_ptr<const Brdf> albedo_mixture(float a, float b,
 /// m.ior and, for a tinted reflection, m.brdf (a mixture keeping the parts' albedos); no Phong
 /// lobe, which would double the reflection and darken the glass.
 void set_dielectric(Material& m, Rgb transmittance, float ior, Rgb reflection_tint);
+
+/// glTF's KHR_materials_transmission over a dielectric base of colour `base`: the fraction
+/// `transmission` (in (0, 1]) becomes a smooth dielectric of index `ior` whose refraction the
+/// base colour tints, the rest stays diffuse (reflectance base (1 - transmission)); the
+/// refracting MTL illum modes' model (set_dielectric()) with an untinted reflection.
+void set_transmission(Material& m, Rgb base, float transmission, float ior);
 
 /// The metallic-roughness model: base colour `base` (each channel in [0, 1)), `metallic` and
 /// `roughness` in [0, 1] (GGX alpha = roughness^2, at least 0.001: the usual perceptual

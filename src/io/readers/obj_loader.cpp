@@ -148,12 +148,6 @@ std::optional<float> parse_finite_float(std::string_view s) {
   return static_cast<float>(*v);
 }
 
-std::string describe(const Rgb& c) {
-  std::ostringstream s;
-  s << '(' << c.x << ", " << c.y << ", " << c.z << ')';
-  return s.str();
-}
-
 std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
 // ---------------------------------------------------------------------------------------------
@@ -256,17 +250,8 @@ float scalar(const MtlInfo& info, std::string_view key, float fallback) {
 /// with a warning (an Error under strict, worded as the range check it replaces).
 Rgb clamped(const MtlInfo& info, std::string_view key, Rgb c, float upper, float at_or_above, const char* meaning,
             const char* range, ReaderWarnings& warnings) {
-  Rgb out = c;
-  for (int i = 0; i < 3; ++i) out[i] = c[i] < 0.0f ? 0.0f : c[i] >= at_or_above ? upper : c[i];
-  if (out != c) {
-    std::ostringstream problem, action;
-    problem << info.what() << key << ' ' << describe(c) << " is " << meaning << " and must be " << range
-            << " per channel";
-    action << "clamped to " << describe(out);
-    warnings.forgive(std::string("MTL ") + std::string(key) + " out of range", ErrorCode::invalid_scene,
-                     info.where(key), problem.str(), action.str());
-  }
-  return out;
+  return clamp_colour(c, upper, at_or_above, warnings, "MTL " + std::string(key) + " out of range", info.where(key),
+                      info.what() + std::string(key), meaning, range);
 }
 
 /// Converts one MTL material as the format means it (docs/SCENE_OBJ.md has the table).
