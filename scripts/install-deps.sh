@@ -8,6 +8,7 @@ packages=(
   libglm-dev doctest-dev libopenexr-dev libembree-dev libtbb-dev
   libstb-dev nlohmann-json3-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev
+  libtinygltf-dev libassimp-dev
 )
 
 missing=()

@@ -100,18 +100,15 @@ MeshId Scene::add_mesh(const MeshDesc& desc, const LoadOptions& options) {
                                               " does not exist (scene has " + std::to_string(materials_.size()) +
                                               " materials)");
       const glm::vec3 &p0 = mesh.positions[corner[0]], &p1 = mesh.positions[corner[1]], &p2 = mesh.positions[corner[2]];
-      // add_polygon()'s test: area against the diameter squared.
-      const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
-      const float area = 0.5f * glm::length(n);
-      const float diameter = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
-      if (!(area > detail::kDegenerateAreaRatio * diameter * diameter)) {
+      const detail::TriangleShape shape = detail::triangle_shape(p0, p1, p2);
+      if (shape.degenerate) {
         degenerate.push_back(static_cast<std::uint32_t>(t));
         continue;
       }
       Polygon polygon;
       polygon.vertices = {p0, p1, p2};
-      polygon.normal = n / (2.0f * area);
-      polygon.area = area;
+      polygon.normal = shape.normal;
+      polygon.area = shape.area;
       polygon.material = material;
       polygon.group = mesh.group;
       polygon.mesh = id;

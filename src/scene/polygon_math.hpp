@@ -1,8 +1,10 @@
 // Polygon clean-up, planarity/convexity tests and triangulation used when a polygon enters a Scene.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 namespace radiosity::detail {
@@ -11,6 +13,25 @@ namespace radiosity::detail {
 inline constexpr float kDegenerateAreaRatio = 1e-7f;
 /// Vertices may leave the best-fit plane by this fraction of the diameter and still be planar.
 inline constexpr float kPlanarityTolerance = 1e-4f;
+
+/// A triangle's area and unit normal, and whether it is degenerate by add_polygon()'s test
+/// (area against the diameter squared). Scene::add_mesh() skips the degenerate ones; the file
+/// readers ask first, so that they can report them at their place in the file.
+struct TriangleShape {
+  glm::vec3 normal{0.0f};  ///< unit, right-hand rule of p0 p1 p2 (meaningless when degenerate)
+  float area = 0.0f;
+  bool degenerate = true;
+};
+
+inline TriangleShape triangle_shape(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
+  const glm::vec3 n = glm::cross(p1 - p0, p2 - p0);
+  TriangleShape t;
+  t.area = 0.5f * glm::length(n);
+  const float diameter = std::max({glm::length(p1 - p0), glm::length(p2 - p1), glm::length(p0 - p2)});
+  t.degenerate = !(t.area > kDegenerateAreaRatio * diameter * diameter);
+  if (!t.degenerate) t.normal = n / (2.0f * t.area);
+  return t;
+}
 
 struct CleanPolygon {
   std::vector<glm::vec3> vertices;  ///< duplicates and collinear vertices removed

@@ -286,10 +286,10 @@ TEST_CASE("a missing OBJ file or an unsupported extension is an error naming the
   CHECK(missing.code() == ErrorCode::file_not_found);
   CHECK(contains(missing.what(), "no_such_file.obj"));
 
-  Error ext = load_error(kData / "scene.gltf");
+  Error ext = load_error(kData / "scene.abc");
   CHECK(ext.code() == ErrorCode::invalid_argument);
-  CHECK(contains(ext.what(), "scene.gltf"));
-  CHECK(contains(ext.what(), "'.gltf'"));
+  CHECK(contains(ext.what(), "scene.abc"));
+  CHECK(contains(ext.what(), "'.abc'"));
 }
 
 TEST_CASE("a missing MTL file gives the default grey with a warning - an error naming the mtllib line under strict") {

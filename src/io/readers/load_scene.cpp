@@ -15,6 +15,7 @@ Scene load_scene(const std::filesystem::path& path, const LoadOptions& options) 
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".obj") return detail::load_obj(path, options);
   if (ext == ".json") return detail::load_scene_json(path, options);
+  if (ext == ".gltf" || ext == ".glb") return detail::load_gltf(path, options);
   if (ext.empty())
     throw Error(ErrorCode::invalid_argument,
                 "load_scene: '" + path.string() + "' has no file extension (supported: .obj, .json)");

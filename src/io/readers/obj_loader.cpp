@@ -25,6 +25,8 @@
 #include <system_error>
 #include <vector>
 
+#include "io/readers/material_mapping.hpp"
+#include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
 #include "io/readers/readers.hpp"
 #include "radiosity/brdf.hpp"
@@ -54,18 +56,8 @@ std::string at(const fs::path& file, std::size_t line) { return loc(file, line) 
 }
 
 std::string read_text(const fs::path& path, const char* what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw Error(ErrorCode::file_not_found,
-                std::string("load_scene: cannot open ") + what + " '" + path.string() +
-                    (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot open ") + what + " '" + path.string() + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot read ") + what + " '" + path.string() + "'");
+  std::string s = read_file(path, what);
   // A UTF-8 byte order mark would hide the first statement.
-  std::string s = text.str();
   if (s.compare(0, 3, "\xEF\xBB\xBF") == 0) s.erase(0, 3);
   return s;
 }
@@ -154,12 +146,6 @@ std::optional<float> parse_finite_float(std::string_view s) {
   std::optional<double> v = parse_real(s);
   if (!v || !std::isfinite(*v) || std::fabs(*v) > static_cast<double>(FLT_MAX)) return std::nullopt;
   return static_cast<float>(*v);
-}
-
-std::string describe(const Rgb& c) {
-  std::ostringstream s;
-  s << '(' << c.x << ", " << c.y << ", " << c.z << ')';
-  return s.str();
 }
 
 std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
@@ -264,29 +250,8 @@ float scalar(const MtlInfo& info, std::string_view key, float fallback) {
 /// with a warning (an Error under strict, worded as the range check it replaces).
 Rgb clamped(const MtlInfo& info, std::string_view key, Rgb c, float upper, float at_or_above, const char* meaning,
             const char* range, ReaderWarnings& warnings) {
-  Rgb out = c;
-  for (int i = 0; i < 3; ++i) out[i] = c[i] < 0.0f ? 0.0f : c[i] >= at_or_above ? upper : c[i];
-  if (out != c) {
-    std::ostringstream problem, action;
-    problem << info.what() << key << ' ' << describe(c) << " is " << meaning << " and must be " << range
-            << " per channel";
-    action << "clamped to " << describe(out);
-    warnings.forgive(std::string("MTL ") + std::string(key) + " out of range", ErrorCode::invalid_scene,
-                     info.where(key), problem.str(), action.str());
-  }
-  return out;
-}
-
-/// f = (1 - w) first + w second with the two parts' albedos `a` and `b` kept (w = max b /
-/// (max a + max b)); `build_first(scale)` and `build_second(scale)` make the parts with their
-/// coefficients multiplied by scale = 1 / weight. Used for the MTL models that make_brdf() has
-/// no field for (a tinted Fresnel reflection, a PBR coat).
-std::shared_ptr<const Brdf> mixture(float a, float b, const std::function<std::shared_ptr<const Brdf>(float)>& build_first,
-                                    const std::function<std::shared_ptr<const Brdf>(float)>& build_second) {
-  if (a <= 0.0f) return build_second(1.0f);
-  if (b <= 0.0f) return build_first(1.0f);
-  const float w = b / (a + b);
-  return make_mix(build_first(1.0f / (1.0f - w)), build_second(1.0f / w), w);
+  return clamp_colour(c, upper, at_or_above, warnings, "MTL " + std::string(key) + " out of range", info.where(key),
+                      info.what() + std::string(key), meaning, range);
 }
 
 /// Converts one MTL material as the format means it (docs/SCENE_OBJ.md has the table).
@@ -324,43 +289,16 @@ Material to_material(const MtlInfo& info, ReaderWarnings& warnings) {
     // A smooth dielectric: Fresnel's reflection (tinted by Ks when given) and refraction
     // (tinted by Tf, white when absent); no Phong lobe on top, which would double the
     // reflection and darken the glass.
-    m.transmittance = clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f, "a transmittance", "in [0, 1]", warnings);
-    m.ior = positive_ni().value_or(1.5f);
-    const Rgb tint = info.key("Ks") ? ks : Rgb(1.0f);
-    if (tint != Rgb(1.0f)) {
-      const float ior = m.ior;
-      const Rgb tf = m.transmittance;
-      m.brdf = mixture(
-          max_channel(kd), max_channel(glm::max(tf, tint)),
-          [&](float scale) { return std::shared_ptr<const Brdf>(make_lambertian(glm::min(kd * scale, Rgb(1.0f)))); },
-          [&](float scale) {
-            return std::shared_ptr<const Brdf>(
-                make_dielectric(ior, glm::min(tf * scale, Rgb(1.0f)), glm::min(tint * scale, Rgb(1.0f))));
-          });
-    }
+    const Rgb tf = clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f, "a transmittance", "in [0, 1]", warnings);
+    set_dielectric(m, tf, positive_ni().value_or(1.5f), info.key("Ks") ? ks : Rgb(1.0f));
     return m;
   }
 
   if (pbr) {
-    // The PBR extension: base colour Kd, metallic Pm, roughness Pr (GGX alpha = Pr^2, the
-    // usual perceptual mapping), dielectric F0 from Ni (1.5 when absent). The view pass gets a
-    // microfacet coat mixed with the diffuse base; radiosity sees the diffuse base.
-    const float metallic = std::clamp(scalar(info, "Pm", 0.0f), 0.0f, 1.0f);
-    const float roughness = std::clamp(scalar(info, "Pr", 0.5f), 0.0f, 1.0f);
-    const float n = positive_ni().value_or(1.5f);
-    const float f0_dielectric = ((n - 1.0f) / (n + 1.0f)) * ((n - 1.0f) / (n + 1.0f));
-    const Rgb f0 = glm::mix(Rgb(f0_dielectric), kd, metallic);
-    const float w = std::clamp(max_channel(f0), 1e-3f, 0.999f);
-    const Rgb base = glm::min(kd * (1.0f - metallic), Rgb((1.0f - w) * kMaxAlbedo));
-    const float alpha = std::max(roughness * roughness, 1e-3f);
-    m.reflectance = base;
-    // A mixture keeps each part's albedo when the coat is built with f0 / w at weight w; its
-    // rise towards grazing angles is then scaled by w too (an approximation of the layered
-    // model that the library has no BRDF for). A pure metal is the microfacet model itself.
-    if (max_channel(base) <= 0.0f)
-      m.brdf = make_microfacet(f0, alpha, alpha);
-    else
-      m.brdf = make_mix(make_lambertian(base / (1.0f - w)), make_microfacet(glm::min(f0 / w, Rgb(1.0f)), alpha, alpha), w);
+    // The PBR extension: base colour Kd, metallic Pm, roughness Pr, dielectric F0 from Ni
+    // (1.5 when absent); glTF's metallic-roughness model (material_mapping.hpp).
+    set_metallic_roughness(m, kd, std::clamp(scalar(info, "Pm", 0.0f), 0.0f, 1.0f),
+                           std::clamp(scalar(info, "Pr", 0.5f), 0.0f, 1.0f), positive_ni().value_or(1.5f));
     return m;
   }
 
@@ -402,13 +340,9 @@ Material to_material(const MtlInfo& info, ReaderWarnings& warnings) {
                      "clamped");
     opacity = clamped_opacity;
   }
-  if (opacity < 1.0f) {
-    m.reflectance *= opacity;
-    m.specular *= opacity;
-    m.transmittance = (1.0f - opacity) * clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f,
-                                                 "a transmittance", "in [0, 1]", warnings);
-    m.ior = 1.0f;
-  }
+  if (opacity < 1.0f)
+    set_thin_pane(m, opacity, clamped(info, "Tf", colour(info, "Tf", Rgb(1.0f)), 1.0f, 1.0f + 1e-6f,
+                                      "a transmittance", "in [0, 1]", warnings));
   return m;
 }
 

@@ -15,4 +15,7 @@ Scene load_obj(const std::filesystem::path& path, const LoadOptions& options);
 /// The JSON scene format of docs/SCENE_JSON.md (reads the file, then parse_scene_json()).
 Scene load_scene_json(const std::filesystem::path& path, const LoadOptions& options);
 
+/// glTF 2.0, .gltf (embedded or external buffers) or .glb (docs/SCENE_GLTF.md).
+Scene load_gltf(const std::filesystem::path& path, const LoadOptions& options);
+
 }  // namespace radiosity::detail

@@ -22,6 +22,7 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
 #include "io/readers/readers.hpp"
 #include "radiosity/brdf.hpp"
@@ -50,15 +51,6 @@ std::string rgb_text(const Rgb& c) {
 
 std::string key_path(const std::string& loc, const char* key) { return loc.empty() ? key : loc + "." + key; }
 std::string index_path(const std::string& loc, std::size_t i) { return loc + "[" + std::to_string(i) + "]"; }
-
-/// "line:column" (both 1-based) of the byte at 0-based offset `pos` of `text`.
-std::string line_column(std::string_view text, std::size_t pos) {
-  pos = std::min(pos, text.size());
-  std::size_t line = 1, line_start = 0;
-  for (std::size_t i = 0; i < pos; ++i)
-    if (text[i] == '\n') ++line, line_start = i + 1;
-  return std::to_string(line) + ":" + std::to_string(pos - line_start + 1);
-}
 
 /// A key that occurs twice in one object: nlohmann-json would keep the last silently, which
 /// hides a pasted-over value as surely as a typo.
@@ -697,15 +689,7 @@ Scene SceneReader::read(const json& root) {
 }  // namespace
 
 Scene load_scene_json(const fs::path& path, const LoadOptions& options) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw Error(ErrorCode::file_not_found, "load_scene: cannot open JSON scene '" + path.string() +
-                                               (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw Error(ErrorCode::file_not_found, "load_scene: cannot read JSON scene '" + path.string() + "'");
-  return parse_scene_json(text.str(), path.parent_path(), path.string(), options);
+  return parse_scene_json(read_file(path, "JSON scene"), path.parent_path(), path.string(), options);
 }
 
 }  // namespace detail

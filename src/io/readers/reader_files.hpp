@@ -1,0 +1,20 @@
+// What every scene reader does with its files: read one whole, with the same errors for a file
+// that is missing or unreadable, and turn a byte offset into the "line:column" of a message.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace radiosity::detail {
+
+/// The bytes of the file at `path`. Throws Error{file_not_found} "load_scene: cannot open
+/// <what> '<path>': no such file" (or ": not a regular file"), or "cannot read" when reading
+/// fails; `what` names the kind of file ("OBJ file", "glTF file").
+std::string read_file(const std::filesystem::path& path, const char* what);
+
+/// "line:column" (both 1-based) of the byte at 0-based offset `pos` of `text`.
+std::string line_column(std::string_view text, std::size_t pos);
+
+}  // namespace radiosity::detail
