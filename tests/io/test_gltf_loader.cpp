@@ -347,6 +347,53 @@ TEST_CASE("glTF cameras: the scene's first perspective camera is the scene camer
   check_error(path, ErrorCode::invalid_scene, {"nodes[2]: camera 1 'spare'"}, true);
 }
 
+TEST_CASE("glTF KHR_lights_punctual: point - spot and directional lights at their nodes - photometric - range and unknown types warn") {
+  test::GltfBuilder b;
+  b.doc["extensionsUsed"] = json::array({"KHR_lights_punctual"});
+  b.doc["extensions"] = {{"KHR_lights_punctual",
+                          {{"lights", json::array({{{"type", "point"}, {"name", "bulb"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 683.0}},
+                                                   {{"type", "spot"}, {"intensity", 10.0}, {"range", 5.0},
+                                                    {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.5}}}},
+                                                   {{"type", "directional"}, {"intensity", 3.0}},
+                                                   {{"type", "area"}, {"intensity", 1.0}}})}}}};
+  const float h = std::sqrt(0.5f);  // -90 degrees about X: -Z turns to -Y (down)
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}))}}),
+           b.node({{"translation", {1, 2, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}),
+           b.node({{"translation", {0, 4, 0}}, {"rotation", {-h, 0, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}}),
+           b.node({{"rotation", {-h, 0, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}}),
+           b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 3}}}}}})});
+  const fs::path path = write_gltf(b, "lights.gltf");
+  const radiosity::Scene s = load(path);
+  REQUIRE(s.lights().size() == 3);
+  const radiosity::Light& bulb = s.lights()[0];
+  CHECK(bulb.type == radiosity::LightType::point);
+  CHECK(bulb.name == "bulb");
+  CHECK(near(bulb.position, {1, 2, 3}));
+  CHECK(near(bulb.color, {1.0f, 0.5f, 0.25f}));
+  CHECK(bulb.intensity == doctest::Approx(683.0));  // radiometric: W/sr as written
+  const radiosity::Light& spot = s.lights()[1];
+  CHECK(spot.type == radiosity::LightType::spot);
+  CHECK(near(spot.direction, {0, -1, 0}));
+  CHECK(spot.inner_cone_deg == doctest::Approx(0.1 * 180.0 / 3.14159265358979));
+  CHECK(spot.outer_cone_deg == doctest::Approx(0.5 * 180.0 / 3.14159265358979));
+  CHECK(s.lights()[2].type == radiosity::LightType::directional);
+  CHECK(near(s.lights()[2].direction, {0, -1, 0}));
+  REQUIRE(s.warnings().size() == 2);
+  CHECK(contains(s.warnings()[0], "extensions.KHR_lights_punctual.lights[1]: range 5"));
+  CHECK(contains(s.warnings()[1], "lights[3]: type 'area' is not point, spot or directional; skipped"));
+  check_error(path, ErrorCode::invalid_scene, {"lights[1]: range"}, true);
+
+  // Photometric: candela and lux at 683 lm/W.
+  radiosity::LoadOptions photometric;
+  photometric.photometric = true;
+  const radiosity::Scene p = radiosity::load_scene(path, photometric);
+  CHECK(p.lights()[0].intensity == doctest::Approx(1.0));
+
+  // A light index out of range names the node.
+  b.doc["nodes"][1]["extensions"]["KHR_lights_punctual"]["light"] = 9;
+  check_error(write_gltf(b, "lights_bad.gltf"), ErrorCode::parse_error, {"nodes[1].extensions.KHR_lights_punctual.light", "not an index"});
+}
+
 TEST_CASE("glTF furnace: a closed inward box of emission E and reflectance rho solves to B = E/(1-rho) within 0.5 %") {
   test::GltfBuilder b;
   const Rgb base(0.5f, 0.6f, 0.3f), emissive(0.2f, 0.4f, 0.1f);

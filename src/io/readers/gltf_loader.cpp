@@ -4,7 +4,8 @@
 // hierarchy and its transforms (3.5), primitive modes and winding (3.7.2.1), cameras (3.10) and
 // the metallic-roughness material (3.9), with the Khronos extensions
 // KHR_materials_emissive_strength, KHR_materials_transmission, KHR_materials_ior and
-// KHR_mesh_quantization. docs/SCENE_GLTF.md has the mapping.
+// KHR_mesh_quantization, and KHR_lights_punctual (docs/LIGHTS.md). docs/SCENE_GLTF.md has the
+// mapping.
 //
 // tinygltf (Debian's shared libtinygltf) parses the JSON and decodes the buffers. It leaves most
 // ranges to its caller (a bufferView that reaches beyond its buffer, an accessor beyond its
@@ -553,6 +554,7 @@ class GltfReader {
             src_.fail(ErrorCode::invalid_scene, place, "its world transform (the product of its ancestors') is not finite");
       if (node.mesh >= 0) add_node_mesh(n, node, world);
       if (node.camera >= 0) add_camera(n, node, world);
+      add_node_light(n, node, world);
       for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, world);
     }
     if (scene_.polygons().empty())
@@ -864,6 +866,58 @@ class GltfReader {
     if (add_placed_mesh(scene_, warnings_, std::move(local), world, id, group,
                         src_.where(place + " (placed by " + node_place + ")"), options_) > 0)
       skipped_triangles_ = true;
+  }
+
+  // --- lights (KHR_lights_punctual) -----------------------------------------------------------
+
+  /// The light a node carries (its extension's "light" index into the root's lights): point,
+  /// spot and directional map onto Light (docs/LIGHTS.md) at the node's world position, shining
+  /// down its world -Z; intensities as written (W/sr, W/m^2) or, under LoadOptions::photometric,
+  /// candela and lux / 683. `range` (a cut-off the library does not have) is ignored with a
+  /// warning, an unknown type is skipped with one.
+  void add_node_light(int n, const tinygltf::Node& node, const glm::dmat4& world) {
+    const auto ext = node.extensions.find("KHR_lights_punctual");
+    if (ext == node.extensions.end()) return;
+    const std::string place = "nodes[" + std::to_string(n) + "].extensions.KHR_lights_punctual";
+    if (!ext->second.IsObject() || !ext->second.Has("light") || !ext->second.Get("light").IsNumber())
+      src_.fail(ErrorCode::parse_error, place, "has no light index (\"light\": an integer)");
+    const double index = ext->second.Get("light").GetNumberAsDouble();
+    if (!(index >= 0.0 && index < static_cast<double>(model_.lights.size()) && index == std::floor(index)))
+      src_.fail(ErrorCode::parse_error, place + ".light",
+                std::to_string(index) + " is not an index into the " + std::to_string(model_.lights.size()) +
+                    " lights of extensions.KHR_lights_punctual.lights");
+    const auto k = static_cast<std::size_t>(index);
+    const tinygltf::Light& in = model_.lights[k];
+    const std::string where = "extensions.KHR_lights_punctual.lights[" + std::to_string(k) + "]";
+    Light light;
+    if (in.type == "point") {
+      light.type = LightType::point;
+    } else if (in.type == "spot") {
+      light.type = LightType::spot;
+      light.inner_cone_deg = static_cast<float>(glm::degrees(in.spot.innerConeAngle));
+      light.outer_cone_deg = static_cast<float>(glm::degrees(in.spot.outerConeAngle));
+    } else if (in.type == "directional") {
+      light.type = LightType::directional;
+    } else {
+      warnings_.forgive("unknown light type", ErrorCode::parse_error, src_.where(where),
+                        "type " + in_quotes(in.type) + " is not point, spot or directional", "skipped");
+      return;
+    }
+    if (in.range > 0.0)
+      warnings_.forgive("light range", ErrorCode::invalid_scene, src_.where(where),
+                        "range " + std::to_string(in.range) + " is not supported (lights reach everything)", "ignored");
+    light.name = in.name.empty() ? "light " + std::to_string(k) : in.name;
+    if (in.color.size() == 3)
+      light.color = Rgb(static_cast<float>(in.color[0]), static_cast<float>(in.color[1]), static_cast<float>(in.color[2]));
+    light.intensity = static_cast<float>(in.intensity);
+    if (options_.photometric) light.intensity = photometric_to_radiometric(light.intensity);
+    light.position = glm::vec3(glm::dvec3(world[3]));
+    light.direction = glm::vec3(glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0));
+    try {
+      scene_.add_light(light);
+    } catch (const Error& e) {
+      src_.fail(e.code(), where, std::string("(on ") + place + "): " + e.what());
+    }
   }
 
   // --- cameras --------------------------------------------------------------------------------
