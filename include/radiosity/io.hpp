@@ -13,7 +13,8 @@
 namespace radiosity {
 inline namespace v1 {
 
-/// Loads a scene, choosing the reader by extension (.obj with its .mtl files, .json).
+/// Loads a scene, choosing the reader by extension: .obj with its .mtl files, .json, .gltf and
+/// .glb, and the formats of Assimp.
 /// OBJ: `o`/`g` names become groups, `Kd` the diffuse reflectance, `Ke` emitted radiance (so
 /// E = pi * Ke); without materials everything is grey 0.5. MTL `illum` modes map as the format
 /// means them (docs/SCENE_OBJ.md has the table): 0/1 diffuse; 2 (or none, with Ks) Phong from
@@ -27,6 +28,19 @@ inline namespace v1 {
 /// an Error under `options.strict`): see LoadOptions. Warnings start with "file:line: ".
 /// JSON (.json): the scene format of docs/SCENE_JSON.md (materials with any model of brdf.hpp,
 /// polygons, quads, boxes, spheres, OBJ includes, a camera); see parse_scene_json().
+/// glTF 2.0 (.gltf with embedded or external buffers, .glb; docs/SCENE_GLTF.md): each mesh
+/// primitive placed by its node's world matrix becomes one Scene mesh (Scene::add_mesh(),
+/// TEXCOORD_0/1 as uv0/uv1), grouped by node name (else mesh name, else "mesh<N>"); the first
+/// perspective camera of the default scene becomes the scene's; materials map physically:
+/// baseColorFactor (times the mean of its texture) the diffuse reflectance, emissiveFactor x
+/// KHR_materials_emissive_strength the emitted radiance (E = pi L), metallic-roughness the
+/// GGX model of the view pass, KHR_materials_transmission (with KHR_materials_ior) a
+/// dielectric, doubleSided Material::two_sided. Errors name the file and the place in the
+/// document ("scene.glb: meshes[2].primitives[0]: accessor 7 (POSITION): ..."): Error{parse_error}
+/// for a broken container, JSON, reference, accessor or index, NaN values, an unsupported
+/// required extension (Draco, meshopt); Error{file_not_found} for a missing external buffer.
+/// Every other extension Assimp reads (FBX, COLLADA, 3DS, PLY, STL, ...): its scene graph and
+/// materials read the same way, where the format carries them.
 /// Throws Error{invalid_argument} for an unsupported extension, and only radiosity::Error (or
 /// std::bad_alloc) whatever the file holds.
 /// Thread safety: may be called concurrently.

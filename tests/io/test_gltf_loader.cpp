@@ -127,7 +127,10 @@ test::GltfBuilder make_room() {
   auto wall = [&](const char* name, glm::vec3 a, glm::vec3 c, glm::vec3 d, glm::vec3 e, int m) {
     roots.push_back(b.node({{"name", name}, {"mesh", b.mesh(b.quad(a, c, d, e, m), name)}}));
   };
-  wall("floor", {0, 0, 0}, {0, 0, D}, {W, 0, D}, {W, 0, 0}, white);
+  // The floor has lightmap coordinates (TEXCOORD_1) of its own, the rest get them made.
+  json floor = b.quad({0, 0, 0}, {0, 0, D}, {W, 0, D}, {W, 0, 0}, white);
+  floor["attributes"]["TEXCOORD_1"] = b.vec2s({{0.05f, 0.05f}, {0.05f, 0.95f}, {0.95f, 0.95f}, {0.95f, 0.05f}});
+  roots.push_back(b.node({{"name", "floor"}, {"mesh", b.mesh(floor, "floor")}}));
   wall("ceiling", {0, H, 0}, {W, H, 0}, {W, H, D}, {0, H, D}, white);
   wall("back_wall", {0, 0, 0}, {W, 0, 0}, {W, H, 0}, {0, H, 0}, white);
   wall("red_wall", {0, 0, 0}, {0, H, 0}, {0, H, D}, {0, 0, D}, red);
@@ -520,6 +523,10 @@ TEST_CASE("glTF the checked-in room is what the generator makes and reads as a C
   CHECK(near(group_polygons(s, "red_wall")[0].normal, {1, 0, 0}));
   CHECK(s.has_camera());
   CHECK(near(s.camera().eye, {2, 1.5f, 9}));
+  REQUIRE(s.meshes()[0].uv1.size() == 4);
+  CHECK(s.meshes()[0].uv1[2] == glm::vec2(0.95f, 0.95f));
+  CHECK(s.meshes()[0].uv0.empty());
+  CHECK(s.meshes()[1].uv1.empty());
   check_error(broken, ErrorCode::parse_error, {"truncated GLB: its header gives " + std::to_string(glb_bytes.size()) + " bytes"});
 }
 

@@ -339,10 +339,11 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
 
 /// Help text for the SCENE argument of every command.
 constexpr const char* kSceneHelp =
-    "OBJ or JSON scene file, or a built-in scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
+    "Scene file (OBJ, JSON, glTF .gltf/.glb, or a format Assimp reads: FBX, COLLADA, 3DS, PLY, STL, ...), or a built-in "
+    "scene: cornell (the default; also cornell-box), cornell-specular (mirror tall "
     "block, glass short block), cornell-mirror, cornell-glass";
 
-/// A built-in scene by name, else the OBJ or JSON file at `path`, read strictly when `strict`
+/// A built-in scene by name, else the scene file at `path` (load_scene()), read strictly when `strict`
 /// (LoadOptions::strict: what the readers would fix with a warning is an error; built-in scenes
 /// have nothing to fix), its light intensities photometric when `photometric`
 /// (LoadOptions::photometric).

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 
 #include "radiosity/io.hpp"
 #include "radiosity/scene.hpp"
@@ -17,5 +18,15 @@ Scene load_scene_json(const std::filesystem::path& path, const LoadOptions& opti
 
 /// glTF 2.0, .gltf (embedded or external buffers) or .glb (docs/SCENE_GLTF.md).
 Scene load_gltf(const std::filesystem::path& path, const LoadOptions& options);
+
+/// Every other format Assimp reads (FBX, COLLADA, 3DS, PLY, STL, ...; docs/SCENE_GLTF.md).
+Scene load_assimp(const std::filesystem::path& path, const LoadOptions& options);
+
+/// Whether Assimp reads files of `extension` (".fbx", lower case, with the dot).
+bool assimp_reads(const std::string& extension);
+
+/// The extensions load_assimp() reads, space-separated (".3ds .dae .fbx ..."), without those
+/// that have a reader of their own.
+std::string assimp_extensions();
 
 }  // namespace radiosity::detail

@@ -1,0 +1,464 @@
+// Every other scene format through Assimp, the Open Asset Import Library (Debian's libassimp
+// 5.2: FBX, COLLADA, 3DS, PLY, STL, OFF, Blender and more; the formats with a reader of their own
+// here, OBJ, glTF and JSON, never go to it). Its scene graph is read as glTF's is (nodes place
+// meshes by their world matrices, groups are node names) and its materials through the mapping
+// glTF's reader uses (material_mapping.hpp), with the keys each format fills (Assimp's
+// "Material System" documentation: $clr.base or $clr.diffuse, $clr.emissive with
+// $mat.emissiveIntensity, $mat.twosided, $mat.opacity, $mat.transmission.factor, $mat.refracti,
+// $mat.metallicFactor and $mat.roughnessFactor). docs/SCENE_GLTF.md has the table.
+//
+// Assimp is asked to parse and validate only (aiProcess_ValidateDataStructure); the reader then
+// checks what the validation leaves through (empty faces, NaN positions) before triangulating,
+// because Debian's build asserts, and aborts, in its Triangulate step on the empty faces of a
+// truncated PLY. The files known to make Assimp 5.2 loop forever or write out of bounds (a PLY
+// whose header never ends, a COLLADA index list with a stray character or an array longer than
+// its count) are refused before Assimp opens them. Other
+// corruptions of formats read by Assimp are in its hands: its parsers are not hardened the way
+// the glTF reader is.
+#include <assimp/Importer.hpp>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/constants.hpp"
+#include "io/readers/material_mapping.hpp"
+#include "io/readers/placed_mesh.hpp"
+#include "io/readers/reader_files.hpp"
+#include "io/readers/reader_warnings.hpp"
+#include "io/readers/readers.hpp"
+#include "io/readers/texture_mean.hpp"
+
+namespace radiosity::detail {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::string in_quotes(const std::string& s) { return "'" + s + "'"; }
+
+/// Assimp 5.2's PLY reader loops forever when the header ends before its end_header line (a
+/// truncated file), so the header is looked at first: "end_header" on a line of its own, within
+/// the first MiB.
+void check_ply_header(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(std::size_t{1} << 20, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  for (std::size_t at = head.find("end_header"); at != std::string::npos; at = head.find("end_header", at + 1)) {
+    const bool line_start = at > 0 && (head[at - 1] == '\n' || head[at - 1] == '\r');
+    const std::size_t end = at + 10;
+    if (line_start && end < head.size() && (head[end] == '\n' || head[end] == '\r' || head[end] == ' ')) return;
+  }
+  throw Error(ErrorCode::parse_error, path.string() + ": the PLY header has no end_header line (a truncated file?)");
+}
+
+/// What Assimp 5.2's COLLADA reader trusts and should not: an index list (<p>) that holds
+/// anything but numbers makes it loop forever, an array (<float_array count="N">) holding more
+/// values than its count makes it write beyond what it allocated. Such corruptions are refused
+/// here first, with their line.
+void check_collada(const fs::path& path) {
+  const std::string text = read_file(path, "COLLADA file");
+  auto fail = [&](std::size_t at, const std::string& problem) {
+    throw Error(ErrorCode::parse_error, path.string() + ":" + line_column(text, at) + ": " + problem);
+  };
+  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  for (std::size_t at = text.find("<p>"); at != std::string::npos; at = text.find("<p>", at + 3)) {
+    const std::size_t end = std::min(text.find('<', at + 3), text.size());
+    for (std::size_t i = at + 3; i < end; ++i)
+      if (!((text[i] >= '0' && text[i] <= '9') || blank(text[i]) || text[i] == '-' || text[i] == '+'))
+        fail(i, "an index list (<p>) holds a character that is not part of a number");
+  }
+  for (const char* tag : {"<float_array", "<int_array"}) {
+    for (std::size_t at = text.find(tag); at != std::string::npos; at = text.find(tag, at + 1)) {
+      const std::size_t open_end = text.find('>', at);
+      if (open_end == std::string::npos) break;
+      if (text[open_end - 1] == '/') continue;  // empty
+      const std::size_t count_at = text.find(" count=\"", at);
+      if (count_at == std::string::npos || count_at > open_end) fail(at, std::string(tag + 1) + " has no count");
+      std::size_t count = 0, i = count_at + 8;
+      for (; i < open_end && text[i] >= '0' && text[i] <= '9'; ++i) count = std::min(count * 10 + std::size_t(text[i] - '0'), std::size_t{1} << 40);
+      if (i == count_at + 8 || text[i] != '"') fail(count_at, std::string(tag + 1) + "'s count is not a number");
+      const std::size_t end = std::min(text.find('<', open_end), text.size());
+      std::size_t values = 0;
+      for (std::size_t k = open_end + 1; k < end; ++k)
+        if (!blank(text[k]) && blank(text[k - 1] == '>' ? ' ' : text[k - 1])) ++values;
+      if (values > count)
+        fail(at, std::string(tag + 1) + " holds " + std::to_string(values) + " values, more than its count " + std::to_string(count));
+    }
+  }
+}
+
+glm::dmat4 to_glm(const aiMatrix4x4& m) {
+  // Assimp's matrices are row-major (a1..a4 the first row), GLM's column-major.
+  const ai_real* r = &m.a1;
+  glm::dmat4 out;
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) out[col][row] = static_cast<double>(r[4 * row + col]);
+  return out;
+}
+
+bool finite(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+class AssimpReader {
+ public:
+  AssimpReader(const fs::path& path, const aiScene& scene, const LoadOptions& options)
+      : path_(path), name_(path.string()), ai_(scene), options_(options), warnings_(options.strict),
+        ply_(lower_extension(path) == ".ply") {}
+
+  /// What validation does not check, before anything else runs on the scene.
+  void check() const {
+    if (!ai_.mRootNode) fail(ErrorCode::parse_error, "", "has no scene graph (no root node)");
+    for (unsigned m = 0; m < ai_.mNumMeshes; ++m) {
+      const aiMesh* mesh = ai_.mMeshes[m];
+      const std::string place = mesh_place(m);
+      if (!mesh || !mesh->HasPositions()) continue;
+      for (unsigned v = 0; v < mesh->mNumVertices; ++v)
+        if (!finite(mesh->mVertices[v]))
+          fail(ErrorCode::parse_error, place, "vertex " + std::to_string(v) + " is NaN or infinite");
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const aiFace& face = mesh->mFaces[f];
+        if (face.mNumIndices == 0 || !face.mIndices)
+          fail(ErrorCode::parse_error, place, "face " + std::to_string(f) + " has no vertices (a truncated file?)");
+        for (unsigned k = 0; k < face.mNumIndices; ++k)
+          if (face.mIndices[k] >= mesh->mNumVertices)
+            fail(ErrorCode::parse_error, place, "face " + std::to_string(f) + ": vertex " + std::to_string(face.mIndices[k]) +
+                                                    " is out of range (" + std::to_string(mesh->mNumVertices) + " vertices)");
+      }
+    }
+  }
+
+  Scene read() {
+    // Depth first from the root, each node with its parent's world matrix.
+    std::vector<std::pair<const aiNode*, glm::dmat4>> stack = {{ai_.mRootNode, glm::dmat4(1.0)}};
+    std::size_t visited = 0;
+    while (!stack.empty()) {
+      const auto [node, parent] = stack.back();
+      stack.pop_back();
+      // Assimp builds a tree; a count beyond its nodes would be a cycle.
+      if (++visited > (std::size_t{1} << 24)) fail(ErrorCode::parse_error, "", "its node hierarchy does not end");
+      const glm::dmat4 world = parent * to_glm(node->mTransformation);
+      const std::string node_name = node->mName.C_Str();
+      for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+        const unsigned m = node->mMeshes[k];
+        if (m >= ai_.mNumMeshes || !ai_.mMeshes[m]) continue;  // validation refuses these
+        add_mesh(m, node_name, world);
+      }
+      for (unsigned c = node->mNumChildren; c-- > 0;)
+        if (node->mChildren[c]) stack.emplace_back(node->mChildren[c], world);
+    }
+    add_camera();
+    if (scene_.polygons().empty())
+      fail(ErrorCode::parse_error, "",
+           skipped_ ? "has no triangles that are not degenerate" : "has no triangles (no node places a mesh of faces)");
+    warnings_.move_to(scene_);
+    return std::move(scene_);
+  }
+
+ private:
+  [[noreturn]] void fail(ErrorCode code, const std::string& place, const std::string& problem) const {
+    throw Error(code, name_ + ": " + (place.empty() ? "" : place + ": ") + problem);
+  }
+  std::string where(const std::string& place) const { return name_ + ": " + place; }
+
+  std::string mesh_place(unsigned m) const {
+    const aiMesh* mesh = ai_.mMeshes[m];
+    const std::string name = mesh ? mesh->mName.C_Str() : "";
+    return "meshes[" + std::to_string(m) + "]" + (name.empty() ? "" : " " + in_quotes(name));
+  }
+
+  void add_mesh(unsigned m, const std::string& node_name, const glm::dmat4& world) {
+    const aiMesh& mesh = *ai_.mMeshes[m];
+    const std::string mesh_name = mesh.mName.C_Str();
+    // Assimp names the root node after the file format ("<STL_ASCII>") or leaves it empty.
+    const bool made_up = node_name.empty() || node_name.front() == '<';
+    const std::string group = !made_up ? node_name : !mesh_name.empty() ? mesh_name : "mesh" + std::to_string(m);
+    const std::string place = mesh_place(m) + (node_name.empty() ? "" : " (placed by node " + in_quotes(node_name) + ")");
+
+    LocalMesh local;
+    local.positions.resize(mesh.mNumVertices);
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v)
+      local.positions[v] = glm::vec3(mesh.mVertices[v].x, mesh.mVertices[v].y, mesh.mVertices[v].z);
+    if (mesh.HasNormals()) {
+      local.normals.resize(mesh.mNumVertices);
+      for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+        const aiVector3D& n = mesh.mNormals[v];
+        local.normals[v] = finite(n) ? glm::vec3(n.x, n.y, n.z) : glm::vec3(0.0f);
+      }
+    }
+    auto uv = [&](unsigned set, std::vector<glm::vec2>& out) {
+      if (!mesh.HasTextureCoords(set)) return;
+      out.resize(mesh.mNumVertices);
+      for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+        const aiVector3D& t = mesh.mTextureCoords[set][v];
+        out[v] = finite(t) ? glm::vec2(t.x, t.y) : glm::vec2(0.0f);
+      }
+    };
+    uv(0, local.uv0);
+    uv(1, local.uv1);
+    std::size_t no_area = 0;
+    local.indices.reserve(3 * std::size_t{mesh.mNumFaces});
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) {
+        ++no_area;  // points and lines (Triangulate left no polygons)
+        continue;
+      }
+      local.indices.insert(local.indices.end(), {face.mIndices[0], face.mIndices[1], face.mIndices[2]});
+    }
+    if (no_area > 0)
+      warnings_.forgive("points or lines", ErrorCode::parse_error, where(place),
+                        std::to_string(no_area) + " point or line face" + (no_area > 1 ? "s have" : " has") + " no area",
+                        "skipped");
+    if (local.indices.empty()) return;
+    if (add_placed_mesh(scene_, warnings_, std::move(local), world, material(mesh.mMaterialIndex), group, where(place),
+                        options_) > 0)
+      skipped_ = true;
+  }
+
+  /// The first camera placed by a node becomes the scene's: Assimp gives its position, viewing
+  /// direction and up in its node's coordinates, and the horizontal field of view, which its
+  /// importers (COLLADA, FBX, 3DS) fill with the full angle though its documentation says half.
+  void add_camera() {
+    bool set = false;
+    for (unsigned i = 0; i < ai_.mNumCameras; ++i) {
+      const aiCamera* camera = ai_.mCameras[i];
+      if (!camera) continue;
+      const aiNode* node = ai_.mRootNode->FindNode(camera->mName);
+      const std::string place = "cameras[" + std::to_string(i) + "] " + in_quotes(camera->mName.C_Str());
+      if (!node) continue;  // not in the scene
+      if (set) {
+        warnings_.forgive("more cameras", ErrorCode::invalid_scene, where(place), "only the scene's first camera is used",
+                          "ignored");
+        continue;
+      }
+      glm::dmat4 world(1.0);
+      for (const aiNode* n = node; n; n = n->mParent) world = to_glm(n->mTransformation) * world;
+      const glm::dmat3 linear(world);
+      const glm::dvec3 eye(world * glm::dvec4(camera->mPosition.x, camera->mPosition.y, camera->mPosition.z, 1.0));
+      const glm::dvec3 forward = glm::normalize(linear * glm::dvec3(camera->mLookAt.x, camera->mLookAt.y, camera->mLookAt.z));
+      const glm::dvec3 up = glm::normalize(linear * glm::dvec3(camera->mUp.x, camera->mUp.y, camera->mUp.z));
+      const double horizontal = camera->mHorizontalFOV, aspect = camera->mAspect;
+      const double vertical = aspect > 0.0 ? 2.0 * std::atan(std::tan(horizontal / 2.0) / aspect) : horizontal;
+      Camera c;
+      c.eye = glm::vec3(eye);
+      c.look_at = glm::vec3(eye + forward);
+      c.up = glm::vec3(up);
+      c.fov_deg = static_cast<float>(glm::degrees(vertical));
+      try {
+        scene_.set_camera(c);
+      } catch (const Error& e) {
+        fail(e.code(), place, e.what());
+      }
+      set = true;
+    }
+  }
+
+  /// A texture's mean (decoded from sRGB), or nullopt with a warning when it cannot be read.
+  std::optional<Rgb> texture_mean(const aiMaterial& m, const std::string& place) {
+    aiString file;
+    if (m.GetTexture(aiTextureType_BASE_COLOR, 0, &file) != AI_SUCCESS &&
+        m.GetTexture(aiTextureType_DIFFUSE, 0, &file) != AI_SUCCESS)
+      return std::nullopt;
+    const std::string name = file.C_Str();
+    if (auto it = textures_.find(name); it != textures_.end()) {
+      if (!it->second.first)
+        warnings_.forgive("unreadable texture", ErrorCode::file_not_found, where(place), it->second.second,
+                          "its colour alone is used");
+      return it->second.first;
+    }
+    std::optional<Rgb> mean;
+    std::string why;
+    if (const aiTexture* embedded = ai_.GetEmbeddedTexture(file.C_Str())) {
+      if (embedded->mHeight == 0) {
+        mean = mean_of_encoded_image(reinterpret_cast<const unsigned char*>(embedded->pcData), embedded->mWidth, true, why);
+      } else {
+        // Uncompressed texels, stored b g r a.
+        const std::size_t count = std::size_t{embedded->mWidth} * embedded->mHeight;
+        std::vector<std::uint8_t> rgba(4 * count);
+        for (std::size_t i = 0; i < count; ++i) {
+          const aiTexel& t = embedded->pcData[i];
+          rgba[4 * i] = t.r, rgba[4 * i + 1] = t.g, rgba[4 * i + 2] = t.b, rgba[4 * i + 3] = t.a;
+        }
+        mean = mean_of_rgba8(rgba.data(), count, true);
+      }
+    } else {
+      std::string relative = name;
+      std::replace(relative.begin(), relative.end(), '\\', '/');  // paths written on Windows
+      const fs::path image = path_.parent_path() / fs::u8path(relative);
+      try {
+        const std::string bytes = read_file(image, "texture");
+        mean = mean_of_encoded_image(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), true, why);
+      } catch (const Error&) {
+        why = "its file was not found or could not be read (looked for '" + image.string() + "')";
+      }
+    }
+    if (!mean) why = "texture " + in_quotes(name) + ": " + why;
+    textures_[name] = {mean, why};
+    if (!mean)
+      warnings_.forgive("unreadable texture", ErrorCode::file_not_found, where(place), why, "its colour alone is used");
+    return mean;
+  }
+
+  /// Scene material of Assimp material `index`, made once.
+  MaterialId material(unsigned index) {
+    if (auto it = materials_.find(index); it != materials_.end()) return it->second;
+    const aiMaterial* a = index < ai_.mNumMaterials ? ai_.mMaterials[index] : nullptr;
+    aiString ai_name;
+    if (a) a->Get(AI_MATKEY_NAME, ai_name);
+    const std::string name = ai_name.C_Str();
+    // Assimp's stand-in where the file has no material: "DefaultMaterial" (STL, meshes without
+    // one), and the unnamed white one its PLY reader makes. Ours is the readers' grey.
+    Material m;
+    if (!a || name == AI_DEFAULT_MATERIAL_NAME || (ply_ && name.empty())) {
+      m.name = "default";
+    } else {
+      m = to_material(*a, index, name);
+    }
+    MaterialId id;
+    try {
+      id = scene_.add_material(m);
+    } catch (const Error& e) {
+      fail(e.code(), "materials[" + std::to_string(index) + "]", e.what());
+    }
+    materials_.emplace(index, id);
+    return id;
+  }
+
+  Material to_material(const aiMaterial& a, unsigned index, const std::string& name) {
+    const std::string place = "materials[" + std::to_string(index) + "]" + (name.empty() ? "" : " " + in_quotes(name));
+    auto colour = [&](const char* key, unsigned type, unsigned idx) -> std::optional<Rgb> {
+      aiColor4D c;
+      if (a.Get(key, type, idx, c) != AI_SUCCESS) return std::nullopt;
+      return Rgb(c.r, c.g, c.b);
+    };
+    auto number = [&](const char* key, unsigned type, unsigned idx) -> std::optional<float> {
+      ai_real v;
+      if (a.Get(key, type, idx, v) != AI_SUCCESS || !std::isfinite(v)) return std::nullopt;
+      return static_cast<float>(v);
+    };
+    Material m;
+    m.name = name.empty() ? "material" + std::to_string(index) : name;
+
+    // Base colour (PBR formats) or diffuse colour, times the mean of its texture.
+    std::optional<Rgb> base = colour(AI_MATKEY_BASE_COLOR);
+    if (!base) base = colour(AI_MATKEY_COLOR_DIFFUSE);
+    Rgb rho = base.value_or(Rgb(0.5f));
+    std::string what = "diffuse colour";
+    if (const std::optional<Rgb> mean = texture_mean(a, place)) {
+      rho *= *mean;
+      what = "diffuse colour (times the mean of its texture)";
+    }
+    if (!std::isfinite(rho.x) || !std::isfinite(rho.y) || !std::isfinite(rho.z))
+      fail(ErrorCode::parse_error, place, what + " is NaN or infinite");
+    rho = clamp_colour(rho, kMaxForgivenAlbedo, 1.0f, warnings_, "material colour out of range", where(place), what,
+                       "a diffuse reflectance (1 or more would create energy)", "in [0, 1)");
+
+    // Emission: a radiance, as glTF's and MTL's (E = pi L).
+    Rgb emissive = colour(AI_MATKEY_COLOR_EMISSIVE).value_or(Rgb(0.0f));
+    emissive *= number(AI_MATKEY_EMISSIVE_INTENSITY).value_or(1.0f);
+    if (!std::isfinite(emissive.x) || !std::isfinite(emissive.y) || !std::isfinite(emissive.z))
+      fail(ErrorCode::parse_error, place, "emissive colour is NaN or infinite");
+    emissive = clamp_colour(emissive, FLT_MAX, FLT_MAX, warnings_, "material colour out of range", where(place),
+                            "emissive colour", "an emitted radiance", ">= 0");
+    m.emission = kPi * emissive;
+
+    int two_sided = 0;
+    if (a.Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) m.two_sided = two_sided != 0;
+
+    float ior = number(AI_MATKEY_REFRACTI).value_or(1.5f);
+    if (!(ior > 0.0f)) ior = 1.5f;
+    const float transmission = std::clamp(number(AI_MATKEY_TRANSMISSION_FACTOR).value_or(0.0f), 0.0f, 1.0f);
+    const std::optional<float> metallic = number(AI_MATKEY_METALLIC_FACTOR), roughness = number(AI_MATKEY_ROUGHNESS_FACTOR);
+    if (transmission > 0.0f) {
+      set_transmission(m, rho, transmission, ior);
+    } else if (metallic || roughness) {
+      set_metallic_roughness(m, rho, std::clamp(metallic.value_or(0.0f), 0.0f, 1.0f),
+                             std::clamp(roughness.value_or(0.5f), 0.0f, 1.0f), ior);
+    } else {
+      m.reflectance = rho;
+      const float opacity = number(AI_MATKEY_OPACITY).value_or(1.0f);
+      if (opacity < 0.0f || opacity > 1.0f)
+        warnings_.forgive("material opacity out of range", ErrorCode::invalid_scene, where(place),
+                          "opacity " + std::to_string(opacity) + " must be in [0, 1]", "clamped");
+      if (std::clamp(opacity, 0.0f, 1.0f) < 1.0f) set_thin_pane(m, std::clamp(opacity, 0.0f, 1.0f), Rgb(1.0f));
+    }
+    return m;
+  }
+
+  fs::path path_;
+  std::string name_;
+  const aiScene& ai_;
+  const LoadOptions& options_;
+  ReaderWarnings warnings_;
+  bool ply_;
+  Scene scene_;
+  std::map<unsigned, MaterialId> materials_;
+  std::map<std::string, std::pair<std::optional<Rgb>, std::string>> textures_;
+  bool skipped_ = false;
+};
+
+}  // namespace
+
+bool assimp_reads(const std::string& extension) {
+  const Assimp::Importer importer;
+  return !extension.empty() && importer.IsExtensionSupported(extension);
+}
+
+std::string assimp_extensions() {
+  const Assimp::Importer importer;
+  std::string list;
+  importer.GetExtensionList(list);  // "*.3ds;*.dae;..."
+  std::string out;
+  for (std::size_t at = 0; at < list.size();) {
+    std::size_t end = list.find(';', at);
+    if (end == std::string::npos) end = list.size();
+    std::string ext = list.substr(at, end - at);
+    if (ext.rfind("*", 0) == 0) ext.erase(0, 1);
+    if (ext != ".obj" && ext != ".gltf" && ext != ".glb" && !ext.empty()) out += (out.empty() ? "" : " ") + ext;
+    at = end + 1;
+  }
+  return out;
+}
+
+Scene load_assimp(const fs::path& path, const LoadOptions& options) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw Error(ErrorCode::file_not_found, "load_scene: cannot open model file '" + path.string() +
+                                               (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
+  if (lower_extension(path) == ".ply") check_ply_header(path);
+  if (lower_extension(path) == ".dae") check_collada(path);
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
+  if (!scene) throw Error(ErrorCode::parse_error, path.string() + ": " + importer.GetErrorString());
+  if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
+    throw Error(ErrorCode::parse_error, path.string() + ": holds no complete scene (" +
+                                            std::string(scene->mNumMeshes == 0 ? "no meshes" : "an animation or skeleton only") + ")");
+  AssimpReader(path, *scene, options).check();
+  // Polygons to triangles, and the corners that the file repeats merged into shared vertices.
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  if (!scene) throw Error(ErrorCode::parse_error, path.string() + ": " + importer.GetErrorString());
+  return AssimpReader(path, *scene, options).read();
+}
+
+}  // namespace radiosity::detail

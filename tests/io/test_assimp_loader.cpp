@@ -1,0 +1,296 @@
+// load_scene() on the formats read through Assimp, with files written by the tests: ASCII and
+// binary PLY and STL (no materials: the default grey, without a warning), COLLADA (node names as
+// groups, node transforms, diffuse colour and emission mapped as glTF's, the camera, lines
+// skipped with a warning); and broken files: a PLY header cut short (Assimp 5.2 would loop
+// forever on it), the empty faces of a truncated PLY (its Triangulate step would abort), NaN
+// coordinates, every truncation of each file an Error or a scene, never a crash or a hang.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+
+#include "radiosity/io.hpp"
+#include "support/gltf_builder.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using radiosity::Error;
+using radiosity::ErrorCode;
+using radiosity::Rgb;
+
+const fs::path kTmp = fs::path(RADIOSITY_TEST_TMP) / "assimp";
+constexpr float kPi = 3.14159265358979323846f;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+bool near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
+  return std::fabs(a.x - b.x) <= eps && std::fabs(a.y - b.y) <= eps && std::fabs(a.z - b.z) <= eps;
+}
+
+radiosity::Scene load(const fs::path& path, bool strict = false) {
+  radiosity::LoadOptions options;
+  options.strict = strict;
+  return radiosity::load_scene(path, options);
+}
+
+Error load_error(const fs::path& path, bool strict = false) {
+  try {
+    load(path, strict);
+  } catch (const Error& e) {
+    return e;
+  }
+  FAIL("load_scene(" << path.string() << ") did not throw");
+  return Error(ErrorCode::internal, "");
+}
+
+fs::path write(const std::string& name, const std::string& bytes) { return test::write_file(kTmp / name, bytes); }
+
+/// A unit square in z = 0 facing +z, as one quad face.
+const char* const kPly =
+    "ply\nformat ascii 1.0\ncomment a unit square\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+
+std::string binary_ply() {
+  std::string s =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  const float v[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  s.append(reinterpret_cast<const char*>(v), sizeof v);
+  const std::int32_t faces[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  for (const auto& f : faces) {
+    s += '\3';
+    s.append(reinterpret_cast<const char*>(f), sizeof f);
+  }
+  return s;
+}
+
+const char* const kStl =
+    "solid square\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 1 1 0\n endloop\nendfacet\n"
+    "facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 1 0\n  vertex 0 1 0\n endloop\nendfacet\nendsolid square\n";
+
+std::string binary_stl() {
+  std::string s(80, ' ');
+  const std::uint32_t count = 2;
+  s.append(reinterpret_cast<const char*>(&count), 4);
+  const float tris[2][12] = {{0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 1, 0}};
+  for (const auto& t : tris) {
+    s.append(reinterpret_cast<const char*>(t), sizeof t);
+    s += std::string(2, '\0');
+  }
+  return s;
+}
+
+/// A COLLADA scene: a lamp panel (diffuse 0.8 0.4 0.2, emission 2) moved by its node, a white
+/// floor (diffuse 1, clamped), a line, and a camera (xfov 60 degrees, aspect 1.5).
+const char* const kCollada = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_cameras>
+    <camera id="cam" name="cam"><optics><technique_common><perspective>
+      <xfov>60</xfov><aspect_ratio>1.5</aspect_ratio><znear>0.1</znear><zfar>100</zfar>
+    </perspective></technique_common></optics></camera>
+  </library_cameras>
+  <library_effects>
+    <effect id="lamp-fx"><profile_COMMON><technique sid="common"><lambert>
+      <emission><color>2 2 2 1</color></emission>
+      <diffuse><color>0.8 0.4 0.2 1</color></diffuse>
+    </lambert></technique></profile_COMMON></effect>
+    <effect id="white-fx"><profile_COMMON><technique sid="common"><lambert>
+      <diffuse><color>1 1 1 1</color></diffuse>
+    </lambert></technique></profile_COMMON></effect>
+  </library_effects>
+  <library_materials>
+    <material id="lamp-mat" name="lamp"><instance_effect url="#lamp-fx"/></material>
+    <material id="white-mat" name="white"><instance_effect url="#white-fx"/></material>
+  </library_materials>
+  <library_geometries>
+    <geometry id="quad" name="quad"><mesh>
+      <source id="quad-pos"><float_array id="quad-pos-arr" count="12">0 0 0 1 0 0 1 1 0 0 1 0</float_array>
+        <technique_common><accessor source="#quad-pos-arr" count="4" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="quad-vtx"><input semantic="POSITION" source="#quad-pos"/></vertices>
+      <polylist material="m" count="1"><input semantic="VERTEX" source="#quad-vtx" offset="0"/><vcount>4</vcount><p>0 1 2 3</p></polylist>
+      <lines material="m" count="1"><input semantic="VERTEX" source="#quad-vtx" offset="0"/><p>0 2</p></lines>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes>
+    <visual_scene id="scene">
+      <node id="panel" name="panel"><translate>0 0 -2</translate>
+        <instance_geometry url="#quad"><bind_material><technique_common>
+          <instance_material symbol="m" target="#lamp-mat"/></technique_common></bind_material></instance_geometry>
+      </node>
+      <node id="floor" name="floor"><rotate>1 0 0 -90</rotate><scale>4 4 4</scale>
+        <instance_geometry url="#quad"><bind_material><technique_common>
+          <instance_material symbol="m" target="#white-mat"/></technique_common></bind_material></instance_geometry>
+      </node>
+      <node id="camnode" name="camnode"><translate>0 1 5</translate><instance_camera url="#cam"/></node>
+    </visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+
+/// Loads every prefix of `bytes` (every `step`-th length) as `name`: each must give an Error
+/// naming the file, or a scene. Returns how many were refused.
+std::size_t load_truncations(const std::string& name, const std::string& bytes, std::size_t step) {
+  std::size_t refused = 0;
+  for (std::size_t n = 0; n < bytes.size(); n += step) {
+    const fs::path path = write(name, bytes.substr(0, n));
+    try {
+      load(path);
+    } catch (const Error& e) {
+      ++refused;
+      const std::string message = e.what();
+      INFO(message);
+      CHECK(contains(message, path.string()));
+    }
+  }
+  return refused;
+}
+
+}  // namespace
+
+TEST_SUITE("io") {
+
+TEST_CASE("Assimp PLY: a quad face becomes two triangles with the default grey and no warning") {
+  for (const auto& [name, bytes] : {std::pair<std::string, std::string>{"square.ply", kPly}, {"square_binary.ply", binary_ply()}}) {
+    CAPTURE(name);
+    const radiosity::Scene s = load(write(name, bytes), true);
+    CHECK(s.warnings().empty());
+    REQUIRE(s.polygons().size() == 2);
+    CHECK(s.polygons()[0].area + s.polygons()[1].area == doctest::Approx(1.0));
+    for (const radiosity::Polygon& p : s.polygons()) CHECK(near(p.normal, {0, 0, 1}));
+    CHECK(s.material(s.polygons()[0].material).name == "default");
+    CHECK(s.material(s.polygons()[0].material).reflectance == Rgb(0.5f));
+    REQUIRE(s.meshes().size() == 1);
+    CHECK(s.meshes()[0].positions.size() == 4);  // one vertex per corner
+    CHECK(s.groups()[0] == "mesh0");
+  }
+}
+
+TEST_CASE("Assimp ASCII and binary STL read the same triangles with the default grey") {
+  const radiosity::Scene ascii = load(write("square.stl", kStl), true);
+  const radiosity::Scene binary = load(write("square_binary.stl", binary_stl()), true);
+  REQUIRE(ascii.polygons().size() == 2);
+  REQUIRE(binary.polygons().size() == 2);
+  for (std::size_t i = 0; i < 2; ++i) CHECK(ascii.polygons()[i].vertices == binary.polygons()[i].vertices);
+  CHECK(ascii.groups()[0] == "square");  // the solid's name
+  CHECK(ascii.material(0).reflectance == Rgb(0.5f));
+  CHECK(ascii.warnings().empty());
+}
+
+TEST_CASE("Assimp COLLADA: node names as groups - node transforms - colours mapped as glTF's - the camera") {
+  const fs::path path = write("scene.dae", kCollada);
+  const radiosity::Scene s = load(path);
+  CHECK(s.groups() == std::vector<std::string>{"panel", "floor"});
+  const radiosity::Polygon& panel = s.polygons()[0];
+  CHECK(s.groups()[panel.group] == "panel");
+  for (const glm::vec3& v : panel.vertices) CHECK(v.z == doctest::Approx(-2.0f));
+  const radiosity::Material& lamp = s.material(panel.material);
+  CHECK(lamp.name == "lamp");
+  CHECK(near(lamp.reflectance, Rgb(0.8f, 0.4f, 0.2f)));
+  CHECK(near(lamp.emission, Rgb(2.0f * kPi), 1e-5f));
+  CHECK_FALSE(lamp.brdf);  // Lambertian: no metallic or roughness in the file
+  // The floor: the quad turned to face +y and scaled by 4; its white diffuse colour clamped.
+  double floor_area = 0.0;
+  for (const radiosity::Polygon& p : s.polygons())
+    if (s.groups()[p.group] == "floor") {
+      CHECK(near(p.normal, {0, 1, 0}));
+      floor_area += p.area;
+      CHECK(near(s.material(p.material).reflectance, Rgb(0.99f)));
+    }
+  CHECK(floor_area == doctest::Approx(16.0));
+  REQUIRE(s.has_camera());
+  CHECK(near(s.camera().eye, {0, 1, 5}));
+  CHECK(near(s.camera().look_at, {0, 1, 4}));
+  // The vertical angle of a 60 degree horizontal one at aspect 1.5.
+  CHECK(s.camera().fov_deg == doctest::Approx(2.0 * std::atan(std::tan(kPi / 6.0) / 1.5) * 180.0 / kPi).epsilon(1e-4));
+  // Two warnings: the line (under both nodes), the clamped white.
+  REQUIRE(s.warnings().size() == 2);
+  CHECK(contains(s.warnings()[0], path.string() + ": meshes[1] 'quad' (placed by node 'panel'): 1 point or line face has no "
+                                                  "area; skipped (2 in all; also at "));
+  CHECK(contains(s.warnings()[1], path.string() + ": materials[1] 'white': diffuse colour (1, 1, 1) is a diffuse reflectance"));
+  const Error strict = load_error(path, true);
+  CHECK(strict.code() == ErrorCode::parse_error);
+  CHECK(contains(strict.what(), path.string() + ": meshes[1] 'quad' (placed by node 'panel'): 1 point or line face"));
+}
+
+TEST_CASE("Assimp broken files: a cut PLY header - empty faces - NaN - every truncation an Error or a scene") {
+  Error header = load_error(write("header.ply", std::string(kPly).substr(0, 120)));
+  CHECK(header.code() == ErrorCode::parse_error);
+  CHECK(contains(header.what(), "header.ply: the PLY header has no end_header line (a truncated file?)"));
+
+  // Cut after the first vertex: Assimp makes the face without vertices.
+  const std::string ply = kPly;
+  Error faces = load_error(write("faces.ply", ply.substr(0, ply.find("end_header\n") + 11 + 6)));
+  CHECK(faces.code() == ErrorCode::parse_error);
+  CHECK(contains(faces.what(), "faces.ply: meshes[0]: face 0 has no vertices (a truncated file?)"));
+
+  std::string nan = kStl;
+  nan.replace(nan.find("vertex 1 0 0"), 12, "vertex 1 nan 0");
+  Error e = load_error(write("nan.stl", nan));
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "nan.stl: meshes[0] 'square': vertex 1 is NaN or infinite"));
+
+  Error missing = load_error(kTmp / "no_such_model.fbx");
+  CHECK(missing.code() == ErrorCode::file_not_found);
+  CHECK(contains(missing.what(), "no_such_model.fbx"));
+
+  CHECK(load_truncations("cut.ply", kPly, 1) > 0);
+  CHECK(load_truncations("cut_binary.ply", binary_ply(), 1) > 0);
+  CHECK(load_truncations("cut.stl", kStl, 3) > 0);
+  CHECK(load_truncations("cut_binary.stl", binary_stl(), 1) > 0);
+  CHECK(load_truncations("cut.dae", kCollada, 37) > 0);
+}
+
+TEST_CASE("Assimp broken COLLADA: a stray character in an index list - an array beyond its count - corrupted bytes") {
+  // Assimp 5.2 would loop forever on the first and write out of bounds on the second.
+  std::string stray = kCollada;
+  stray.replace(stray.find("<p>0 1 2 3</p>"), 14, "<p>0 1 x 3</p>");
+  const Error e = load_error(write("stray.dae", stray));
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "stray.dae:29:"));
+  CHECK(contains(e.what(), ": an index list (<p>) holds a character that is not part of a number"));
+  std::string count = kCollada;
+  count.replace(count.find("count=\"12\""), 10, "count=\"2\"");
+  const Error c = load_error(write("count.dae", count));
+  CHECK(contains(c.what(), "count.dae:24:29: "));
+  CHECK(contains(c.what(), "float_array holds 12 values, more than its count 2"));
+
+  // Every 7th byte of each file set to a few values: an Error naming the file, or a scene.
+  for (const auto& [name, bytes] : {std::pair<std::string, std::string>{"corrupt.dae", kCollada}, {"corrupt.ply", kPly},
+                                    {"corrupt_binary.ply", binary_ply()}, {"corrupt.stl", kStl}, {"corrupt_binary.stl", binary_stl()}}) {
+    std::size_t refused = 0;
+    for (std::size_t at = 0; at < bytes.size(); at += 7)
+      for (char value : {'\0', '\xff', '9', 'x'}) {
+        std::string bad = bytes;
+        bad[at] = value;
+        const fs::path path = write(name, bad);
+        try {
+          load(path);
+        } catch (const Error& error) {
+          ++refused;
+          const std::string message = error.what();
+          INFO(message);
+          CHECK(contains(message, path.string()));
+        }
+      }
+    CHECK(refused > 0);
+  }
+}
+
+TEST_CASE("an unsupported extension lists the formats load_scene reads") {
+  const Error e = load_error(write("scene.abc", "nothing"));
+  CHECK(e.code() == ErrorCode::invalid_argument);
+  CHECK(contains(e.what(), "unsupported extension '.abc' (supported: .obj, .json, .gltf, .glb, and through Assimp "));
+  CHECK(contains(e.what(), " .fbx "));
+  CHECK(contains(e.what(), " .ply "));
+}
+
+}  // TEST_SUITE
