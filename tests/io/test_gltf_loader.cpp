@@ -643,6 +643,8 @@ TEST_CASE("glTF broken: a missing external buffer is file_not_found naming the b
   const fs::path path = test::write_file(kTmp / "missing_buffer.gltf", b.gltf("missing.bin"));
   check_error(path, ErrorCode::file_not_found, {"buffers[0].uri: external buffer file 'missing.bin' not found (looked for '"});
   check_error(kTmp / "no_such_scene.glb", ErrorCode::file_not_found, {"cannot open glTF file"});
+  const fs::path remote = test::write_file(kTmp / "remote_buffer.gltf", b.gltf("https://example.com/scene.bin"));
+  check_error(remote, ErrorCode::parse_error, {"buffers[0].uri: 'https://example.com/scene.bin' is not a relative file name"});
 }
 
 TEST_CASE("glTF broken: NaN and infinite positions - indices out of range") {

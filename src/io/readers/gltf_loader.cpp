@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cfloat>
 #include <climits>
 #include <cmath>
@@ -29,7 +30,6 @@
 #include <map>
 #include <numeric>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -394,6 +394,10 @@ class JsonCheck {
       }
       const std::string u = uri->get<std::string>();
       if (is_data_uri(u)) return;
+      // tinygltf looks for files below the .gltf's folder only (the file system callbacks).
+      if (u.find("://") != std::string::npos || fs::u8path(decode_uri(u)).is_absolute())
+        src_.fail(ErrorCode::parse_error, at + ".uri",
+                  in_quotes(u) + " is not a relative file name (data: URIs and files beside the glTF are read)");
       const fs::path file = base_dir / fs::u8path(decode_uri(u));
       std::error_code ec;
       if (!fs::is_regular_file(file, ec))
