@@ -20,6 +20,7 @@
 #include "radiosity/render.hpp"
 #include "radiosity/solver.hpp"
 #include "support/gltf_builder.hpp"
+#include "support/loading.hpp"
 
 namespace {
 
@@ -35,26 +36,9 @@ constexpr float kPi = 3.14159265358979323846f;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-bool near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
-  return std::fabs(a.x - b.x) <= eps && std::fabs(a.y - b.y) <= eps && std::fabs(a.z - b.z) <= eps;
-}
-
-radiosity::Scene load(const fs::path& path, bool strict = false) {
-  radiosity::LoadOptions options;
-  options.strict = strict;
-  return radiosity::load_scene(path, options);
-}
-
-/// The Error that loading `path` throws (failing the test when it loads).
-Error load_error(const fs::path& path, bool strict = false) {
-  try {
-    load(path, strict);
-  } catch (const Error& e) {
-    return e;
-  }
-  FAIL("load_scene(" << path.string() << ") did not throw");
-  return Error(ErrorCode::internal, "");
-}
+using test::load;
+using test::load_error;
+using test::near;
 
 /// Checks the code, and that the message names the file and contains each of `parts`.
 void check_error(const fs::path& path, ErrorCode code, const std::vector<std::string>& parts, bool strict = false) {
