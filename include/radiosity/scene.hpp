@@ -163,6 +163,8 @@ struct MeshDesc {
   const glm::vec3* normals = nullptr;      ///< per vertex (shading normals; kept, not used by radiosity)
   const glm::vec2* uv0 = nullptr;          ///< per vertex: texture coordinates
   const glm::vec2* uv1 = nullptr;          ///< per vertex: lightmap coordinates
+  /// Where the host's mesh came from, kept as Mesh::source (a file reader's place; optional).
+  std::string_view source;
 };
 
 /// What a Scene keeps of a mesh given to add_mesh(): copies of the host's arrays in its own
@@ -177,6 +179,14 @@ struct Mesh {
   /// Per triangle: the polygon it became, or kNone when it was skipped (degenerate).
   std::vector<PolygonId> triangle_polygon;
   PolygonRange polygons;               ///< the polygons of its triangles, consecutive (add_mesh())
+  /// Where it came from (MeshDesc::source): the glTF reader writes
+  /// "nodes[N]: meshes[M].primitives[P]" (the node that places it and the primitive, indices
+  /// into the file's arrays), the Assimp reader "nodes 'NAME': meshes[M]"; empty otherwise.
+  std::string source;
+  /// Empty while the mesh has the host's vertices; after set_mesh_lightmap_uvs() split them,
+  /// per vertex the host vertex (as given to add_mesh()) it copies, so that a host's other
+  /// per-vertex data (tangents, colours, skin weights) can follow the split.
+  std::vector<std::uint32_t> vertex_origin;
 };
 
 /// What kind of light a Light is (docs/LIGHTS.md).
@@ -293,6 +303,7 @@ class RADIOSITY_API Scene {
   /// the mesh's, one new vertex per corner of the same triangles in the same order, so
   /// vertex_origin[indices[c]] must be the corner's old index. Polygons and triangle_polygon do
   /// not change (the geometry is the same); a Solution solved before keeps the old vertices.
+  /// Mesh::vertex_origin then names each new vertex's host vertex (through earlier splits).
   /// Throws Error{invalid_argument} naming the mesh for an unknown mesh, sizes that disagree
   /// (indices.size() must stay, uv1 has one entry per new vertex), an index or origin out of
   /// range, a corner whose new vertex does not copy its old one, or a NaN or infinite uv1; the

@@ -78,6 +78,7 @@ MeshId Scene::add_mesh(const MeshDesc& desc, const LoadOptions& options) {
   if (desc.uv0) mesh.uv0.assign(desc.uv0, desc.uv0 + vertex_count);
   if (desc.uv1) mesh.uv1.assign(desc.uv1, desc.uv1 + vertex_count);
   mesh.triangle_polygon.assign(triangles, kNone);
+  mesh.source = std::string(desc.source);
 
   // Polygons go straight into the scene; on an error they (and a group made for this mesh) are
   // taken back, so a throwing call leaves the scene as it was.
@@ -224,12 +225,16 @@ void Scene::set_mesh_lightmap_uvs(MeshId id, const std::vector<std::uint32_t>& v
   // Built aside and moved in, so a throw above (or bad_alloc here) leaves the mesh unchanged.
   std::vector<glm::vec3> positions(count), normals(old.normals.empty() ? 0 : count);
   std::vector<glm::vec2> uv0(old.uv0.empty() ? 0 : count);
+  // The host's vertex of each new one: through an earlier split when there was one.
+  std::vector<std::uint32_t> host(count);
   for (std::size_t v = 0; v < count; ++v) {
     positions[v] = old.positions[vertex_origin[v]];
     if (!normals.empty()) normals[v] = old.normals[vertex_origin[v]];
     if (!uv0.empty()) uv0[v] = old.uv0[vertex_origin[v]];
+    host[v] = old.vertex_origin.empty() ? vertex_origin[v] : old.vertex_origin[vertex_origin[v]];
   }
   Mesh& mesh = meshes_[id];
+  mesh.vertex_origin = std::move(host);
   mesh.positions = std::move(positions);
   mesh.normals = std::move(normals);
   mesh.uv0 = std::move(uv0);

@@ -16,7 +16,7 @@ namespace radiosity::detail {
 
 std::size_t add_placed_mesh(Scene& scene, ReaderWarnings& warnings, LocalMesh mesh, const glm::dmat4& world,
                             MaterialId material, std::string_view group, const std::string& where,
-                            const LoadOptions& options) {
+                            const LoadOptions& options, std::string_view source) {
   const std::size_t vertices = mesh.positions.size();
   for (std::size_t v = 0; v < vertices; ++v) {
     const glm::dvec4 q = world * glm::dvec4(glm::dvec3(mesh.positions[v]), 1.0);
@@ -74,6 +74,7 @@ std::size_t add_placed_mesh(Scene& scene, ReaderWarnings& warnings, LocalMesh me
   desc.normals = mesh.normals.empty() ? nullptr : mesh.normals.data();
   desc.uv0 = mesh.uv0.empty() ? nullptr : mesh.uv0.data();
   desc.uv1 = mesh.uv1.empty() ? nullptr : mesh.uv1.data();
+  desc.source = source;
   try {
     scene.add_mesh(desc, options);
   } catch (const Error& e) {

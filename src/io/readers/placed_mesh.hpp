@@ -34,9 +34,9 @@ struct LocalMesh {
 /// forgiven in one warning at `where` ("file: meshes[2].primitives[0]"; an Error under strict);
 /// returns how many there were. A mesh left without triangles adds nothing. Throws
 /// Error{invalid_scene} at `where` for a position the matrix takes beyond float range, and
-/// add_mesh()'s errors with `where` in front.
+/// add_mesh()'s errors with `where` in front. `source` becomes Mesh::source.
 std::size_t add_placed_mesh(Scene& scene, ReaderWarnings& warnings, LocalMesh mesh, const glm::dmat4& world,
                             MaterialId material, std::string_view group, const std::string& where,
-                            const LoadOptions& options);
+                            const LoadOptions& options, std::string_view source = {});
 
 }  // namespace radiosity::detail

@@ -3,10 +3,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "io/writers/image_checks.hpp"
+#include "io/writers/png_encode.hpp"
 #include "io/writers/srgb.hpp"
 #include "radiosity/io.hpp"
 
@@ -28,21 +30,39 @@
 #pragma GCC diagnostic pop
 
 namespace radiosity {
-inline namespace v1 {
+namespace detail {
 
-void write_png(const Image& image, const std::filesystem::path& path, const PngOptions& options) {
-  const std::string where = "write_png: '" + path.string() + "': ";
-  detail::check_image_size(image, where);
+std::vector<std::uint8_t> encode_png(const Image& image, const PngOptions& options, const std::string& where) {
+  check_image_size(image, where);
   const std::size_t n = image.pixels.size();
   if (!(options.exposure >= 0.0f) || !std::isfinite(options.exposure))
     throw Error(ErrorCode::invalid_argument, where + "PngOptions::exposure must be finite and >= 0");
 
   std::vector<std::uint8_t> rgb(3 * n);
   for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = detail::srgb8(options.exposure * image.pixels[i][c]);
+    for (int c = 0; c < 3; ++c) rgb[3 * i + c] = srgb8(options.exposure * image.pixels[i][c]);
 
-  if (stbi_write_png(path.string().c_str(), image.width, image.height, 3, rgb.data(), 3 * image.width) == 0)
-    throw Error(ErrorCode::io_error, "write_png: cannot write '" + path.string() + "'");
+  std::vector<std::uint8_t> png;
+  auto append = [](void* context, void* data, int size) {
+    const auto* bytes = static_cast<const std::uint8_t*>(data);
+    static_cast<std::vector<std::uint8_t>*>(context)->insert(static_cast<std::vector<std::uint8_t>*>(context)->end(),
+                                                             bytes, bytes + size);
+  };
+  if (stbi_write_png_to_func(append, &png, image.width, image.height, 3, rgb.data(), 3 * image.width) == 0)
+    throw Error(ErrorCode::io_error, where + "PNG encoding failed");
+  return png;
+}
+
+}  // namespace detail
+
+inline namespace v1 {
+
+void write_png(const Image& image, const std::filesystem::path& path, const PngOptions& options) {
+  const std::vector<std::uint8_t> png = detail::encode_png(image, options, "write_png: '" + path.string() + "': ");
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  out.close();
+  if (!out) throw Error(ErrorCode::io_error, "write_png: cannot write '" + path.string() + "'");
 }
 
 }  // namespace v1
