@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string_view>
+#include <vector>
 
 #include "radiosity/common.hpp"
 #include "radiosity/render.hpp"
@@ -102,6 +103,45 @@ RADIOSITY_API void write_ply(const Solution& solution, const std::filesystem::pa
 /// the file cannot be written.
 RADIOSITY_API void write_mesh_ply(const Scene& scene, const Solution& solution, MeshId mesh,
                                   const std::filesystem::path& path, const PngOptions& options = {});
+
+/// What write_baked_gltf() bakes into the scene. Every field has a default.
+/// Thread safety: a plain value; write_baked_gltf() only reads it.
+struct GltfBakeOptions {
+  /// What the vertex colours and lightmaps hold, as LightmapOptions::quantity; a viewer shows it
+  /// times the material's diffuse reflectance (Material::reflectance), or as it is for
+  /// Quantity::radiosity, so that irradiance shows the radiosity B = reflectance x H.
+  Quantity quantity = Quantity::irradiance;
+  /// Per MeshId: the lightmap bake_lightmap() made of `quantity` in that mesh's UV1, or an empty
+  /// Image for none. Empty (the default): no lightmaps. A mesh with one gets TEXCOORD_1 and the
+  /// lightmap as its base colour texture; one without gets COLOR_0.
+  std::vector<Image> lightmaps;
+  /// Linear scale from `quantity` to display values: vertex colours and lightmap texels are
+  /// clamp(exposure x value, 0, 1), the texels sRGB-encoded in 8-bit PNG. >= 0, finite.
+  float exposure = 1.0f;
+};
+
+/// Writes `scene` with `solution` baked in as glTF 2.0, so that any glTF viewer (Blender,
+/// three.js, ...) shows the lit scene: `output` is binary (.glb) or JSON (.gltf, its buffer in
+/// OUTPUT_STEM.bin beside it). Every material becomes KHR_materials_unlit, its base colour the
+/// diffuse reflectance (white for Quantity::radiosity; an emitter shows its emission x exposure,
+/// flat); each mesh's light goes in as COLOR_0 vertex colours, or, where options.lightmaps has
+/// one, as its base colour texture on TEXCOORD_1 (not both: viewers would multiply them). Every
+/// primitive also gets `_IRRADIANCE` (float RGB per vertex, W/m^2, unscaled) for pipelines.
+/// `source` is the glTF file the scene was loaded from (load_scene()): the output is that file
+/// (its node hierarchy, transforms, cameras, lights, animations, extras) with its meshes' light
+/// added, found by Mesh::source; a mesh placed by several nodes is copied for each, and
+/// vertices split by lightmap UVs (Mesh::vertex_origin) carry every attribute of the vertex
+/// they copy (skin weights, morph targets). Textures are dropped (the viewer shows the light,
+/// not the texture). An empty `source` (scenes from OBJ, JSON, add_mesh(), the built-ins): a new
+/// file, one node per mesh (Scene::add_group_meshes() makes meshes of polygons), positions in
+/// world units, one primitive per material.
+/// Throws Error{invalid_argument} for bad options, a lightmap count larger than the meshes, a
+/// solution not solved with these meshes, or a scene that was not loaded from `source`
+/// (a mesh without a glTF Mesh::source, or one whose vertex count differs from the file's);
+/// the reader's errors for a broken `source`; Error{io_error} naming the path when the output
+/// cannot be written. Thread safety: may be called concurrently for different outputs.
+RADIOSITY_API void write_baked_gltf(const std::filesystem::path& source, const Scene& scene, const Solution& solution,
+                                    const std::filesystem::path& output, const GltfBakeOptions& options = {});
 
 /// Writes the statistics JSON of `radiosity solve --stats` (format in docs/CLI-stats.md):
 /// status, iterations, residual history, per-group mean radiosity and area, power balance,
