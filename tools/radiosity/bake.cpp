@@ -70,6 +70,17 @@ double texel_density(const rad::Mesh& m, int size) {
   return area > 0.0 ? static_cast<double>(size) * std::sqrt(uv_area / area) : 0.0;
 }
 
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+bool is_gltf(const std::string& path) {
+  const std::string ext = lower_extension(path);
+  return ext == ".glb" || ext == ".gltf";
+}
+
 int run_bake(const BakeArgs& a) {
   return run_guarded([&] {
     ProgressBar bar;
@@ -111,10 +122,16 @@ int run_bake(const BakeArgs& a) {
     print_estimator(sol, options);
     print_solve_warnings(scene, sol);
 
-    std::error_code made;
-    fs::create_directories(a.output, made);
-    if (made)
-      throw rad::Error(rad::ErrorCode::io_error, "cannot create the output folder '" + a.output + "': " + made.message());
+    // `-o lit.glb`: one glTF file with the light baked in, instead of a folder.
+    const bool gltf_output = is_gltf(a.output);
+    rad::GltfBakeOptions gltf;
+    gltf.quantity = quantity_from_name(a.quantity);
+    if (!gltf_output) {
+      std::error_code made;
+      fs::create_directories(a.output, made);
+      if (made)
+        throw rad::Error(rad::ErrorCode::io_error, "cannot create the output folder '" + a.output + "': " + made.message());
+    }
     rad::LightmapOptions lo;
     lo.width = lo.height = std::max(a.lightmap, 1);
     lo.quantity = quantity_from_name(a.quantity);
@@ -138,6 +155,29 @@ int run_bake(const BakeArgs& a) {
       std::printf("preview exposure: %.4g (automatic: the 99th percentile of the vertex %s shows at 0.8; --exposure "
                   "overrides)\n",
                   po.exposure, a.quantity.c_str());
+    }
+    if (gltf_output) {
+      gltf.exposure = po.exposure;
+      if (a.lightmap > 0) gltf.lightmaps.resize(scene.meshes().size());
+      double bake_seconds = 0.0;
+      for (rad::MeshId id = 0; id < scene.meshes().size() && a.lightmap > 0; ++id) {
+        rad::Lightmap map = rad::bake_lightmap(scene, sol, id, lo);
+        bar.finish();
+        if (map.cancelled) throw rad::Error(rad::ErrorCode::invalid_argument, "bake cancelled");
+        bake_seconds += map.seconds;
+        gltf.lightmaps[id] = std::move(map.image);
+      }
+      // A glTF scene is written back as itself; any other becomes a new file.
+      const std::string source = is_gltf(a.solve.scene) ? a.solve.scene : std::string();
+      rad::write_baked_gltf(source, scene, sol, a.output, gltf);
+      if (a.lightmap > 0)
+        std::printf("lightmaps: %zu at %dx%d, %s%s, %.2f s, in the glTF as base colour textures on TEXCOORD_1\n",
+                    scene.meshes().size(), a.lightmap, a.lightmap, a.quantity.c_str(),
+                    a.final_gather ? " (final gather)" : " (interpolated)", bake_seconds);
+      std::printf("wrote %s (%zu meshes; %s, unlit materials, exposure %.4g%s)\n", fs::absolute(a.output).c_str(),
+                  scene.meshes().size(), a.lightmap > 0 ? "lightmaps" : "COLOR_0 vertex colours", po.exposure,
+                  source.empty() ? "; a new file: the scene was not read from glTF" : "");
+      return 0;
     }
     // A PLY colour shows B / pi; pi x exposure puts B on the lightmaps' scale.
     rad::PngOptions ply_colours = po;
@@ -210,7 +250,10 @@ Command add_bake_command(CLI::App& app) {
       "bake", "Solve and write, per mesh, a lightmap (EXR + PNG preview), a PLY with the solution on its vertices, "
               "and manifest.json");
   cmd->add_option("scene", a.solve.scene, kSceneHelp);
-  cmd->add_option("-o,--output", a.output, "Output folder (created)")->required();
+  cmd->add_option("-o,--output", a.output,
+                  "Output folder (created); or a .glb/.gltf file: the scene with the light baked in (lightmaps, or "
+                  "vertex colours with --lightmap 0)")
+      ->required();
   cmd->add_option("--lightmap", a.lightmap, "Lightmap width and height in texels, 0 = no lightmaps")
       ->check(in_range<int>(0, 16384))
       ->capture_default_str();
