@@ -101,6 +101,8 @@ rad::SolveOptions quick_solve() {
 
 }  // namespace
 
+TEST_SUITE("io") {
+
 TEST_CASE("glTF bake: the room written back shows its light per vertex or per lightmap texel - geometry and winding kept") {
   rad::Scene scene = test::load(kData / "gltf" / "room.glb");
   const rad::MeshId floor = mesh_of(scene, "floor"), block = mesh_of(scene, "block"), wall = mesh_of(scene, "red_wall"),
@@ -306,3 +308,5 @@ TEST_CASE("glTF bake: wrong inputs are errors that say what is wrong") {
   const fs::path other = test::write_file(kTmp / "other.gltf", b.gltf());
   CHECK(error(other, kTmp / "x.glb", {}).find("was the scene loaded from") != std::string::npos);
 }
+
+}  // TEST_SUITE

@@ -8,24 +8,16 @@
 #include <cmath>
 #include <memory>
 
+#include "core/third_party_warnings.hpp"
+
 // The implementation lives here, with internal linkage so it cannot clash with another copy of
 // stb in the program (tinygltf's shared library carries its own).
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_NO_STDIO  // images come from memory only
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wall"
-#pragma GCC diagnostic ignored "-Wextra"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
-#pragma GCC diagnostic ignored "-Wdouble-promotion"
+RADIOSITY_THIRD_PARTY_BEGIN
 #include <stb_image.h>
-#pragma GCC diagnostic pop
+RADIOSITY_THIRD_PARTY_END
 
 namespace radiosity::detail {
 namespace {

@@ -12,22 +12,15 @@
 #include "io/writers/srgb.hpp"
 #include "radiosity/io.hpp"
 
+#include "core/third_party_warnings.hpp"
+
 // The implementation lives here, with internal linkage so it cannot clash with another copy of
 // stb in the program.
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wall"
-#pragma GCC diagnostic ignored "-Wextra"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+RADIOSITY_THIRD_PARTY_BEGIN
 #include <stb_image_write.h>
-#pragma GCC diagnostic pop
+RADIOSITY_THIRD_PARTY_END
 
 namespace radiosity {
 namespace detail {
