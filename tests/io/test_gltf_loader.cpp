@@ -221,8 +221,11 @@ TEST_CASE("glTF materials: base colour - metallic-roughness - emission with its 
   }
   b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior"};
   b.scene(roots);
-  const radiosity::Scene s = load(write_gltf(b, "materials.gltf"));
-  CHECK(s.warnings().empty());
+  const fs::path path = write_gltf(b, "materials.gltf");
+  const radiosity::Scene s = load(path);
+  // The gold is a metal on purpose: a note, not a problem (below).
+  REQUIRE(s.warnings().size() == 1);
+  CHECK(contains(s.warnings()[0], path.string() + ": materials[4] 'gold': metallic 1"));
   auto by_name = [&](const std::string& name) -> const radiosity::Material& {
     for (const radiosity::Material& m : s.materials())
       if (m.name == name) return m;
@@ -255,6 +258,43 @@ TEST_CASE("glTF materials: base colour - metallic-roughness - emission with its 
   REQUIRE(au.brdf);
   const auto ggx = radiosity::make_microfacet(Rgb(0.95f, 0.8f, 0.3f), 0.09f, 0.09f);
   for (int c = 0; c < 3; ++c) CHECK(au.brdf->eval(wo, wi)[c] == doctest::Approx(ggx->eval(wo, wi)[c]));
+}
+
+TEST_CASE("glTF a material that is all metal (metallicFactor absent) gets one note naming it - kept under strict") {
+  test::GltfBuilder b;
+  // The spec's defaults: metallicFactor 1, so base colour alone is a rough metal.
+  const int wall = b.material({{"name", "Wall"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+  const int floor = b.material({{"name", "Floor"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.4, 0.3, 1.0}}}}});
+  const int paint = b.material(diffuse(Rgb(0.8f, 0.8f, 0.8f), {{"name", "Paint"}}));
+  b.material({{"name", "Unused"}});  // a metal that no mesh uses: no note
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, wall))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, floor))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 2}, {1, 0, 2}, {1, 1, 2}, {0, 1, 2}, wall))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 3}, {1, 0, 3}, {1, 1, 3}, {0, 1, 3}, paint))}})});
+  const fs::path path = write_gltf(b, "metal.gltf");
+  for (const bool strict : {false, true}) {
+    CAPTURE(strict);
+    const radiosity::Scene s = load(path, strict);
+    REQUIRE(s.warnings().size() == 1);
+    const std::string& w = s.warnings()[0];
+    INFO(w);
+    CHECK(w == path.string() + ": materials[0] 'Wall': metallic 1 (glTF's default when metallicFactor is absent): a metal has "
+                               "no diffuse reflectance, so radiosity passes no light on from it; set metallicFactor 0 for a "
+                               "diffuse surface (2 in all; also at " + path.string() + ": materials[1] 'Floor')");
+    for (const radiosity::Material& m : s.materials())
+      CHECK(m.reflectance == (m.name == "Paint" ? Rgb(0.8f) : Rgb(0.0f)));
+  }
+}
+
+TEST_CASE("glTF metallicFactor 0 or 0.5 leaves a diffuse part and no note") {
+  test::GltfBuilder b;
+  const int dielectric = b.material(diffuse(Rgb(0.5f), {{"name", "plastic"}}));
+  const int half_metal = b.material({{"name", "half"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}}, {"metallicFactor", 0.5}}}});
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, dielectric))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, half_metal))}})});
+  const radiosity::Scene s = load(write_gltf(b, "not_metal.gltf"), true);
+  CHECK(s.warnings().empty());
+  for (const radiosity::Material& m : s.materials()) CHECK(m.reflectance.x > 0.0f);
 }
 
 TEST_CASE("glTF a base colour of 1 is clamped with one warning - and is an error under strict") {

@@ -1106,6 +1106,13 @@ class GltfReader {
       set_transmission(m, base, transmission, static_cast<float>(ior));
     } else {
       set_metallic_roughness(m, base, metallic, roughness, static_cast<float>(ior));
+      // Valid and read as written, but a hand-written material that gives only its base colour
+      // is this metal, and radiosity would pass no light on from it without a word.
+      if (metallic >= 1.0f)
+        warnings_.note("all metal", src_.where(place + (g.name.empty() ? "" : " " + in_quotes(g.name))),
+                       "metallic 1 (glTF's default when metallicFactor is absent): a metal has no diffuse reflectance, "
+                       "so radiosity passes no light on from it",
+                       "set metallicFactor 0 for a diffuse surface");
     }
     return m;
   }
