@@ -421,6 +421,21 @@ TEST_CASE("glTF KHR_lights_punctual: point - spot and directional lights at thei
   check_error(write_gltf(b, "lights_bad.gltf"), ErrorCode::parse_error, {"nodes[1].extensions.KHR_lights_punctual.light", "not an index"});
 }
 
+TEST_CASE("glTF a file that requires KHR_lights_punctual loads with its lights") {
+  test::GltfBuilder b;
+  b.doc["extensionsUsed"] = json::array({"KHR_lights_punctual"});
+  b.doc["extensionsRequired"] = json::array({"KHR_lights_punctual"});
+  b.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", json::array({{{"type", "point"}, {"intensity", 2.0}}})}}}};
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, b.material(diffuse(Rgb(0.5f)))))}}),
+           b.node({{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+  const radiosity::Scene s = load(write_glb(b, "lights_required.glb"), true);
+  CHECK(s.warnings().empty());
+  REQUIRE(s.lights().size() == 1);
+  CHECK(s.lights()[0].name == "light 0");
+  CHECK(near(s.lights()[0].position, {0, 0, 2}));
+  CHECK(s.lights()[0].intensity == doctest::Approx(2.0));
+}
+
 TEST_CASE("glTF furnace: a closed inward box of emission E and reflectance rho solves to B = E/(1-rho) within 0.5 %") {
   test::GltfBuilder b;
   const Rgb base(0.5f, 0.6f, 0.3f), emissive(0.2f, 0.4f, 0.1f);

@@ -69,7 +69,7 @@ constexpr std::size_t kMaxZeroAccessor = std::size_t{1} << 24;
 /// which moves texels around but leaves the mean of a texture (all that is read of it) alone.
 constexpr std::string_view kReadableRequired[] = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
                                                   "KHR_materials_ior", "KHR_mesh_quantization",
-                                                  "KHR_texture_transform"};
+                                                  "KHR_texture_transform", "KHR_lights_punctual"};
 
 std::uint32_t le32(const unsigned char* p) {
   return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
@@ -194,8 +194,8 @@ class JsonCheck {
                              ? " (decompress the file first, e.g. gltf-transform copy or gltfpack -noq)"
                              : std::string()) +
                         "; the extensions a file may require here are KHR_materials_emissive_strength, "
-                        "KHR_materials_transmission, KHR_materials_ior, KHR_mesh_quantization and "
-                        "KHR_texture_transform");
+                        "KHR_materials_transmission, KHR_materials_ior, KHR_mesh_quantization, "
+                        "KHR_texture_transform and KHR_lights_punctual");
       }
 
     if (const json* scene = find(root_, "scene")) index(*scene, "scene", "scenes");
