@@ -44,6 +44,7 @@
 
 #include "core/constants.hpp"
 #include "io/readers/material_mapping.hpp"
+#include "io/readers/placed_light.hpp"
 #include "io/readers/placed_mesh.hpp"
 #include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
@@ -914,14 +915,8 @@ class GltfReader {
     if (in.color.size() == 3)
       light.color = Rgb(static_cast<float>(in.color[0]), static_cast<float>(in.color[1]), static_cast<float>(in.color[2]));
     light.intensity = static_cast<float>(in.intensity);
-    if (options_.photometric) light.intensity = photometric_to_radiometric(light.intensity);
-    light.position = glm::vec3(glm::dvec3(world[3]));
-    light.direction = glm::vec3(glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0));
-    try {
-      scene_.add_light(light);
-    } catch (const Error& e) {
-      src_.fail(e.code(), where, std::string("(on ") + place + "): " + e.what());
-    }
+    add_placed_light(scene_, light, world, glm::dvec3(0.0), glm::dvec3(0.0, 0.0, -1.0), options_,
+                     src_.where(where) + ": (on " + place + ")");
   }
 
   // --- cameras --------------------------------------------------------------------------------
