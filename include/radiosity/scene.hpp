@@ -145,8 +145,9 @@ struct LoadOptions {
   /// The library is radiometric (Light): false (the default) reads light intensities as they
   /// are written, W/sr for point and spot lights and W/m^2 for directional lights and skies.
   /// true reads them as photometric, candela and lux, and divides by 683 lm/W
-  /// (photometric_to_radiometric()). Read by the JSON scene reader and the glTF reader
-  /// (KHR_lights_punctual); see docs/LIGHTS.md.
+  /// (photometric_to_radiometric()). Read by the JSON scene reader, the glTF reader
+  /// (KHR_lights_punctual) and the Assimp reader (its point, spot and directional lights); see
+  /// docs/LIGHTS.md.
   bool photometric = false;
 };
 

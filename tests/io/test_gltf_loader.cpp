@@ -392,19 +392,12 @@ TEST_CASE("glTF KHR_lights_punctual: point - spot and directional lights at thei
   const fs::path path = write_gltf(b, "lights.gltf");
   const radiosity::Scene s = load(path);
   REQUIRE(s.lights().size() == 3);
-  const radiosity::Light& bulb = s.lights()[0];
-  CHECK(bulb.type == radiosity::LightType::point);
-  CHECK(bulb.name == "bulb");
-  CHECK(near(bulb.position, {1, 2, 3}));
-  CHECK(near(bulb.color, {1.0f, 0.5f, 0.25f}));
-  CHECK(bulb.intensity == doctest::Approx(683.0));  // radiometric: W/sr as written
-  const radiosity::Light& spot = s.lights()[1];
-  CHECK(spot.type == radiosity::LightType::spot);
-  CHECK(near(spot.direction, {0, -1, 0}));
-  CHECK(spot.inner_cone_deg == doctest::Approx(0.1 * 180.0 / 3.14159265358979));
-  CHECK(spot.outer_cone_deg == doctest::Approx(0.5 * 180.0 / 3.14159265358979));
-  CHECK(s.lights()[2].type == radiosity::LightType::directional);
-  CHECK(near(s.lights()[2].direction, {0, -1, 0}));
+  using radiosity::LightType;
+  // Radiometric: W/sr as written.
+  test::check_light(s.lights()[0], test::light_of(LightType::point, "bulb", {1, 2, 3}, {}, Rgb(1.0f, 0.5f, 0.25f), 683.0f));
+  test::check_light(s.lights()[1], test::light_of(LightType::spot, "light 1", {0, 4, 0}, {0, -1, 0}, Rgb(1.0f), 10.0f,
+                                                  0.1f * 180.0f / kPi, 0.5f * 180.0f / kPi));
+  test::check_light(s.lights()[2], test::light_of(LightType::directional, "light 2", {}, {0, -1, 0}, Rgb(1.0f), 3.0f));
   REQUIRE(s.warnings().size() == 2);
   CHECK(contains(s.warnings()[0], "extensions.KHR_lights_punctual.lights[1]: range 5"));
   CHECK(contains(s.warnings()[1], "lights[3]: type 'area' is not point, spot or directional; skipped"));
