@@ -313,7 +313,9 @@ class AssimpReader {
         case aiLightSource_SPOT: light.type = LightType::spot; break;
         case aiLightSource_DIRECTIONAL: light.type = LightType::directional; break;
         default: {
-          const char* type = in->mType == aiLightSource_AMBIENT ? "an ambient" : in->mType == aiLightSource_AREA ? "an area" : "an undefined";
+          const char* type = in->mType == aiLightSource_AMBIENT ? "an ambient"
+                             : in->mType == aiLightSource_AREA  ? "an area"
+                                                                : "an undefined";
           warnings_.forgive("unsupported light type", ErrorCode::invalid_scene, where(place),
                             std::string(type) + " light has no counterpart (point, spot and directional lights are read)",
                             "skipped");
@@ -326,12 +328,12 @@ class AssimpReader {
                           "no node is named after it, so nothing places it in the scene", "skipped");
         continue;
       }
-      const Rgb flux(in->mColorDiffuse.r, in->mColorDiffuse.g, in->mColorDiffuse.b);
-      if (!finite(in->mPosition) || !finite(in->mDirection) || !std::isfinite(flux.x) || !std::isfinite(flux.y) ||
-          !std::isfinite(flux.z) || !std::isfinite(in->mAngleInnerCone) || !std::isfinite(in->mAngleOuterCone))
+      const Rgb folded(in->mColorDiffuse.r, in->mColorDiffuse.g, in->mColorDiffuse.b);  // colour x intensity
+      if (!finite(in->mPosition) || !finite(in->mDirection) || !std::isfinite(folded.x) || !std::isfinite(folded.y) ||
+          !std::isfinite(folded.z) || !std::isfinite(in->mAngleInnerCone) || !std::isfinite(in->mAngleOuterCone))
         fail(ErrorCode::parse_error, place, "a position, direction, colour or cone angle is NaN or infinite");
       light.name = name.empty() ? "light " + std::to_string(i) : name;
-      const Rgb c = clamp_colour(flux, FLT_MAX, FLT_MAX, warnings_, "light colour out of range", where(place),
+      const Rgb c = clamp_colour(folded, FLT_MAX, FLT_MAX, warnings_, "light colour out of range", where(place),
                                  "colour x intensity", "an emitted intensity", ">= 0");
       light.intensity = max_channel(c);
       light.color = light.intensity > 0.0f ? c / light.intensity : Rgb(1.0f);
