@@ -137,13 +137,17 @@ struct LoadOptions {
   /// a diffuse reflectance of 1 or more is clamped to 0.99 and Kd + Ks above 0.99 scaled down;
   /// negative colours are clamped to 0; a missing MTL file or an undefined material gives the
   /// default grey; non-planar or non-convex faces are triangulated. true: each such problem
-  /// is an Error naming the file and line instead, so a loaded scene has no warnings.
+  /// is an Error naming the file and line instead, so a loaded scene has no warnings but
+  /// notes. A note reports valid input read exactly as written whose result is probably not
+  /// what was meant (a glTF material that is all metal, so radiosity passes no light on from
+  /// it); it stays a warning under strict, which would otherwise refuse a valid file.
   bool strict = false;
   /// The library is radiometric (Light): false (the default) reads light intensities as they
   /// are written, W/sr for point and spot lights and W/m^2 for directional lights and skies.
   /// true reads them as photometric, candela and lux, and divides by 683 lm/W
-  /// (photometric_to_radiometric()). Read by the JSON scene reader and the glTF reader
-  /// (KHR_lights_punctual); see docs/LIGHTS.md.
+  /// (photometric_to_radiometric()). Read by the JSON scene reader, the glTF reader
+  /// (KHR_lights_punctual) and the Assimp reader (its point, spot and directional lights); see
+  /// docs/LIGHTS.md.
   bool photometric = false;
 };
 

@@ -1,9 +1,11 @@
 // load_scene() on the formats read through Assimp, with files written by the tests: ASCII and
 // binary PLY and STL (no materials: the default grey, without a warning), COLLADA (node names as
 // groups, node transforms, diffuse colour and emission mapped as glTF's, the camera, lines
-// skipped with a warning); and broken files: a PLY header cut short (Assimp 5.2 would loop
-// forever on it), the empty faces of a truncated PLY (its Triangulate step would abort), NaN
-// coordinates, every truncation of each file an Error or a scene, never a crash or a hang.
+// skipped with a warning; point, spot and directional lights placed by their nodes, the ambient
+// one skipped, attenuation and cone angles warned about); and broken files: a PLY header cut
+// short (Assimp 5.2 would loop forever on it), the empty faces of a truncated PLY (its
+// Triangulate step would abort), NaN coordinates, every truncation of each file an Error or a
+// scene, never a crash or a hang.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -121,6 +123,58 @@ const char* const kCollada = R"(<?xml version="1.0" encoding="utf-8"?>
 </COLLADA>
 )";
 
+/// A COLLADA scene lit by lights only: a grey floor; a point light (colour 2 1 0.5, intensity
+/// 3, inverse-square attenuation) and a spot (full cones of 40 and 60 degrees, intensity 10)
+/// under a node that moves and scales them, the spot turned to shine down; a sun turned 45
+/// degrees from -Z towards -Y; an ambient light.
+const char* const kColladaLights = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_lights>
+    <light id="bulb-light" name="bulb-light"><technique_common><point><color>2 1 0.5</color>
+      <constant_attenuation>0</constant_attenuation><linear_attenuation>0</linear_attenuation><quadratic_attenuation>1</quadratic_attenuation>
+    </point></technique_common><extra><technique profile="FCOLLADA"><intensity>3</intensity></technique></extra></light>
+    <light id="spot-light" name="spot-light"><technique_common><spot><color>1 1 1</color>
+      <constant_attenuation>0</constant_attenuation><linear_attenuation>0</linear_attenuation><quadratic_attenuation>1</quadratic_attenuation>
+      <falloff_angle>40</falloff_angle><falloff_exponent>0</falloff_exponent>
+    </spot></technique_common><extra><technique profile="FCOLLADA"><intensity>10</intensity><outer_cone>60</outer_cone></technique></extra></light>
+    <light id="sun-light" name="sun-light"><technique_common><directional><color>5 5 5</color></directional></technique_common></light>
+    <light id="sky-light" name="sky-light"><technique_common><ambient><color>0.1 0.2 0.3</color></ambient></technique_common></light>
+  </library_lights>
+  <library_effects>
+    <effect id="grey-fx"><profile_COMMON><technique sid="common"><lambert>
+      <diffuse><color>0.5 0.5 0.5 1</color></diffuse>
+    </lambert></technique></profile_COMMON></effect>
+  </library_effects>
+  <library_materials><material id="grey-mat" name="grey"><instance_effect url="#grey-fx"/></material></library_materials>
+  <library_geometries>
+    <geometry id="quad" name="quad"><mesh>
+      <source id="quad-pos"><float_array id="quad-pos-arr" count="12">-5 0 5 5 0 5 5 0 -5 -5 0 -5</float_array>
+        <technique_common><accessor source="#quad-pos-arr" count="4" stride="3">
+          <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+        </accessor></technique_common></source>
+      <vertices id="quad-vtx"><input semantic="POSITION" source="#quad-pos"/></vertices>
+      <polylist material="m" count="1"><input semantic="VERTEX" source="#quad-vtx" offset="0"/><vcount>4</vcount><p>0 1 2 3</p></polylist>
+    </mesh></geometry>
+  </library_geometries>
+  <library_visual_scenes>
+    <visual_scene id="scene">
+      <node id="floor" name="floor">
+        <instance_geometry url="#quad"><bind_material><technique_common>
+          <instance_material symbol="m" target="#grey-mat"/></technique_common></bind_material></instance_geometry>
+      </node>
+      <node id="rig" name="rig"><translate>0 4 0</translate><scale>2 2 2</scale>
+        <node id="bulb" name="bulb"><translate>1 0 1</translate><instance_light url="#bulb-light"/></node>
+        <node id="spot" name="spot"><translate>-1 0 0</translate><rotate>1 0 0 -90</rotate><instance_light url="#spot-light"/></node>
+      </node>
+      <node id="sun" name="sun"><rotate>1 0 0 -45</rotate><instance_light url="#sun-light"/></node>
+      <node id="sky" name="sky"><instance_light url="#sky-light"/></node>
+    </visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+
 /// Loads every prefix of `bytes` (every `step`-th length) as `name`: each must give an Error
 /// naming the file, or a scene. Returns how many were refused.
 std::size_t load_truncations(const std::string& name, const std::string& bytes, std::size_t step) {
@@ -204,6 +258,63 @@ TEST_CASE("Assimp COLLADA: node names as groups - node transforms - colours mapp
   const Error strict = load_error(path, true);
   CHECK(strict.code() == ErrorCode::parse_error);
   CHECK(contains(strict.what(), path.string() + ": meshes[1] 'quad' (placed by node 'panel'): 1 point or line face"));
+}
+
+TEST_CASE("Assimp COLLADA lights: point - spot and sun placed by their nodes - colour x intensity split - photometric - ambient skipped") {
+  const fs::path path = write("lights.dae", kColladaLights);
+  const radiosity::Scene s = load(path);
+  REQUIRE(s.lights().size() == 3);
+  using radiosity::LightType;
+  // The point light: at rig (0 4 0) + 2 x (1 0 1); Assimp's colour x intensity (6 3 1.5) split.
+  test::check_light(s.lights()[0], test::light_of(LightType::point, "bulb", {2, 4, 2}, {}, Rgb(1.0f, 0.5f, 0.25f), 6.0f));
+  // The spot: at rig + 2 x (-1 0 0), its -Z turned down; COLLADA's full cones of 40 and 60
+  // degrees are half angles of 20 and 30.
+  test::check_light(s.lights()[1], test::light_of(LightType::spot, "spot", {-2, 4, 0}, {0, -1, 0}, Rgb(1.0f), 10.0f, 20.0f, 30.0f));
+  // The sun: -Z turned 45 degrees about -X; intensity as written, in W/m^2.
+  const float h = std::sqrt(0.5f);
+  test::check_light(s.lights()[2], test::light_of(LightType::directional, "sun", {}, {0, -h, -h}, Rgb(1.0f), 5.0f));
+  // One warning: the ambient light has no counterpart; strict refuses it.
+  REQUIRE(s.warnings().size() == 1);
+  CHECK(contains(s.warnings()[0], path.string() + ": lights[3] 'sky': an ambient light has no counterpart (point, spot and "
+                                                  "directional lights are read); skipped"));
+  const Error strict = load_error(path, true);
+  CHECK(strict.code() == ErrorCode::invalid_scene);
+  CHECK(contains(strict.what(), path.string() + ": lights[3] 'sky': an ambient light has no counterpart"));
+
+  // Photometric: candela and lux at 683 lm/W; the colours stay.
+  radiosity::LoadOptions photometric;
+  photometric.photometric = true;
+  const radiosity::Scene p = radiosity::load_scene(path, photometric);
+  REQUIRE(p.lights().size() == 3);
+  CHECK(p.lights()[0].intensity == doctest::Approx(6.0 / 683.0));
+  CHECK(p.lights()[1].intensity == doctest::Approx(10.0 / 683.0));
+  CHECK(p.lights()[2].intensity == doctest::Approx(5.0 / 683.0));
+  CHECK(near(p.lights()[0].color, {1.0f, 0.5f, 0.25f}));
+}
+
+TEST_CASE("Assimp COLLADA lights: attenuation that is not inverse-square and cones beyond 90 degrees warn") {
+  std::string text = kColladaLights;
+  // COLLADA's default attenuation (constant 1: no fall-off) for the point light, a spot wider
+  // than a hemisphere, and no ambient light.
+  const std::string att = "<constant_attenuation>0</constant_attenuation><linear_attenuation>0</linear_attenuation>"
+                          "<quadratic_attenuation>1</quadratic_attenuation>";
+  text.erase(text.find(att), att.size());
+  text.replace(text.find("<falloff_angle>40"), 17, "<falloff_angle>170");
+  text.replace(text.find("<outer_cone>60"), 14, "<outer_cone>200");
+  text.erase(text.find("<node id=\"sky\""), text.find("</visual_scene>") - text.find("<node id=\"sky\""));
+  const fs::path path = write("lights_warn.dae", text);
+  const radiosity::Scene s = load(path);
+  REQUIRE(s.lights().size() == 3);
+  CHECK(s.lights()[1].inner_cone_deg == doctest::Approx(85.0));
+  CHECK(s.lights()[1].outer_cone_deg == doctest::Approx(90.0));
+  REQUIRE(s.warnings().size() == 2);
+  CHECK(contains(s.warnings()[0], path.string() + ": lights[0] 'bulb': attenuation 1/(1 + 0 d + 0 d^2) is not applied; the "
+                                                  "light falls off as 1/d^2 (physical)"));
+  CHECK(contains(s.warnings()[1], path.string() + ": lights[1] 'spot': cone half angles 85 and 100 degrees (inner, outer) "
+                                                  "must satisfy 0 <= inner <= outer <= 90; clamped to 85 and 90"));
+  const Error strict = load_error(path, true);
+  CHECK(strict.code() == ErrorCode::invalid_scene);
+  CHECK(contains(strict.what(), "lights[0] 'bulb': attenuation 1/(1 + 0 d + 0 d^2) is not applied"));
 }
 
 TEST_CASE("Assimp broken files: a cut PLY header - empty faces - NaN - every truncation an Error or a scene") {

@@ -221,8 +221,11 @@ TEST_CASE("glTF materials: base colour - metallic-roughness - emission with its 
   }
   b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior"};
   b.scene(roots);
-  const radiosity::Scene s = load(write_gltf(b, "materials.gltf"));
-  CHECK(s.warnings().empty());
+  const fs::path path = write_gltf(b, "materials.gltf");
+  const radiosity::Scene s = load(path);
+  // The gold is a metal on purpose: a note, not a problem (below).
+  REQUIRE(s.warnings().size() == 1);
+  CHECK(contains(s.warnings()[0], path.string() + ": materials[4] 'gold': metallic 1"));
   auto by_name = [&](const std::string& name) -> const radiosity::Material& {
     for (const radiosity::Material& m : s.materials())
       if (m.name == name) return m;
@@ -255,6 +258,43 @@ TEST_CASE("glTF materials: base colour - metallic-roughness - emission with its 
   REQUIRE(au.brdf);
   const auto ggx = radiosity::make_microfacet(Rgb(0.95f, 0.8f, 0.3f), 0.09f, 0.09f);
   for (int c = 0; c < 3; ++c) CHECK(au.brdf->eval(wo, wi)[c] == doctest::Approx(ggx->eval(wo, wi)[c]));
+}
+
+TEST_CASE("glTF a material that is all metal (metallicFactor absent) gets one note naming it - kept under strict") {
+  test::GltfBuilder b;
+  // The spec's defaults: metallicFactor 1, so base colour alone is a rough metal.
+  const int wall = b.material({{"name", "Wall"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+  const int floor = b.material({{"name", "Floor"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.4, 0.3, 1.0}}}}});
+  const int paint = b.material(diffuse(Rgb(0.8f, 0.8f, 0.8f), {{"name", "Paint"}}));
+  b.material({{"name", "Unused"}});  // a metal that no mesh uses: no note
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, wall))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, floor))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 2}, {1, 0, 2}, {1, 1, 2}, {0, 1, 2}, wall))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 3}, {1, 0, 3}, {1, 1, 3}, {0, 1, 3}, paint))}})});
+  const fs::path path = write_gltf(b, "metal.gltf");
+  for (const bool strict : {false, true}) {
+    CAPTURE(strict);
+    const radiosity::Scene s = load(path, strict);
+    REQUIRE(s.warnings().size() == 1);
+    const std::string& w = s.warnings()[0];
+    INFO(w);
+    CHECK(w == path.string() + ": materials[0] 'Wall': metallic 1 (glTF's default when metallicFactor is absent): a metal has "
+                               "no diffuse reflectance, so radiosity passes no light on from it; set metallicFactor 0 for a "
+                               "diffuse surface (2 in all; also at " + path.string() + ": materials[1] 'Floor')");
+    for (const radiosity::Material& m : s.materials())
+      CHECK(m.reflectance == (m.name == "Paint" ? Rgb(0.8f) : Rgb(0.0f)));
+  }
+}
+
+TEST_CASE("glTF metallicFactor 0 or 0.5 leaves a diffuse part and no note") {
+  test::GltfBuilder b;
+  const int dielectric = b.material(diffuse(Rgb(0.5f), {{"name", "plastic"}}));
+  const int half_metal = b.material({{"name", "half"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}}, {"metallicFactor", 0.5}}}});
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, dielectric))}}),
+           b.node({{"mesh", b.mesh(b.quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}, half_metal))}})});
+  const radiosity::Scene s = load(write_gltf(b, "not_metal.gltf"), true);
+  CHECK(s.warnings().empty());
+  for (const radiosity::Material& m : s.materials()) CHECK(m.reflectance.x > 0.0f);
 }
 
 TEST_CASE("glTF a base colour of 1 is clamped with one warning - and is an error under strict") {
@@ -352,19 +392,12 @@ TEST_CASE("glTF KHR_lights_punctual: point - spot and directional lights at thei
   const fs::path path = write_gltf(b, "lights.gltf");
   const radiosity::Scene s = load(path);
   REQUIRE(s.lights().size() == 3);
-  const radiosity::Light& bulb = s.lights()[0];
-  CHECK(bulb.type == radiosity::LightType::point);
-  CHECK(bulb.name == "bulb");
-  CHECK(near(bulb.position, {1, 2, 3}));
-  CHECK(near(bulb.color, {1.0f, 0.5f, 0.25f}));
-  CHECK(bulb.intensity == doctest::Approx(683.0));  // radiometric: W/sr as written
-  const radiosity::Light& spot = s.lights()[1];
-  CHECK(spot.type == radiosity::LightType::spot);
-  CHECK(near(spot.direction, {0, -1, 0}));
-  CHECK(spot.inner_cone_deg == doctest::Approx(0.1 * 180.0 / 3.14159265358979));
-  CHECK(spot.outer_cone_deg == doctest::Approx(0.5 * 180.0 / 3.14159265358979));
-  CHECK(s.lights()[2].type == radiosity::LightType::directional);
-  CHECK(near(s.lights()[2].direction, {0, -1, 0}));
+  using radiosity::LightType;
+  // Radiometric: W/sr as written.
+  test::check_light(s.lights()[0], test::light_of(LightType::point, "bulb", {1, 2, 3}, {}, Rgb(1.0f, 0.5f, 0.25f), 683.0f));
+  test::check_light(s.lights()[1], test::light_of(LightType::spot, "light 1", {0, 4, 0}, {0, -1, 0}, Rgb(1.0f), 10.0f,
+                                                  0.1f * 180.0f / kPi, 0.5f * 180.0f / kPi));
+  test::check_light(s.lights()[2], test::light_of(LightType::directional, "light 2", {}, {0, -1, 0}, Rgb(1.0f), 3.0f));
   REQUIRE(s.warnings().size() == 2);
   CHECK(contains(s.warnings()[0], "extensions.KHR_lights_punctual.lights[1]: range 5"));
   CHECK(contains(s.warnings()[1], "lights[3]: type 'area' is not point, spot or directional; skipped"));
@@ -379,6 +412,21 @@ TEST_CASE("glTF KHR_lights_punctual: point - spot and directional lights at thei
   // A light index out of range names the node.
   b.doc["nodes"][1]["extensions"]["KHR_lights_punctual"]["light"] = 9;
   check_error(write_gltf(b, "lights_bad.gltf"), ErrorCode::parse_error, {"nodes[1].extensions.KHR_lights_punctual.light", "not an index"});
+}
+
+TEST_CASE("glTF a file that requires KHR_lights_punctual loads with its lights") {
+  test::GltfBuilder b;
+  b.doc["extensionsUsed"] = json::array({"KHR_lights_punctual"});
+  b.doc["extensionsRequired"] = json::array({"KHR_lights_punctual"});
+  b.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", json::array({{{"type", "point"}, {"intensity", 2.0}}})}}}};
+  b.scene({b.node({{"mesh", b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, b.material(diffuse(Rgb(0.5f)))))}}),
+           b.node({{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}})});
+  const radiosity::Scene s = load(write_glb(b, "lights_required.glb"), true);
+  CHECK(s.warnings().empty());
+  REQUIRE(s.lights().size() == 1);
+  CHECK(s.lights()[0].name == "light 0");
+  CHECK(near(s.lights()[0].position, {0, 0, 2}));
+  CHECK(s.lights()[0].intensity == doctest::Approx(2.0));
 }
 
 TEST_CASE("glTF furnace: a closed inward box of emission E and reflectance rho solves to B = E/(1-rho) within 0.5 %") {

@@ -1,8 +1,10 @@
-// Loading a scene file in a test: strict or not, the Error it throws, and a vector comparison.
+// Loading a scene file in a test: strict or not, the Error it throws, a vector comparison, and
+// the check of a light a reader made.
 #pragma once
 
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include <doctest/doctest.h>
 #include <glm/vec3.hpp>
@@ -13,6 +15,37 @@ namespace test {
 
 inline bool near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
   return std::fabs(a.x - b.x) <= eps && std::fabs(a.y - b.y) <= eps && std::fabs(a.z - b.z) <= eps;
+}
+
+/// A Light of the given fields, what a reader is expected to make (cones in degrees).
+inline radiosity::Light light_of(radiosity::LightType type, const std::string& name, glm::vec3 position, glm::vec3 direction,
+                                 radiosity::Rgb color, float intensity, float inner_cone_deg = 0.0f, float outer_cone_deg = 45.0f) {
+  radiosity::Light l;
+  l.type = type;
+  l.name = name;
+  l.position = position;
+  l.direction = direction;
+  l.color = color;
+  l.intensity = intensity;
+  l.inner_cone_deg = inner_cone_deg;
+  l.outer_cone_deg = outer_cone_deg;
+  return l;
+}
+
+/// Checks that `got` is `want` in what its type uses: name, colour, intensity; the position of
+/// a point or spot, the direction of a spot or directional light, a spot's cones.
+inline void check_light(const radiosity::Light& got, const radiosity::Light& want) {
+  INFO("light '" << want.name << "'");
+  CHECK(got.type == want.type);
+  CHECK(got.name == want.name);
+  CHECK(near(got.color, want.color));
+  CHECK(got.intensity == doctest::Approx(want.intensity));
+  if (want.type != radiosity::LightType::directional) CHECK(near(got.position, want.position));
+  if (want.type != radiosity::LightType::point) CHECK(near(got.direction, want.direction));
+  if (want.type == radiosity::LightType::spot) {
+    CHECK(got.inner_cone_deg == doctest::Approx(want.inner_cone_deg));
+    CHECK(got.outer_cone_deg == doctest::Approx(want.outer_cone_deg));
+  }
 }
 
 /// load_scene() with LoadOptions::strict as given.

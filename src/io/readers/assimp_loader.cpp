@@ -5,7 +5,9 @@
 // glTF's reader uses (material_mapping.hpp), with the keys each format fills (Assimp's
 // "Material System" documentation: $clr.base or $clr.diffuse, $clr.emissive with
 // $mat.emissiveIntensity, $mat.twosided, $mat.opacity, $mat.transmission.factor, $mat.refracti,
-// $mat.metallicFactor and $mat.roughnessFactor). docs/SCENE_GLTF.md has the table.
+// $mat.metallicFactor and $mat.roughnessFactor). docs/SCENE_GLTF.md has the table. Its point,
+// spot and directional lights (aiLight, each placed by the node of its name) become Lights as
+// glTF's KHR_lights_punctual ones do (placed_light.hpp; docs/LIGHTS.md).
 //
 // Assimp is asked to parse and validate only (aiProcess_ValidateDataStructure); the reader then
 // checks what the validation leaves through (empty faces, NaN positions) before triangulating,
@@ -27,6 +29,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -37,8 +40,10 @@
 #include <glm/mat4x4.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "core/color.hpp"
 #include "core/constants.hpp"
 #include "io/readers/material_mapping.hpp"
+#include "io/readers/placed_light.hpp"
 #include "io/readers/placed_mesh.hpp"
 #include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
@@ -57,6 +62,13 @@ std::string lower_extension(const fs::path& path) {
 }
 
 std::string in_quotes(const std::string& s) { return "'" + s + "'"; }
+
+/// A number as the messages show it: 6 significant digits, no trailing zeros.
+std::string number_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 /// Assimp 5.2's PLY reader loops forever when the header ends before its end_header line (a
 /// truncated file), so the header is looked at first: "end_header" on a line of its own, within
@@ -121,6 +133,15 @@ glm::dmat4 to_glm(const aiMatrix4x4& m) {
 
 bool finite(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+glm::dvec3 to_glm(const aiVector3D& v) { return glm::dvec3(v.x, v.y, v.z); }
+
+/// A node's world matrix: its own transformation under its ancestors'.
+glm::dmat4 world_matrix(const aiNode* node) {
+  glm::dmat4 world(1.0);
+  for (const aiNode* n = node; n; n = n->mParent) world = to_glm(n->mTransformation) * world;
+  return world;
+}
+
 class AssimpReader {
  public:
   AssimpReader(const fs::path& path, const aiScene& scene, const LoadOptions& options)
@@ -169,6 +190,7 @@ class AssimpReader {
         if (node->mChildren[c]) stack.emplace_back(node->mChildren[c], world);
     }
     add_camera();
+    add_lights();
     if (scene_.polygons().empty())
       fail(ErrorCode::parse_error, "",
            skipped_ ? "has no triangles that are not degenerate" : "has no triangles (no node places a mesh of faces)");
@@ -253,12 +275,11 @@ class AssimpReader {
                           "ignored");
         continue;
       }
-      glm::dmat4 world(1.0);
-      for (const aiNode* n = node; n; n = n->mParent) world = to_glm(n->mTransformation) * world;
+      const glm::dmat4 world = world_matrix(node);
       const glm::dmat3 linear(world);
-      const glm::dvec3 eye(world * glm::dvec4(camera->mPosition.x, camera->mPosition.y, camera->mPosition.z, 1.0));
-      const glm::dvec3 forward = glm::normalize(linear * glm::dvec3(camera->mLookAt.x, camera->mLookAt.y, camera->mLookAt.z));
-      const glm::dvec3 up = glm::normalize(linear * glm::dvec3(camera->mUp.x, camera->mUp.y, camera->mUp.z));
+      const glm::dvec3 eye(world * glm::dvec4(to_glm(camera->mPosition), 1.0));
+      const glm::dvec3 forward = glm::normalize(linear * to_glm(camera->mLookAt));
+      const glm::dvec3 up = glm::normalize(linear * to_glm(camera->mUp));
       const double horizontal = camera->mHorizontalFOV, aspect = camera->mAspect;
       const double vertical = aspect > 0.0 ? 2.0 * std::atan(std::tan(horizontal / 2.0) / aspect) : horizontal;
       Camera c;
@@ -273,6 +294,79 @@ class AssimpReader {
       }
       set = true;
     }
+  }
+
+  /// Assimp's lights as docs/SCENE_GLTF.md ("Other formats") maps them: point, spot and
+  /// directional lights placed by the node of the light's name (its world matrix moves
+  /// mPosition and turns mDirection); ambient, area and undefined ones skipped with a warning.
+  /// Assimp folds the intensity into the colour (mColorDiffuse = colour x intensity): the
+  /// largest channel becomes Light::intensity, the colour is what is left (largest channel 1).
+  void add_lights() {
+    for (unsigned i = 0; i < ai_.mNumLights; ++i) {
+      const aiLight* in = ai_.mLights[i];
+      if (!in) continue;
+      const std::string name = in->mName.C_Str();
+      const std::string place = "lights[" + std::to_string(i) + "]" + (name.empty() ? "" : " " + in_quotes(name));
+      Light light;
+      switch (in->mType) {
+        case aiLightSource_POINT: light.type = LightType::point; break;
+        case aiLightSource_SPOT: light.type = LightType::spot; break;
+        case aiLightSource_DIRECTIONAL: light.type = LightType::directional; break;
+        default: {
+          const char* type = in->mType == aiLightSource_AMBIENT ? "an ambient"
+                             : in->mType == aiLightSource_AREA  ? "an area"
+                                                                : "an undefined";
+          warnings_.forgive("unsupported light type", ErrorCode::invalid_scene, where(place),
+                            std::string(type) + " light has no counterpart (point, spot and directional lights are read)",
+                            "skipped");
+          continue;
+        }
+      }
+      const aiNode* node = ai_.mRootNode->FindNode(in->mName);
+      if (!node) {
+        warnings_.forgive("light without a node", ErrorCode::invalid_scene, where(place),
+                          "no node is named after it, so nothing places it in the scene", "skipped");
+        continue;
+      }
+      const Rgb folded(in->mColorDiffuse.r, in->mColorDiffuse.g, in->mColorDiffuse.b);  // colour x intensity
+      if (!finite(in->mPosition) || !finite(in->mDirection) || !std::isfinite(folded.x) || !std::isfinite(folded.y) ||
+          !std::isfinite(folded.z) || !std::isfinite(in->mAngleInnerCone) || !std::isfinite(in->mAngleOuterCone))
+        fail(ErrorCode::parse_error, place, "a position, direction, colour or cone angle is NaN or infinite");
+      light.name = name.empty() ? "light " + std::to_string(i) : name;
+      const Rgb c = clamp_colour(folded, FLT_MAX, FLT_MAX, warnings_, "light colour out of range", where(place),
+                                 "colour x intensity", "an emitted intensity", ">= 0");
+      light.intensity = max_channel(c);
+      light.color = light.intensity > 0.0f ? c / light.intensity : Rgb(1.0f);
+      if (light.type == LightType::spot) set_cones(light, *in, place);
+      // Assimp's attenuation is 1 / (constant + linear d + quadratic d^2); the library's lights
+      // fall off as 1 / d^2 (the physical law, and glTF's).
+      if (light.type != LightType::directional &&
+          (in->mAttenuationConstant != 0.0f || in->mAttenuationLinear != 0.0f || in->mAttenuationQuadratic != 1.0f))
+        warnings_.forgive("light attenuation", ErrorCode::invalid_scene, where(place),
+                          "attenuation 1/(" + number_text(in->mAttenuationConstant) + " + " + number_text(in->mAttenuationLinear) +
+                              " d + " + number_text(in->mAttenuationQuadratic) + " d^2) is not applied",
+                          "the light falls off as 1/d^2 (physical)");
+      const glm::dvec3 direction = light.type == LightType::point ? glm::dvec3(0.0) : to_glm(in->mDirection);
+      add_placed_light(scene_, light, world_matrix(node), to_glm(in->mPosition), direction, options_, where(place));
+    }
+  }
+
+  /// A spot's cones: Assimp's angles are the full angles of the cones (what its COLLADA, FBX,
+  /// 3DS and Blender importers fill them with, though its documentation does not say), the
+  /// Light's half angles from the axis. Forgiven: an outer half angle beyond 90 degrees (90
+  /// used), an inner one beyond the outer (the outer used), a negative one (0).
+  void set_cones(Light& light, const aiLight& in, const std::string& place) {
+    const double inner = glm::degrees(0.5 * static_cast<double>(in.mAngleInnerCone));
+    const double outer = glm::degrees(0.5 * static_cast<double>(in.mAngleOuterCone));
+    const double outer_used = std::clamp(outer, 0.0, 90.0);
+    const double inner_used = std::clamp(inner, 0.0, outer_used);
+    if (outer_used != outer || inner_used != inner)
+      warnings_.forgive("spot cone out of range", ErrorCode::invalid_scene, where(place),
+                        "cone half angles " + number_text(inner) + " and " + number_text(outer) +
+                            " degrees (inner, outer) must satisfy 0 <= inner <= outer <= 90",
+                        "clamped to " + number_text(inner_used) + " and " + number_text(outer_used));
+    light.inner_cone_deg = static_cast<float>(inner_used);
+    light.outer_cone_deg = static_cast<float>(outer_used);
   }
 
   /// A texture's mean (decoded from sRGB), or nullopt with a warning when it cannot be read.

@@ -34,6 +34,7 @@
 #include "core/constants.hpp"
 #include "io/readers/gltf_model.hpp"
 #include "io/readers/material_mapping.hpp"
+#include "io/readers/placed_light.hpp"
 #include "io/readers/placed_mesh.hpp"
 #include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
@@ -332,14 +333,8 @@ class GltfReader {
     if (in.color.size() == 3)
       light.color = Rgb(static_cast<float>(in.color[0]), static_cast<float>(in.color[1]), static_cast<float>(in.color[2]));
     light.intensity = static_cast<float>(in.intensity);
-    if (options_.photometric) light.intensity = photometric_to_radiometric(light.intensity);
-    light.position = glm::vec3(glm::dvec3(world[3]));
-    light.direction = glm::vec3(glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0));
-    try {
-      scene_.add_light(light);
-    } catch (const Error& e) {
-      src_.fail(e.code(), where, std::string("(on ") + place + "): " + e.what());
-    }
+    add_placed_light(scene_, light, world, glm::dvec3(0.0), glm::dvec3(0.0, 0.0, -1.0), options_,
+                     src_.where(where) + ": (on " + place + ")");
   }
 
   // --- cameras --------------------------------------------------------------------------------
@@ -524,6 +519,13 @@ class GltfReader {
       set_transmission(m, base, transmission, static_cast<float>(ior));
     } else {
       set_metallic_roughness(m, base, metallic, roughness, static_cast<float>(ior));
+      // Valid and read as written, but a hand-written material that gives only its base colour
+      // is this metal, and radiosity would pass no light on from it without a word.
+      if (metallic >= 1.0f)
+        warnings_.note("all metal", src_.where(place + (g.name.empty() ? "" : " " + in_quotes(g.name))),
+                       "metallic 1 (glTF's default when metallicFactor is absent): a metal has no diffuse reflectance, "
+                       "so radiosity passes no light on from it",
+                       "set metallicFactor 0 for a diffuse surface");
     }
     return m;
   }

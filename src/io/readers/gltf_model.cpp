@@ -33,7 +33,7 @@ constexpr std::size_t kMaxZeroAccessor = std::size_t{1} << 24;
 /// which moves texels around but leaves the mean of a texture (all that is read of it) alone.
 constexpr std::string_view kReadableRequired[] = {"KHR_materials_emissive_strength", "KHR_materials_transmission",
                                                   "KHR_materials_ior", "KHR_mesh_quantization",
-                                                  "KHR_texture_transform"};
+                                                  "KHR_texture_transform", "KHR_lights_punctual"};
 
 /// A URI's path with its %XX escapes decoded (RFC 3986), for the file it names.
 std::string decode_uri(std::string_view uri) {
@@ -126,8 +126,8 @@ class JsonCheck {
                              ? " (decompress the file first, e.g. gltf-transform copy or gltfpack -noq)"
                              : std::string()) +
                         "; the extensions a file may require here are KHR_materials_emissive_strength, "
-                        "KHR_materials_transmission, KHR_materials_ior, KHR_mesh_quantization and "
-                        "KHR_texture_transform");
+                        "KHR_materials_transmission, KHR_materials_ior, KHR_mesh_quantization, "
+                        "KHR_texture_transform and KHR_lights_punctual");
       }
 
     if (const json* scene = find(root_, "scene")) index(*scene, "scene", "scenes");

@@ -1,8 +1,12 @@
-// The forgiving-reader policy shared by the scene readers (OBJ/MTL, JSON): a problem that a
+// The forgiving-reader policy shared by the scene readers (OBJ/MTL, JSON, glTF, Assimp): a problem that a
 // renderer would step over (a degenerate face, Kd 1, a missing MTL) is fixed or skipped and
 // reported once per kind, with how often it happened and where first; under
 // LoadOptions::strict the first occurrence is the Error it would have been. Input that cannot
 // mean anything (a bad index, NaN, broken syntax) never comes here: it is an Error at once.
+// A note is the third case: valid input, read exactly as the file says (nothing fixed, nothing
+// dropped), whose result is probably not what its author meant (a glTF material that is all
+// metal because metallicFactor defaults to 1). It is aggregated the same way and stays a
+// warning under strict too, since refusing it would refuse a valid file.
 #pragma once
 
 #include <cstddef>
@@ -31,15 +35,14 @@ class ReaderWarnings {
   void forgive(std::string_view kind, ErrorCode code, const std::string& where, const std::string& problem,
                std::string_view action) {
     if (strict_) throw Error(code, where + ": " + problem);
-    for (Tally& t : tallies_)
-      if (t.kind == kind) {
-        ++t.count;
-        if (t.others.size() < kListed) t.others.push_back(where);
-        return;
-      }
-    std::string first = where + ": " + problem;
-    if (!action.empty()) first += "; " + std::string(action);
-    tallies_.push_back(Tally{std::string(kind), std::move(first), 1, {}});
+    tally(kind, where, problem, action);
+  }
+
+  /// One occurrence of a note (above): `problem` says what the file means and why that may
+  /// surprise, `hint` how to say the other thing (may be empty). Aggregated by `kind` as
+  /// forgive() does, and never an Error, strict or not.
+  void note(std::string_view kind, const std::string& where, const std::string& problem, std::string_view hint) {
+    tally(kind, where, problem, hint);
   }
 
   /// Appends one warning per kind, in order of first occurrence, to `scene`:
@@ -67,6 +70,19 @@ class ReaderWarnings {
     std::size_t count = 0;
     std::vector<std::string> others;  ///< locations of the next few
   };
+
+  void tally(std::string_view kind, const std::string& where, const std::string& problem, std::string_view action) {
+    for (Tally& t : tallies_)
+      if (t.kind == kind) {
+        ++t.count;
+        if (t.others.size() < kListed) t.others.push_back(where);
+        return;
+      }
+    std::string first = where + ": " + problem;
+    if (!action.empty()) first += "; " + std::string(action);
+    tallies_.push_back(Tally{std::string(kind), std::move(first), 1, {}});
+  }
+
   bool strict_;
   std::vector<Tally> tallies_;
 };
