@@ -245,6 +245,10 @@ TEST_CASE("Assimp COLLADA: node names as groups - node transforms - colours mapp
       CHECK(near(s.material(p.material).reflectance, Rgb(0.99f)));
     }
   CHECK(floor_area == doctest::Approx(16.0));
+  // Where each mesh came from: its node and Assimp's mesh.
+  REQUIRE(s.meshes().size() == 2);
+  CHECK(s.meshes()[0].source == "nodes 'panel': meshes[0]");
+  CHECK(s.meshes()[1].source.rfind("nodes 'floor': meshes[", 0) == 0);
   REQUIRE(s.has_camera());
   CHECK(near(s.camera().eye, {0, 1, 5}));
   CHECK(near(s.camera().look_at, {0, 1, 4}));

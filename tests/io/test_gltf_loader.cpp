@@ -158,6 +158,10 @@ TEST_CASE("glTF groups are node names - else mesh names - else mesh and its inde
     // One scene mesh per placed primitive, two triangles each, and the material-less grey.
     REQUIRE(s.meshes().size() == 3);
     CHECK(s.polygons().size() == 6);
+    // Mesh::source: the node that places it and the primitive (what write_baked_gltf() reads).
+    CHECK(s.meshes()[0].source == "nodes[0]: meshes[0].primitives[0]");
+    CHECK(s.meshes()[1].source == "nodes[1]: meshes[0].primitives[0]");
+    CHECK(s.meshes()[2].source == "nodes[2]: meshes[1].primitives[0]");
     CHECK(s.material(s.polygons()[0].material).name == "default");
     CHECK(s.material(s.polygons()[0].material).reflectance == Rgb(0.5f));
   }

@@ -255,7 +255,7 @@ class AssimpReader {
                         "skipped");
     if (local.indices.empty()) return;
     if (add_placed_mesh(scene_, warnings_, std::move(local), world, material(mesh.mMaterialIndex), group, where(place),
-                        options_) > 0)
+                        options_, "nodes " + in_quotes(node_name) + ": meshes[" + std::to_string(m) + "]") > 0)
       skipped_ = true;
   }
 
