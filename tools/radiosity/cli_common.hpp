@@ -337,6 +337,13 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   return o;
 }
 
+/// The solution with light group `k` alone, at weight 1 (--light-groups: one group's share).
+inline rad::Solution light_group_alone(const rad::Solution& sol, std::size_t k) {
+  std::vector<rad::Rgb> weights(sol.light_groups().size(), rad::Rgb(0.0f));
+  weights.at(k) = rad::Rgb(1.0f);
+  return sol.relight(weights);
+}
+
 /// Help text for the SCENE argument of every command.
 constexpr const char* kSceneHelp =
     "Scene file (OBJ, JSON, glTF .gltf/.glb, or a format Assimp reads: FBX, COLLADA, 3DS, PLY, STL, ...), or a built-in "
