@@ -308,7 +308,8 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   add_strict_flag(cmd, a.strict);
   cmd.add_flag("--light-groups", a.light_groups,
                "Also solve each emitting group's light on its own (one more solve each, same form factors): solve "
-               "prints and --stats writes each light group's share, render writes an EXR layer per light group");
+               "prints and --stats writes each light group's share, render writes an EXR layer per light group, bake "
+               "each light group's lightmaps and PLYs");
   add_photometric_flag(cmd, a.photometric);
   cmd.add_flag("--two-sided", a.two_sided,
                "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
