@@ -25,6 +25,14 @@ struct LightmapOptions {
   /// renderer multiplies by its own albedo texture; the default), its direct or indirect part,
   /// or the radiosity B.
   Quantity quantity = Quantity::irradiance;
+  /// Whose light is baked: -1 (the default) all of it; k, light group k's contribution alone
+  /// (an index of Solution::light_groups(): solve with SolveOptions::separate_light_groups).
+  /// Interpolated: the group's values (Solution::light_group_values()). Final gather: only the
+  /// group's emitting polygons and lights count, for the exact direct light and where a gather
+  /// ray meets an emitter, and the gather rays read the group's pass-1 radiosity. The weights of
+  /// a relit solution (Solution::relight()) apply: group k at its weight, and with -1 every
+  /// emitter and light at its group's weight. >= -1.
+  int light_group = -1;
   /// false: the solution's field interpolated at the texel's surface point (as render() shows
   /// it; shadows are as sharp as the elements). true: a gather per texel: the light straight
   /// from the emitters by the exact point-to-polygon factor times a visible fraction from
@@ -74,9 +82,17 @@ struct Lightmap {
 /// texels it crosses) takes the value at the point of the triangle nearest to the texel centre,
 /// so a texel on a chart border reads the chart's edge; then `dilation` rings of gutter are
 /// filled. Throws Error{invalid_argument} for an unknown mesh, a mesh without UV1 (see
-/// generate_lightmap_uvs()), a solution not made from this scene, bad options, or a quantity
-/// the solution does not hold. Cost: interpolated, about the covered texels times the depth of
-/// the element quadtrees; final gather, gather_rays + shadow_rays x emitters rays per texel.
+/// generate_lightmap_uvs()), a solution not made from this scene, bad options, a quantity the
+/// solution does not hold, a light group it does not have, or (final gather of a light group or
+/// of a relit solution) light groups that are not the scene's materials' and lights'. Cost:
+/// interpolated, about the covered texels times the depth of the element quadtrees; final
+/// gather, gather_rays + shadow_rays x emitters rays per texel.
+/// Light groups add up: the sum over k of the lightmaps with light_group = k is the one with -1
+/// to within the solver's tolerance (the groups' own solves against the joint one, which is all
+/// that the interpolated values and the final gather's indirect part read). The final gather's
+/// direct part adds up exactly, up to float rounding, where a texel sees at most exact_emitters
+/// emitters (the same seed gives each group the same rays); where it sees more, the strongest
+/// are exact and the rest gathered, group by group, so the sum agrees statistically.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Lightmap bake_lightmap(const Scene& scene, const Solution& solution, MeshId mesh,
                                      const LightmapOptions& options = {});

@@ -80,9 +80,11 @@ RADIOSITY_API void validate(const RenderOptions& options);
 
 /// Ray-casts the solution: each camera ray shows the interpolated vertex radiosity / pi of the
 /// element it hits (Gouraud-style, continuous across elements); a ray that hits nothing shows
-/// the scene's sky (a LightType::sky light; black without one). Deterministic for a seed at any
-/// thread count. Throws Error{invalid_argument} for a non-positive size or spp, or a solution
-/// that was not made from this scene.
+/// the scene's sky (a LightType::sky light; black without one; in a relit solution at its light
+/// group's weight, so the images of one-group relights add up to the whole). Deterministic for a
+/// seed at any thread count. Throws Error{invalid_argument} for a non-positive size or spp, a
+/// solution that was not made from this scene, or a relit one whose light groups are not the
+/// scene's materials' and lights'.
 RADIOSITY_API Image render(const Scene& scene, const Solution& solution, const RenderOptions& options = {});
 
 /// Which pipeline turns a scene into an image (`radiosity render --mode`).

@@ -228,6 +228,11 @@ class RADIOSITY_API Solution {
   /// weight times its radiosity). Throws Error{invalid_argument} for a light group out of range
   /// or an unknown group.
   Rgb light_group_radiosity(std::size_t light_group, std::string_view group) const;
+  /// element_values() of light group `light_group`'s contribution to this solution: its weight
+  /// times its values (LightGroupSolution), per element id. For a light group's values on a host
+  /// mesh, relight() with that group's weight alone and ask the result's mesh_vertex_values() or
+  /// mesh_triangle_values(). Throws Error{invalid_argument} for a light group out of range.
+  std::vector<Rgb> light_group_values(std::size_t light_group, Quantity quantity) const;
   /// Gives the solution its light groups at weight 1 (solve() does). Throws
   /// Error{invalid_argument} when an array does not have one value per element (back_radiosity:
   /// or is empty).
@@ -249,6 +254,8 @@ class RADIOSITY_API Solution {
  private:
   GroupId group_id(std::string_view group) const;
   const SolvedMesh& solved_mesh(MeshId mesh) const;
+  /// light_groups()[light_group]; throws Error{invalid_argument} naming `caller` when out of range.
+  const LightGroupSolution& solved_light_group(std::size_t light_group, const char* caller) const;
 
   PatchHierarchy hierarchy_;
   std::vector<Rgb> radiosity_;

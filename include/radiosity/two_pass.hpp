@@ -116,12 +116,16 @@ RADIOSITY_API void validate(const TwoPassOptions& options);
 /// The four layers sum to the RGB image (up to float rounding). With no specular material and
 /// DiffuseShading::pass1, the image equals render() with the same size, spp, camera, seed and
 /// ambient setting. A material with its own Material::brdf cannot be split into a diffuse and a
-/// specular part: pass 2 samples all of it. The approximations (pass 1 carries no diffuse ->
+/// specular part: pass 2 samples all of it. A relit `pass1` (Solution::relight()) is rendered
+/// with every emitting polygon and light at its light group's weight (emission seen, direct
+/// light, caustic photons, the sky), so the renders of one-group relights add up to the whole,
+/// statistically (each draws its own emitter samples and photons). The approximations (pass 1 carries no diffuse ->
 /// specular -> diffuse light, glass is opaque to pass 1, no caustic photons from Light
 /// sources, ...) are listed in docs/TWO_PASS.md and docs/LIGHTS.md.
 ///
-/// Throws Error{invalid_argument} as validate() does or when `pass1` was not solved from
-/// `scene`, Error{internal} if Embree fails; an exception thrown by on_progress propagates.
+/// Throws Error{invalid_argument} as validate() does, when `pass1` was not solved from `scene`,
+/// or when a relit pass 1's light groups are not the scene's materials' and lights',
+/// Error{internal} if Embree fails; an exception thrown by on_progress propagates.
 /// Thread safety: concurrent calls are safe; the image is bit-identical at any thread count.
 RADIOSITY_API Image render_two_pass(const Scene& scene, const Solution& pass1, const TwoPassOptions& options = {});
 

@@ -34,6 +34,7 @@
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "scene/lights.hpp"
+#include "solver/light_groups.hpp"
 #include "image/image_loop.hpp"
 #include "radiosity/form_factors.hpp"
 #include "radiosity/lightmap.hpp"
@@ -243,7 +244,9 @@ struct Emitter {
 
 /// The final gather at one surface point: the direct light of the strongest emitters exactly
 /// (point-to-polygon factor times a visible fraction), the rest of the light by hemisphere rays
-/// that read pass 1's radiosity where they land.
+/// that read pass 1's radiosity where they land. Each emitting polygon and light counts at its
+/// weight (detail::emitter_weights(): 0 outside the light group baked), and pass 1's radiosity is
+/// the baked light group's.
 class FinalGather {
  public:
   FinalGather(const Scene& scene, const Solution& solution, const detail::RayScene& leaves,
@@ -252,15 +255,27 @@ class FinalGather {
         h_(solution.hierarchy()),
         leaves_(leaves),
         options_(options),
-        epsilon_(epsilon),
-        front_(solution.vertex_radiosity()),
-        back_(solution.vertex_back_radiosity()),
-        lights_(scene.lights()) {
+        epsilon_(epsilon) {
+    const detail::EmitterWeights weights =
+        detail::emitter_weights(scene, solution, options.light_group, "bake_lightmap");
+    lights_ = detail::SceneLights(scene.lights(), &weights.light);
+    if (options.light_group < 0) {
+      front_ = solution.vertex_radiosity();
+      back_ = solution.vertex_back_radiosity();
+    } else {
+      const auto k = static_cast<std::size_t>(options.light_group);
+      front_ = h_.vertex_values(solution.light_group_values(k, Quantity::radiosity));
+      std::vector<Rgb> back = solution.light_groups()[k].back_radiosity;
+      for (Rgb& b : back) b *= solution.light_group_weights()[k];
+      if (!back.empty()) back_ = h_.vertex_values(back);
+    }
     const std::vector<Polygon>& polygons = scene.polygons();
+    emission_.resize(polygons.size());
     for (PolygonId p = 0; p < polygons.size(); ++p) {
       const Material& m = scene.material(polygons[p].material);
-      if (detail::max_channel(m.emission) <= 0.0f) continue;
-      emitters_.push_back({p, m.emission, m.two_sided, detail::PolygonFan(polygons[p].vertices)});
+      emission_[p] = m.emission * weights.polygon[p];
+      if (detail::max_channel(emission_[p]) <= 0.0f) continue;
+      emitters_.push_back({p, emission_[p], m.two_sided, detail::PolygonFan(polygons[p].vertices)});
     }
   }
 
@@ -310,8 +325,7 @@ class FinalGather {
       const std::vector<Rgb>& field = front ? front_ : back_;
       const Rgb B = (1.0f - hit.u - hit.v) * field[tri[0]] + hit.u * field[tri[1]] + hit.v * field[tri[2]];
       const PolygonId q = h_.patches()[h_.element(hit.id).patch].polygon;
-      const Material& m = scene_.material(scene_.polygons()[q].material);
-      const Rgb E = (front || m.two_sided) ? m.emission : Rgb(0.0f);
+      const Rgb E = (front || scene_.material(scene_.polygons()[q].material).two_sided) ? emission_[q] : Rgb(0.0f);
       // An exact emitter's own light was counted above; what it reflects is indirect light.
       if (std::find(exact.begin(), exact.end(), q) == exact.end()) direct += E;
       indirect += glm::max(B - E, Rgb(0.0f));
@@ -374,6 +388,7 @@ class FinalGather {
   const LightmapOptions& options_;
   float epsilon_;
   std::vector<Rgb> front_, back_;  ///< pass 1's radiosity per hierarchy vertex
+  std::vector<Rgb> emission_;      ///< per polygon: its emission at its weight
   std::vector<Emitter> emitters_;
   detail::SceneLights lights_;
 };
@@ -428,6 +443,8 @@ void validate(const LightmapOptions& options) {
   if (options.exact_emitters < 0)
     bad_option("exact_emitters must be >= 0, got " + std::to_string(options.exact_emitters));
   if (options.dilation < 0) bad_option("dilation must be >= 0, got " + std::to_string(options.dilation));
+  if (options.light_group < -1)
+    bad_option("light_group must be >= -1 (-1 = all), got " + std::to_string(options.light_group));
   switch (options.quantity) {
     case Quantity::radiosity:
     case Quantity::irradiance:
@@ -461,8 +478,13 @@ Lightmap bake_lightmap(const Scene& scene, const Solution& solution, const std::
     if (id >= solution.meshes().size() || solution.meshes()[id].triangle_polygon != m.triangle_polygon)
       fail("mesh " + std::to_string(id) + " of the scene is not the mesh the solution was solved with");
   }
-  // The values to interpolate, or (final gather) a check that the solution holds what is asked.
-  const std::vector<Rgb> field = h.vertex_values(solution.element_values(options.quantity));
+  // The values to interpolate (the whole solution's, or one light group's), or (final gather) a
+  // check that the solution holds what is asked.
+  detail::check_light_group(solution, options.light_group, "bake_lightmap");
+  const std::vector<Rgb> field = h.vertex_values(
+      options.light_group < 0 ? solution.element_values(options.quantity)
+                              : solution.light_group_values(static_cast<std::size_t>(options.light_group),
+                                                            options.quantity));
 
   const int W = options.width, H = options.height;
   Lightmap map;

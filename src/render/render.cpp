@@ -20,6 +20,7 @@
 #include "image/image_options.hpp"
 #include "radiosity/render.hpp"
 #include "scene/lights.hpp"
+#include "solver/light_groups.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -46,7 +47,9 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
   const detail::RayScene rays = detail::RayScene::from_leaves(hierarchy);
   const std::vector<Rgb> vertex_B = solution.vertex_radiosity(options.ambient);
   const std::vector<Rgb> vertex_back = solution.vertex_back_radiosity();  // empty: every back is black
-  const detail::SceneLights lights(scene.lights());  // a ray that hits nothing sees the sky
+  // A ray that hits nothing sees the sky, at its light group's weight in a relit solution.
+  const detail::EmitterWeights weights = detail::emitter_weights(scene, solution, -1, "render");
+  const detail::SceneLights lights(scene.lights(), &weights.light);
 
   // spp rounded up to a square for a jittered g x g grid per pixel.
   const int g = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9));

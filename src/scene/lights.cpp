@@ -77,9 +77,15 @@ Rgb PreparedLight::sky_irradiance(const glm::vec3& n) const {
   return zenith_radiance * static_cast<float>((first + 2.0 * second) / 3.0);
 }
 
-SceneLights::SceneLights(const std::vector<Light>& lights) {
+SceneLights::SceneLights(const std::vector<Light>& lights, const std::vector<Rgb>* weights) {
   for (std::size_t i = 0; i < lights.size(); ++i) {
-    const PreparedLight p = prepare(lights[i], static_cast<LightId>(i));
+    PreparedLight p = prepare(lights[i], static_cast<LightId>(i));
+    if (weights) {
+      const Rgb w = (*weights)[i];
+      if (w == Rgb(0.0f)) continue;
+      p.power *= w;
+      p.zenith_radiance *= w;
+    }
     all_.push_back(p);
     (p.delta() ? delta_ : skies_).push_back(p);
   }

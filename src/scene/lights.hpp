@@ -70,7 +70,9 @@ struct Incidence {
 class SceneLights {
  public:
   SceneLights() = default;
-  explicit SceneLights(const std::vector<Light>& lights);
+  /// With `weights` (one per light), each light's power (a sky's radiance) is scaled by its
+  /// weight, and a light of weight 0 is left out: one light group's lights (bake_lightmap()).
+  explicit SceneLights(const std::vector<Light>& lights, const std::vector<Rgb>* weights = nullptr);
 
   bool empty() const { return delta_.empty() && skies_.empty(); }
   bool has_sky() const { return !skies_.empty(); }

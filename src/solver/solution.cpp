@@ -94,13 +94,17 @@ const std::vector<LightGroupSolution>& Solution::light_groups() const {
   return light_groups_ ? *light_groups_ : none;
 }
 
-Rgb Solution::light_group_radiosity(std::size_t light_group, std::string_view group) const {
+const LightGroupSolution& Solution::solved_light_group(std::size_t light_group, const char* caller) const {
   if (light_group >= light_groups().size())
-    throw Error(ErrorCode::invalid_argument, "Solution::light_group_radiosity: light group " +
+    throw Error(ErrorCode::invalid_argument, std::string("Solution::") + caller + ": light group " +
                                                  std::to_string(light_group) + " does not exist (" +
                                                  std::to_string(light_groups().size()) + " light groups)");
-  return light_group_weights_[light_group] *
-         group_mean(hierarchy_, (*light_groups_)[light_group].radiosity, group_id(group));
+  return (*light_groups_)[light_group];
+}
+
+Rgb Solution::light_group_radiosity(std::size_t light_group, std::string_view group) const {
+  const LightGroupSolution& g = solved_light_group(light_group, "light_group_radiosity");
+  return light_group_weights_[light_group] * group_mean(hierarchy_, g.radiosity, group_id(group));
 }
 
 double Solution::group_area(std::string_view group) const {
@@ -111,27 +115,46 @@ double Solution::group_area(std::string_view group) const {
   return area;
 }
 
-std::vector<Rgb> Solution::element_values(Quantity quantity) const {
+namespace {
+
+/// `quantity` from a solution's (or a light group's) radiosity B, irradiance H and its direct
+/// part D, per element id; `n` elements.
+std::vector<Rgb> quantity_values(std::size_t n, const std::vector<Rgb>& B, const std::vector<Rgb>& H,
+                                 const std::vector<Rgb>& D, Quantity quantity) {
   auto held = [&](const std::vector<Rgb>& v, const char* what) -> const std::vector<Rgb>& {
-    if (v.size() != hierarchy_.elements().size())
+    if (v.size() != n)
       throw Error(ErrorCode::invalid_argument, std::string("Solution: no ") + what +
                                                    " in this solution (a cancelled solve has no direct irradiance)");
     return v;
   };
   switch (quantity) {
-    case Quantity::radiosity: return radiosity_;
-    case Quantity::irradiance: return held(irradiance_, "irradiance");
-    case Quantity::direct_irradiance: return held(direct_irradiance_, "direct irradiance");
+    case Quantity::radiosity: return B;
+    case Quantity::irradiance: return held(H, "irradiance");
+    case Quantity::direct_irradiance: return held(D, "direct irradiance");
     case Quantity::indirect_irradiance: {
-      const std::vector<Rgb>& H = held(irradiance_, "irradiance");
-      const std::vector<Rgb>& D = held(direct_irradiance_, "direct irradiance");
-      std::vector<Rgb> out(H.size());
+      const std::vector<Rgb>& h = held(H, "irradiance");
+      const std::vector<Rgb>& d = held(D, "direct irradiance");
+      std::vector<Rgb> out(h.size());
       // Rounding may leave a hair below 0 where all light is direct.
-      for (std::size_t e = 0; e < H.size(); ++e) out[e] = glm::max(H[e] - D[e], Rgb(0.0f));
+      for (std::size_t e = 0; e < h.size(); ++e) out[e] = glm::max(h[e] - d[e], Rgb(0.0f));
       return out;
     }
   }
   throw Error(ErrorCode::invalid_argument, "Solution: unknown quantity");
+}
+
+}  // namespace
+
+std::vector<Rgb> Solution::element_values(Quantity quantity) const {
+  return quantity_values(hierarchy_.elements().size(), radiosity_, irradiance_, direct_irradiance_, quantity);
+}
+
+std::vector<Rgb> Solution::light_group_values(std::size_t light_group, Quantity quantity) const {
+  const LightGroupSolution& g = solved_light_group(light_group, "light_group_values");
+  std::vector<Rgb> out =
+      quantity_values(hierarchy_.elements().size(), g.radiosity, g.irradiance, g.direct_irradiance, quantity);
+  for (Rgb& v : out) v *= light_group_weights_[light_group];
+  return out;
 }
 
 const SolvedMesh& Solution::solved_mesh(MeshId mesh) const {

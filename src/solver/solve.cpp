@@ -12,10 +12,10 @@
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
 #include "form_factors/pass1_material.hpp"
+#include "solver/light_groups.hpp"
 #include "solver/light_shot.hpp"
 #include "solver/system.hpp"
 #include "core/assert.hpp"
-#include "core/color.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -208,30 +208,7 @@ std::vector<LightGroupSolution> Problem::Impl::solve_light_groups(const std::vec
   // same as in the joint shot: its own random stream).
   const std::vector<Polygon>& polygons = scene.polygons();
   const std::vector<Light>& lights = scene.lights();
-  struct Group {
-    std::string name;
-    std::vector<char> polygons;  // per GroupId of the scene: its emitting polygons shine
-    std::vector<char> lights;    // per light
-  };
-  std::vector<Group> groups;
-  auto group_named = [&](const std::string& name) -> Group& {
-    for (Group& g : groups)
-      if (g.name == name) return g;
-    groups.push_back(Group{name, std::vector<char>(scene.groups().size(), 0), std::vector<char>(lights.size(), 0)});
-    return groups.back();
-  };
-  // Emitting polygons by their group, in scene order; then the lights by their light group
-  // (else their name, else "light N"), joining a polygon group of the same name.
-  std::vector<char> emits(scene.groups().size(), 0);
-  for (PolygonId p = 0; p < polygons.size(); ++p)
-    if (detail::max_channel(detail::polygon_emission(scene, p, emission)) > 0.0f) emits[polygons[p].group] = 1;
-  for (GroupId g = 0; g < emits.size(); ++g)
-    if (emits[g]) group_named(scene.groups()[g]).polygons[g] = 1;
-  for (std::size_t k = 0; k < lights.size(); ++k) {
-    const Light& l = lights[k];
-    group_named(!l.light_group.empty() ? l.light_group : !l.name.empty() ? l.name : "light " + std::to_string(k))
-        .lights[k] = 1;
-  }
+  const std::vector<detail::LightGroupMembers> groups = detail::light_group_members(scene, emission);
 
   // The joint solve refined the hierarchy; the groups are solved on it as it is.
   struct KeepAdaptive {
@@ -248,9 +225,9 @@ std::vector<LightGroupSolution> Problem::Impl::solve_light_groups(const std::vec
   std::vector<LightGroupSolution> out;
   std::vector<Rgb> group_emission(polygons.size());
   detail::LightShot shot;
-  for (const Group& g : groups) {
+  for (const detail::LightGroupMembers& g : groups) {
     for (PolygonId p = 0; p < polygons.size(); ++p)
-      group_emission[p] = g.polygons[polygons[p].group] ? detail::polygon_emission(scene, p, emission) : Rgb(0.0f);
+      group_emission[p] = g.groups[polygons[p].group] ? detail::polygon_emission(scene, p, emission) : Rgb(0.0f);
     if (!lights.empty()) {
       shot = detail::LightShot{};
       if (!light_shooter && !shoot_lights({}, gate)) return {};  // makes the shooter

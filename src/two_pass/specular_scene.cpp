@@ -26,8 +26,10 @@ namespace {
 
 }  // namespace
 
-SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy)
-    : hierarchy_(&hierarchy), rays_(RayScene::from_leaves(hierarchy)), lights_(scene.lights()) {
+SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights)
+    : hierarchy_(&hierarchy),
+      rays_(RayScene::from_leaves(hierarchy)),
+      lights_(scene.lights(), weights ? &weights->light : nullptr) {
   const auto& polygons = scene.polygons();
   for (const Patch& p : hierarchy.patches())
     if (p.polygon >= polygons.size())
@@ -59,7 +61,7 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
     SplitSurface& s = surfaces_[p];
     s.normal = poly.normal;
     s.origin = poly.vertices[0];
-    s.emission = m.emission;
+    s.emission = weights ? m.emission * weights->polygon[p] : m.emission;
     s.uses_pass1 = !own_brdf[poly.material];
     s.diffuse = s.uses_pass1 ? m.reflectance : Rgb(0.0f);
     s.specular = specular[poly.material];
@@ -70,9 +72,9 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
     s.ior = m.ior;
     if (s.specular) has_specular_ = true;
 
-    const double power = static_cast<double>(m.emission.x + m.emission.y + m.emission.z) * poly.area;
+    const double power = static_cast<double>(s.emission.x + s.emission.y + s.emission.z) * poly.area;
     if (!(power > 0.0)) continue;
-    emitted_power_ += m.emission * poly.area;
+    emitted_power_ += s.emission * poly.area;
     Emitter e;
     e.polygon = static_cast<std::uint32_t>(p);
     e.fan = PolygonFan(poly.vertices);

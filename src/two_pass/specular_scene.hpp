@@ -18,6 +18,7 @@
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 #include "scene/lights.hpp"
+#include "solver/light_groups.hpp"
 
 namespace radiosity::detail {
 
@@ -25,7 +26,7 @@ namespace radiosity::detail {
 struct SplitSurface {
   glm::vec3 normal{0.0f};
   glm::vec3 origin{0.0f};  ///< a vertex, to snap hit points onto the plane
-  Rgb emission{0.0f};      ///< exitance E, W/m^2
+  Rgb emission{0.0f};      ///< exitance E, W/m^2 (at its light group's weight)
   /// The Lambertian reflectance that pass 1 carries (Material::reflectance), or 0 when the
   /// material has its own Brdf (then pass 2 samples the whole model; see TWO_PASS.md).
   Rgb diffuse{0.0f};
@@ -55,8 +56,10 @@ struct EmitterSample {
 /// Thread safety: immutable after construction; every const member may be called concurrently.
 class SpecularScene {
  public:
+  /// Each emitting polygon and light shines at its weight in `weights` (emitter_weights(): a
+  /// relit solution's light groups), a polygon or light of weight 0 not at all; null: all at 1.
   /// Throws Error{invalid_argument} if the hierarchy refers to polygons `scene` does not have.
-  SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy);
+  SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights = nullptr);
 
   const RayScene& rays() const { return rays_; }
   const PatchHierarchy& hierarchy() const { return *hierarchy_; }

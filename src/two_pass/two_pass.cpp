@@ -62,6 +62,13 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// The scene as pass 2 traces it, its emitters and lights at the weights of pass 1's light
+/// groups (all 1 unless pass 1 was relit).
+detail::SpecularScene traced_scene(const Scene& scene, const Solution& pass1) {
+  const detail::EmitterWeights weights = detail::emitter_weights(scene, pass1, -1, "render_two_pass");
+  return detail::SpecularScene(scene, pass1.hierarchy(), &weights);
+}
+
 /// The four layers of one camera ray.
 struct Radiance {
   Rgb layer[kLayers] = {Rgb(0.0f), Rgb(0.0f), Rgb(0.0f), Rgb(0.0f)};
@@ -72,7 +79,7 @@ class TwoPassRenderer {
   TwoPassRenderer(const Scene& scene, const Solution& pass1, const TwoPassOptions& options, TwoPassReport& report)
       : options_(options),
         camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
-        scene_(scene, pass1.hierarchy()),
+        scene_(traced_scene(scene, pass1)),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
     auto start = std::chrono::steady_clock::now();
     vertex_B_ = pass1.vertex_radiosity(options.ambient);

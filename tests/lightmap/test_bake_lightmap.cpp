@@ -1,7 +1,8 @@
 // bake_lightmap(): a floor under an area light against the closed-form irradiance E F(x -> light)
 // texel by texel (interpolated and final gather; with a blocker, against the exact factor of the
 // light's unblocked part), seams of a furnace cube whose faces are separate charts (dilation),
-// conservative coverage of a sliver, determinism and errors.
+// conservative coverage of a sliver, determinism and errors; light groups: their lightmaps add up
+// to the whole, and one group's final gather sees only its own lights.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -101,6 +102,92 @@ rad::Rgb bilinear(const rad::Image& image, glm::vec2 uv) {
   };
   return (1 - tx) * (1 - ty) * at(x0, y0) + tx * (1 - ty) * at(x0 + 1, y0) + (1 - tx) * ty * at(x0, y0 + 1) +
          tx * ty * at(x0 + 1, y0 + 1);
+}
+
+/// A floor lit by four light groups, in Solution::light_groups() order: "light" (the area
+/// light of LitFloor, reflectance 0.3, joined by a directional light of that light group),
+/// "panel" (a small, brighter area light to the side), "bulb" (a point light) and "sky" (a
+/// uniform sky); a wall at x = 1 reflects light back onto the floor.
+struct GroupedFloor {
+  rad::Scene scene;
+  rad::MeshId floor = 0;
+  Floor mesh;
+  GroupedFloor() {
+    rad::Material white;
+    white.reflectance = rad::Rgb(0.5f);
+    rad::Material lamp;
+    lamp.reflectance = rad::Rgb(0.3f);
+    lamp.emission = rad::Rgb(kE);
+    rad::Material panel = lamp;
+    panel.emission = rad::Rgb(2.0f * kE, kE, 0.5f * kE);
+    const rad::MaterialId w = scene.add_material(white);
+    floor = scene.add_mesh(mesh.desc(w));
+    rad::add_quad(scene, {0.3f, 0.3f, 0.5f}, {0.0f, 0.4f, 0.0f}, {0.4f, 0.0f, 0.0f}, scene.add_material(lamp), "light");
+    rad::add_quad(scene, {0.05f, 0.05f, 0.6f}, {0.0f, 0.2f, 0.0f}, {0.2f, 0.0f, 0.0f}, scene.add_material(panel),
+                  "panel");
+    rad::add_quad(scene, {1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {0.0f, 1.0f, 0.0f}, w, "wall");
+    rad::Light sun, sky;
+    sun.type = rad::LightType::directional;
+    sun.direction = {0.3f, 0.2f, -1.0f};
+    sun.intensity = 1.0f;
+    sun.light_group = "light";
+    sky.type = rad::LightType::sky;
+    sky.name = "sky";
+    sky.direction = {0.0f, 0.0f, 1.0f};
+    sky.intensity = 0.5f;
+    scene.add_light(sun);
+    scene.add_light(test::point_light("bulb", 0.5f, {0.8f, 0.2f, 0.3f}));
+    scene.add_light(sky);
+  }
+};
+
+/// The largest difference between `sum` and `whole` over the texels `whole` covers, relative to
+/// the brightest of them (green channel), the mean of the texels' own relative differences, and
+/// the relative difference of their totals.
+struct Agreement {
+  double worst = 0.0;
+  double mean = 0.0;
+  double total = 0.0;
+};
+Agreement agreement(const std::vector<rad::Rgb>& sum, const rad::Lightmap& whole) {
+  float brightest = 0.0f;
+  for (std::size_t i = 0; i < sum.size(); ++i)
+    if (whole.state[i] == rad::TexelState::covered) brightest = std::max(brightest, whole.image.pixels[i].y);
+  Agreement a;
+  std::size_t count = 0;
+  double sum_total = 0.0, whole_total = 0.0;
+  for (std::size_t i = 0; i < sum.size(); ++i) {
+    if (whole.state[i] != rad::TexelState::covered) continue;
+    const double d = std::abs(static_cast<double>(sum[i].y) - whole.image.pixels[i].y);
+    a.worst = std::max(a.worst, d / brightest);
+    a.mean += d / whole.image.pixels[i].y;
+    sum_total += sum[i].y;
+    whole_total += whole.image.pixels[i].y;
+    ++count;
+  }
+  a.mean /= static_cast<double>(count);
+  a.total = std::abs(sum_total - whole_total) / whole_total;
+  return a;
+}
+
+/// A size x size lightmap, interpolated or final-gathered with `rays` gather rays.
+rad::LightmapOptions lightmap_options(int size, bool gather, int rays = 16) {
+  rad::LightmapOptions o;
+  o.width = o.height = size;
+  o.final_gather = gather;
+  o.gather_rays = rays;
+  return o;
+}
+
+/// The sum over light groups of the lightmaps baked with light_group = k.
+std::vector<rad::Rgb> sum_of_groups(const GroupedFloor& lit, const rad::Solution& sol, rad::LightmapOptions o) {
+  std::vector<rad::Rgb> sum(static_cast<std::size_t>(o.width) * o.height, rad::Rgb(0.0f));
+  for (std::size_t k = 0; k < sol.light_groups().size(); ++k) {
+    o.light_group = static_cast<int>(k);
+    const rad::Lightmap part = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+    for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += part.image.pixels[i];
+  }
+  return sum;
 }
 
 }  // namespace
@@ -442,5 +529,136 @@ TEST_SUITE("lightmap") {
     rad::add_quad(quads, {0.3f, 0.3f, 0.5f}, {0.0f, 0.4f, 0.0f}, {0.4f, 0.0f, 0.0f}, quads.add_material(lamp));
     const rad::Solution other = rad::solve(quads);
     CHECK(message([&] { rad::bake_lightmap(lit.scene, other, lit.floor); }).find("not the mesh") != std::string::npos);
+  }
+
+  TEST_CASE("bake_lightmap: the light groups' lightmaps add up to the whole - interpolated and final gather") {
+    const GroupedFloor lit;
+    rad::SolveOptions so;
+    so.mesh.max_patch_area = 0.01f;
+    so.mesh.max_element_area = 0.0025f;
+    so.tolerance = 1e-6;
+    so.separate_light_groups = true;
+    const rad::Solution sol = rad::solve(lit.scene, so);
+    REQUIRE(sol.light_groups().size() == 4);
+    CHECK(sol.light_groups()[0].name == "light");
+    CHECK(sol.light_groups()[1].name == "panel");
+    CHECK(sol.light_groups()[2].name == "bulb");
+    CHECK(sol.light_groups()[3].name == "sky");
+    // A relit solution bakes its weights: each group at its own, the whole at every group's.
+    const rad::Solution relit =
+        sol.relight({rad::Rgb(0.5f), rad::Rgb(2.0f), rad::Rgb(0.0f), rad::Rgb(1.0f, 0.5f, 0.25f)});
+    for (const rad::Solution* s : {&sol, &relit}) {
+      for (bool gather : {false, true}) {
+        CAPTURE(gather);
+        CAPTURE(s == &relit);
+        const rad::LightmapOptions o = lightmap_options(32, gather);
+        const rad::Lightmap whole = rad::bake_lightmap(lit.scene, *s, lit.floor, o);
+        const Agreement a = agreement(sum_of_groups(lit, *s, o), whole);
+        const std::string what = std::string(s == &relit ? "relit, " : "solved, ") +
+                                 (gather ? "final gather" : "interpolated");
+        MESSAGE(what << ": sum of the groups against the whole: largest difference " << a.worst
+                     << " of the brightest texel, mean " << a.mean);
+        // Every texel's emitters are exact (2 <= exact_emitters) and each group casts the same
+        // rays (same seed and texel), so only float rounding and the solver's tolerance (1e-6:
+        // the groups' own solves against the joint one) separate them.
+        CHECK(a.worst < 1e-5);
+      }
+    }
+    // Final gather with exact_emitters = 1: where the whole takes the light group's lamp exactly
+    // and the panel by gather rays, the panel's own bake takes it exactly: the sum agrees only
+    // statistically, texel by texel within the noise of the gather rays, and over the map (the
+    // estimators are unbiased) within a fraction of it.
+    rad::LightmapOptions o = lightmap_options(32, true, 64);
+    o.exact_emitters = 1;
+    const rad::Lightmap whole = rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+    const Agreement a = agreement(sum_of_groups(lit, sol, o), whole);
+    MESSAGE("final gather, exact_emitters 1: largest difference " << a.worst << " of the brightest texel, mean "
+                                                                  << a.mean << ", totals " << a.total);
+    CHECK(a.worst > 1e-3);  // not exact: the exact and gathered emitters differ between the bakes
+    CHECK(a.mean < 0.05);
+    CHECK(a.total < 0.005);
+  }
+
+  TEST_CASE("bake_lightmap: a light group's point light over a floor bakes I cos / r^2 with other groups on") {
+    // Light groups "panel" (an area light to the side, above the point light), "lamp" (the point
+    // light) and "other" (a second point light).
+    rad::Scene scene;
+    Floor mesh;
+    rad::Material white;
+    white.reflectance = rad::Rgb(0.5f);
+    rad::Material panel;
+    panel.emission = rad::Rgb(kE);
+    const rad::MeshId floor = scene.add_mesh(mesh.desc(scene.add_material(white)));
+    rad::add_quad(scene, {0.75f, 0.05f, 0.6f}, {0.0f, 0.2f, 0.0f}, {0.2f, 0.0f, 0.0f}, scene.add_material(panel),
+                  "panel");
+    const rad::Light lamp = test::point_light("lamp", 2.0f, {0.4f, 0.6f, 0.5f});
+    scene.add_light(lamp);
+    scene.add_light(test::point_light("other", 1.0f, {0.8f, 0.8f, 0.3f}));
+    rad::SolveOptions so = fine_solve();
+    so.separate_light_groups = true;
+    const rad::Solution sol = rad::solve(scene, so);
+    REQUIRE(sol.light_groups().size() == 3);
+    REQUIRE(sol.light_groups()[1].name == "lamp");
+    for (bool gather : {false, true}) {
+      CAPTURE(gather);
+      rad::LightmapOptions o = lightmap_options(32, gather);
+      o.quantity = rad::Quantity::direct_irradiance;
+      const rad::Lightmap all = rad::bake_lightmap(scene, sol, floor, o);
+      o.light_group = 1;
+      const rad::Lightmap map = rad::bake_lightmap(scene, sol, floor, o);
+      double worst = 0.0, others = 1e30;
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+          const glm::vec3 p = Floor::point(x, y, 32);
+          if (std::min({p.x, p.y, 1.0f - p.x, 1.0f - p.y}) < 0.05f) continue;
+          const glm::vec3 d = lamp.position - p;
+          const double expected = lamp.intensity * d.z / std::pow(glm::dot(d, d), 1.5);
+          worst = std::max(worst, std::abs(map.image.at(x, y).y - expected) / expected);
+          others = std::min(others, (all.image.at(x, y).y - expected) / expected);
+        }
+      MESSAGE("light group lamp, direct, " << (gather ? "final gather" : "interpolated") << ": largest relative error "
+                                           << worst << "; the other groups add at least " << others);
+      // Gathered: the point light exact at the texel's point (as with no other light); the
+      // interpolated group values: the element mesh's interpolation error.
+      CHECK(worst < (gather ? 1e-3 : 0.01));
+      CHECK(others > 0.05);  // the other groups do shine on every texel
+    }
+  }
+
+  TEST_CASE("bake_lightmap: light group errors name the problem") {
+    const LitFloor lit(false);
+    auto message = [&](const rad::Solution& sol, const rad::LightmapOptions& o) -> std::string {
+      try {
+        rad::bake_lightmap(lit.scene, sol, lit.floor, o);
+      } catch (const rad::Error& e) {
+        CHECK(e.code() == rad::ErrorCode::invalid_argument);
+        return e.what();
+      }
+      return "no error";
+    };
+    rad::LightmapOptions o = lightmap_options(8, false, 4);
+    o.light_group = 0;
+    const rad::Solution plain = rad::solve(lit.scene);
+    CHECK(message(plain, o).find("the solution has no light groups") != std::string::npos);
+    rad::SolveOptions so;
+    so.separate_light_groups = true;
+    const rad::Solution grouped = rad::solve(lit.scene, so);
+    o.light_group = 1;
+    CHECK(message(grouped, o).find("light group 1 does not exist (the solution has 1 light groups") !=
+          std::string::npos);
+    o.light_group = -2;
+    CHECK(message(grouped, o).find("light_group must be >= -1") != std::string::npos);
+    // Solved with other emission than the materials': the light is off, a blocker-free floor
+    // emits instead, so the solution's light group is "floor", the scene's "light".
+    rad::Problem problem(lit.scene, so);
+    std::vector<rad::Rgb> emission(lit.scene.polygons().size(), rad::Rgb(0.0f));
+    emission.front() = rad::Rgb(1.0f);
+    const rad::Solution other = problem.solve(emission);
+    REQUIRE(other.light_groups().size() == 1);
+    o.light_group = 0;
+    CHECK(message(other, o) == "no error");  // interpolated: the solution's own values
+    o.final_gather = true;
+    CHECK(message(other, o).find("light groups (floor) are not those of the scene's emitters and lights (light)") !=
+          std::string::npos);
   }
 }

@@ -37,6 +37,15 @@ inline rad::Scene closed_box(const rad::Material& m, glm::vec3 s = glm::vec3(1.0
   return scene;
 }
 
+/// A point light named `name` (a light group of its own) of `intensity` W/sr at `position`.
+inline rad::Light point_light(const char* name, float intensity, const glm::vec3& position) {
+  rad::Light l;
+  l.name = name;
+  l.intensity = intensity;
+  l.position = position;
+  return l;
+}
+
 /// A MeshDesc over the caller's arrays (which must outlive the add_mesh call), every triangle of
 /// `material`, with UV1 when `uv1` is not empty.
 inline rad::MeshDesc mesh_desc(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,

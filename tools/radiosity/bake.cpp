@@ -44,11 +44,11 @@ rad::Quantity quantity_from_name(const std::string& name) {
                               : rad::Quantity::irradiance;
 }
 
-/// A file name from a group name: letters, digits, '-' and '_' kept, the rest '_'; unique in
-/// `taken` (the mesh id appended when needed).
-std::string file_stem(const std::string& group, rad::MeshId id, std::set<std::string>& taken) {
+/// A file name from a group's (or light group's) name: letters, digits, '-' and '_' kept, the
+/// rest '_'; unique in `taken` (`id`, the mesh id or light group index, appended when needed).
+std::string file_stem(const std::string& name, std::size_t id, std::set<std::string>& taken) {
   std::string stem;
-  for (const char c : group) stem += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+  for (const char c : name) stem += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
   if (stem.empty()) stem = "mesh";
   if (!taken.insert(stem).second) {
     stem += "_" + std::to_string(id);
@@ -81,9 +81,69 @@ bool is_gltf(const std::string& path) {
   return ext == ".glb" || ext == ".gltf";
 }
 
+/// Bakes mesh `id` of `sol` (whose light: lo.light_group) and writes the lightmap to `exr` and
+/// its preview to `png`. Throws when the bake is cancelled.
+rad::Lightmap bake_to(const rad::Scene& scene, const rad::Solution& sol, rad::MeshId id, const rad::LightmapOptions& lo,
+                      const fs::path& exr, const fs::path& png, const rad::PngOptions& po, ProgressBar& bar) {
+  rad::Lightmap map = rad::bake_lightmap(scene, sol, id, lo);
+  bar.finish();
+  if (map.cancelled) throw rad::Error(rad::ErrorCode::invalid_argument, "bake cancelled");
+  rad::write_exr(map.image, exr);
+  rad::write_png(map.image, png, po);
+  return map;
+}
+
+/// --light-groups: each light group's contribution alone, in DIR/light_groups/<light group>/:
+/// per mesh its lightmap (EXR, PNG at the total's exposure `po`) and its PLY (the solution
+/// relit with that group alone, colours `ply_colours`), named by `stems`; `meshes` (the
+/// manifest's entries, by mesh id) get each group's files. Returns the manifest's
+/// "light_groups" list.
+Json write_light_groups(const rad::Scene& scene, const rad::Solution& sol, const BakeArgs& a, rad::LightmapOptions lo,
+                        const rad::PngOptions& po, const rad::PngOptions& ply_colours,
+                        const std::vector<std::string>& stems, Json& meshes, ProgressBar& bar) {
+  Json groups = Json::array();
+  std::set<std::string> taken;
+  for (std::size_t k = 0; k < sol.light_groups().size(); ++k) {
+    const std::string& name = sol.light_groups()[k].name;
+    const fs::path folder = fs::path("light_groups") / file_stem(name, k, taken);
+    std::error_code made;
+    fs::create_directories(fs::path(a.output) / folder, made);
+    if (made)
+      throw rad::Error(rad::ErrorCode::io_error,
+                       "cannot create the folder '" + (fs::path(a.output) / folder).string() + "': " + made.message());
+    // The group's share on the vertices: the solution with that group alone.
+    const rad::Solution alone = a.vertex_colors ? light_group_alone(sol, k) : rad::Solution();
+    lo.light_group = static_cast<int>(k);
+    double seconds = 0.0;
+    for (rad::MeshId id = 0; id < scene.meshes().size(); ++id) {
+      Json files = {{"name", name}};
+      const fs::path base = folder / stems[id];
+      if (a.lightmap > 0) {
+        const fs::path exr = base.string() + ".exr", png = base.string() + ".png";
+        seconds += bake_to(scene, sol, id, lo, fs::path(a.output) / exr, fs::path(a.output) / png, po, bar).seconds;
+        files["lightmap"] = exr.generic_string();
+        files["preview"] = png.generic_string();
+      }
+      if (a.vertex_colors) {
+        const fs::path ply = base.string() + ".ply";
+        rad::write_mesh_ply(scene, alone, id, fs::path(a.output) / ply, ply_colours);
+        files["ply"] = ply.generic_string();
+      }
+      meshes[id]["light_groups"].push_back(files);
+    }
+    groups.push_back({{"name", name}, {"folder", folder.generic_string()}});
+    std::printf("light group %s: %s (%.2f s)\n", name.c_str(), folder.generic_string().c_str(), seconds);
+  }
+  return groups;
+}
+
 int run_bake(const BakeArgs& a) {
   return run_guarded([&] {
     ProgressBar bar;
+    // Refused before the solve it would waste.
+    if (is_gltf(a.output) && a.solve.light_groups)
+      throw rad::Error(rad::ErrorCode::invalid_argument,
+                       "--light-groups needs an output folder (a .glb/.gltf holds the total only)");
     rad::Scene scene = load(a.solve.scene, a.solve.strict, a.solve.two_sided, a.solve.photometric);
     print_warnings(scene.warnings());
     // Surfaces that came as polygons (OBJ faces, JSON shapes, the built-in scenes) are baked per
@@ -195,22 +255,19 @@ int run_bake(const BakeArgs& a) {
                             {"texel_centre", "((x + 0.5) / width, (y + 0.5) / height) = UV1; row 0 at v = 0"}};
     Json meshes = Json::array();
     std::set<std::string> taken;
+    std::vector<std::string> stems;
     double bake_seconds = 0.0;
     for (rad::MeshId id = 0; id < scene.meshes().size(); ++id) {
       const rad::Mesh& m = scene.meshes()[id];
-      const std::string stem = file_stem(scene.groups()[m.group], id, taken);
+      const std::string stem = stems.emplace_back(file_stem(scene.groups()[m.group], id, taken));
       std::size_t kept = 0;
       for (rad::PolygonId p : m.triangle_polygon) kept += p != rad::kNone ? 1 : 0;
       Json entry = {{"id", id},          {"group", scene.groups()[m.group]}, {"vertices", m.positions.size()},
                     {"triangles", kept}, {"uv1", a.lightmap > 0 ? uv_source[id] : "none"}};
       if (a.lightmap > 0) {
-        const rad::Lightmap map = rad::bake_lightmap(scene, sol, id, lo);
-        bar.finish();
-        if (map.cancelled) throw rad::Error(rad::ErrorCode::invalid_argument, "bake cancelled");
-        bake_seconds += map.seconds;
         const fs::path exr = fs::path(a.output) / (stem + ".exr"), png = fs::path(a.output) / (stem + ".png");
-        rad::write_exr(map.image, exr);
-        rad::write_png(map.image, png, po);
+        const rad::Lightmap map = bake_to(scene, sol, id, lo, exr, png, po, bar);
+        bake_seconds += map.seconds;
         entry["lightmap"] = {{"file", exr.filename().string()},
                              {"preview", png.filename().string()},
                              {"width", map.image.width},
@@ -227,15 +284,17 @@ int run_bake(const BakeArgs& a) {
       }
       meshes.push_back(entry);
     }
+    if (a.lightmap > 0)
+      std::printf("lightmaps: %zu at %dx%d, %s%s, %.2f s\n", scene.meshes().size(), a.lightmap, a.lightmap,
+                  a.quantity.c_str(), a.final_gather ? " (final gather)" : " (interpolated)", bake_seconds);
+    if (!sol.light_groups().empty())
+      manifest["light_groups"] = write_light_groups(scene, sol, a, lo, po, ply_colours, stems, meshes, bar);
     manifest["meshes"] = meshes;
     const fs::path manifest_path = fs::path(a.output) / "manifest.json";
     std::ofstream out(manifest_path);
     out << manifest.dump(2) << "\n";
     out.close();
     if (!out) throw rad::Error(rad::ErrorCode::io_error, "cannot write '" + manifest_path.string() + "'");
-    if (a.lightmap > 0)
-      std::printf("lightmaps: %zu at %dx%d, %s%s, %.2f s\n", scene.meshes().size(), a.lightmap, a.lightmap,
-                  a.quantity.c_str(), a.final_gather ? " (final gather)" : " (interpolated)", bake_seconds);
     std::printf("wrote %s (%zu meshes)\n", fs::absolute(manifest_path).c_str(), scene.meshes().size());
     return 0;
   });

@@ -308,7 +308,8 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   add_strict_flag(cmd, a.strict);
   cmd.add_flag("--light-groups", a.light_groups,
                "Also solve each emitting group's light on its own (one more solve each, same form factors): solve "
-               "prints and --stats writes each light group's share, render writes an EXR layer per light group");
+               "prints and --stats writes each light group's share, render writes an EXR layer per light group, bake "
+               "each light group's lightmaps and PLYs");
   add_photometric_flag(cmd, a.photometric);
   cmd.add_flag("--two-sided", a.two_sided,
                "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
@@ -335,6 +336,13 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.separate_light_groups = a.light_groups;
   o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
   return o;
+}
+
+/// The solution with light group `k` alone, at weight 1 (--light-groups: one group's share).
+inline rad::Solution light_group_alone(const rad::Solution& sol, std::size_t k) {
+  std::vector<rad::Rgb> weights(sol.light_groups().size(), rad::Rgb(0.0f));
+  weights.at(k) = rad::Rgb(1.0f);
+  return sol.relight(weights);
 }
 
 /// Help text for the SCENE argument of every command.

@@ -2,6 +2,7 @@
 // Output formats are a contract that scripts parse: see docs/CLI.md.
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -102,9 +103,9 @@ int main(int argc, char** argv) {
                   .add(direct_only ? rad::RenderMode::two_pass : rad::RenderMode::automatic, "--direct-only")
                   .conflict;
     if (!conflict.empty()) return argument_error("render", conflict);
-    if (render_args.light_groups && requested.mode != rad::RenderMode::automatic &&
-        requested.mode != rad::RenderMode::radiosity)
-      return argument_error("render", "--light-groups needs --mode radiosity (or auto on a diffuse scene)");
+    if (render_args.light_groups && requested.mode == rad::RenderMode::path)
+      return argument_error("render", "--light-groups needs a solve: --mode radiosity, two-pass or auto (the path "
+                                      "tracer solves nothing)");
   }
 
   return run_guarded([&] {
@@ -135,10 +136,6 @@ int main(int argc, char** argv) {
       // The pipeline: as asked, else the one the scene needs.
       const rad::RenderMode needed = rad::choose_render_mode(scene);
       const rad::RenderMode mode = requested.mode == rad::RenderMode::automatic ? needed : requested.mode;
-      if (render_args.light_groups && mode != rad::RenderMode::radiosity)
-        throw rad::Error(rad::ErrorCode::invalid_argument,
-                         "--light-groups: the scene needs the two-pass view (it has specular materials); light group "
-                         "layers are made by --mode radiosity only");
       std::string why = requested.mode == rad::RenderMode::automatic ? "automatic: " : requested.source;
       if (requested.mode == rad::RenderMode::automatic)
         why += mode == rad::RenderMode::radiosity  ? "every material is diffuse"
@@ -162,6 +159,14 @@ int main(int argc, char** argv) {
       }
       std::printf("mode: %s (%s)\n", rad::to_string(mode), why.c_str());
       std::fflush(stdout);
+      // --light-groups: one layer per light group, the image of that group's light alone (its
+      // emitters and lights, and its share of pass 1).
+      auto add_light_group_layers = [](rad::Image& image, const rad::Solution& sol,
+                                       const std::function<rad::Image(const rad::Solution&)>& draw) {
+        for (std::size_t k = 0; k < sol.light_groups().size(); ++k)
+          image.layers.emplace_back("light_group_" + sol.light_groups()[k].name,
+                                    draw(light_group_alone(sol, k)).pixels);
+      };
 
       rad::Image image;
       if (mode == rad::RenderMode::path) {
@@ -189,6 +194,8 @@ int main(int argc, char** argv) {
                                   : rad::TwoPassContent::full;
         rad::TwoPassReport report;
         image = rad::render_two_pass(scene, sol, to, report);
+        add_light_group_layers(image, sol,
+                               [&](const rad::Solution& part) { return rad::render_two_pass(scene, part, to); });
         bar.finish();
         std::printf("two-pass: %d samples per pixel, %zu of %zu caustic photons stored\n", to.spp,
                     report.photons_stored, report.photons_emitted);
@@ -203,13 +210,7 @@ int main(int argc, char** argv) {
         ro.wireframe = wireframe;
         ro.ambient = ambient;
         image = rad::render(scene, sol, ro);
-        // One layer per light group: the display of that group's light alone.
-        for (std::size_t k = 0; k < sol.light_groups().size(); ++k) {
-          std::vector<rad::Rgb> weights(sol.light_groups().size(), rad::Rgb(0.0f));
-          weights[k] = rad::Rgb(1.0f);
-          rad::Image part = rad::render(scene, sol.relight(weights), ro);
-          image.layers.emplace_back("light_group_" + sol.light_groups()[k].name, std::move(part.pixels));
-        }
+        add_light_group_layers(image, sol, [&](const rad::Solution& part) { return rad::render(scene, part, ro); });
         bar.finish();
       }
       rad::write_exr(image, out);
