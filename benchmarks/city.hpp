@@ -1,7 +1,8 @@
 // A procedural city of facets (issue #15's benchmark scene): a ground of streets and blocks, boxes
 // of random height standing on the blocks, every surface cut into quads of about one facet size,
-// under a sky. Built through the public API only, so benchmarks (bench_city) and tests
-// (tests/scene/test_city.cpp) share it. Header-only.
+// under a sky. Built through the public API (its random numbers from the library's
+// core/rng.hpp), so benchmarks (bench_city) and tests (tests/scene/test_city.cpp) share it.
+// Header-only.
 //
 // Layout, in metres, y up: n x n square blocks of kCityBlock, with streets of kCityStreet between
 // them and around the edge, so the city is n (kCityBlock + kCityStreet) + kCityStreet wide in x
@@ -45,6 +46,8 @@
 
 #include <glm/vec3.hpp>
 #include <radiosity/radiosity.hpp>
+
+#include "core/rng.hpp"  // src/ is on the benchmarks' and the tests' include paths
 
 namespace bench {
 
@@ -90,21 +93,12 @@ inline int city_cells(double length, double facet_size) {
 
 namespace city_detail {
 
-/// SplitMix64 (Steele, Lea & Flood 2014): the same numbers on every platform, unlike the
-/// standard distributions.
-inline std::uint64_t mix(std::uint64_t z) {
-  z += 0x9e3779b97f4a7c15ull;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
 /// A random stream per block, keyed by the seed and the block's place, so a block is the same
-/// in every city that has it (a larger city contains the smaller ones).
+/// in every city that has it (a larger city contains the smaller ones). SplitMix64 steps (the
+/// library's mix64) give the same numbers on every platform, unlike the standard distributions.
 class BlockRandom {
  public:
-  BlockRandom(std::uint64_t seed, int i, int j)
-      : state_(mix(mix(seed) ^ mix(0x100000000ull * static_cast<std::uint64_t>(i) + static_cast<std::uint64_t>(j)))) {}
+  BlockRandom(std::uint64_t seed, int i, int j) : state_(mix(mix(seed) ^ mix(key(i, j)))) {}
   /// Uniform in [a, b).
   double uniform(double a, double b) {
     state_ = mix(state_);
@@ -112,6 +106,10 @@ class BlockRandom {
   }
 
  private:
+  static std::uint64_t mix(std::uint64_t z) { return radiosity::detail::mix64(z); }
+  static std::uint64_t key(int i, int j) {
+    return 0x100000000ull * static_cast<std::uint64_t>(i) + static_cast<std::uint64_t>(j);
+  }
   std::uint64_t state_;
 };
 
