@@ -1,0 +1,193 @@
+// The procedural city of issue #15 (benchmarks/city.hpp: streets, blocks and buildings, every
+// surface cut into quads, under a sky) solved on 2 threads with the default SolveOptions, which
+// for a city are the issue's Monte Carlo configuration: Gauss-Seidel, monte_carlo form factors
+// at 1024 rays per element (the automatic choice above 1e4 element x patch pairs), tolerance
+// 1e-3, one element per facet. When the defaults resolve to something else (a small city with a
+// coarse facet size: ray_cast, or facets split into several elements) that configuration is run
+// as well. Each configuration runs in its own child process, so its peak RSS is its own.
+//
+// Usage: bench_city [PRESET] [--blocks N] [--facet S] [--seed K] [--threads T] [--memory-budget MIB]
+//                   [--city-only]
+//   PRESET: 22k (3 blocks, 2.25 m facets: 23.5k facets), 246k (10 blocks: 250k), 1M (20 blocks:
+//   991k); the options after a preset change it. Default: 22k. --memory-budget sets
+//   SolveOptions::memory_budget_bytes (default: the library's 4 GiB). --city-only builds the city
+//   and prints its facets without solving.
+// Prints the city (facets per group, buildings, time to build it), then per configuration the
+// elements, the time of each phase (meshing, the sky's first shot, the estimator's set-up,
+// form factors, solving; from SolveReport, the set-up is the rest of the wall time), sweeps,
+// residual, peak RSS and form-factor memory, the group means and the power balance. A solve the
+// library refuses (the 1M city: the Gauss-Seidel rows exceed the 4 GiB memory budget) prints
+// the library's message and how long the refusal took.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include <radiosity/radiosity.hpp>
+
+#include "bench_common.hpp"
+#include "city.hpp"
+
+namespace rad = radiosity;
+
+namespace {
+
+using bench::peak_rss_mib;
+using bench::seconds_since;
+
+struct Args {
+  bench::CityOptions city;
+  unsigned threads = 2;
+  std::size_t memory_budget_bytes = 0;  ///< SolveOptions::memory_budget_bytes (0: the library's 4 GiB)
+  bool solve = true;                    ///< false: print the city only
+};
+
+/// The issue's configuration: Gauss-Seidel, monte_carlo at 1024 rays, one element per facet.
+rad::SolveOptions issue_options(const Args& a) {
+  rad::SolveOptions opt;
+  opt.threads = a.threads;
+  opt.memory_budget_bytes = a.memory_budget_bytes;
+  opt.method = rad::SolverMethod::gauss_seidel;
+  opt.form_factors.method = rad::FormFactorMethod::monte_carlo;
+  opt.form_factors.hemisphere_rays = 1024;
+  // Facets have edges of at most facet_size, so none is split.
+  opt.mesh.max_patch_area = static_cast<float>(a.city.facet_size * a.city.facet_size);
+  opt.mesh.max_element_area = opt.mesh.max_patch_area;
+  return opt;
+}
+
+double channel_sum(const rad::Rgb& c) { return static_cast<double>(c.x) + c.y + c.z; }
+
+/// Builds the city, solves it with `opt` and prints what it measured; true when the solve was the
+/// issue's configuration (monte_carlo, Gauss-Seidel, one element per facet).
+bool run(const Args& a, const rad::SolveOptions& opt, const char* label, bool print_city) {
+  auto t0 = std::chrono::steady_clock::now();
+  const bench::City city = bench::city(a.city);
+  const double build = seconds_since(t0);
+  if (print_city) {
+    std::printf("city: %d x %d blocks, facet size %g m, seed %llu: %zu facets (ground %zu, under buildings %zu, "
+                "streets %zu, walls %zu, roofs %zu), %zu buildings, %.0f m wide, %.0f m^2 of surface; built in %.2f s, "
+                "peak RSS %.1f MiB\n",
+                a.city.blocks, a.city.blocks, a.city.facet_size, static_cast<unsigned long long>(a.city.seed),
+                city.facets(), city.ground_facets, city.hidden_facets, city.street_facets, city.wall_facets,
+                city.roof_facets, city.buildings.size(), city.size, city.scene.total_area(), build, peak_rss_mib());
+    std::fflush(stdout);
+  }
+  if (!a.solve) return true;
+  std::printf("%s, %u threads:\n", label, a.threads);
+  t0 = std::chrono::steady_clock::now();
+  try {
+    const rad::Solution sol = rad::solve(city.scene, opt);
+    const double total = seconds_since(t0);
+    const rad::SolveReport& r = sol.report();
+    const double setup =
+        total - r.seconds_meshing - r.seconds_lights - r.seconds_form_factors - r.seconds_solving;
+    std::printf("  %zu elements, %zu patches, %s form factors, %d sweeps, residual %.2e, %s\n", r.element_count,
+                r.patch_count, rad::to_string(r.form_factor_method), r.iterations, r.residual,
+                sol.status() == rad::SolveStatus::converged ? "converged" : "not converged");
+    std::printf("  time %.2f s: meshing %.2f s, sky (first shot) %.2f s, set-up %.2f s, form factors %.2f s, "
+                "solving %.2f s\n",
+                total, r.seconds_meshing, r.seconds_lights, setup, r.seconds_form_factors, r.seconds_solving);
+    std::printf("  peak RSS %.1f MiB, form factors %.1f MiB\n", peak_rss_mib(),
+                static_cast<double>(r.form_factor_bytes) / (1024.0 * 1024.0));
+    std::printf("  group means B (W/m^2):");
+    for (const char* group : {"ground", "streets", "walls", "roofs", "under_buildings"}) {
+      const rad::Rgb b = sol.group_radiosity(group);
+      std::printf("  %s (%.3f, %.3f, %.3f)", group, b.x, b.y, b.z);
+    }
+    const double emitted = channel_sum(r.emitted_power);
+    std::printf("\n  power: the sky puts %.4g W onto the surfaces; absorbed %.1f %%, escaped %.1f %%\n", emitted / 3.0,
+                100.0 * channel_sum(r.absorbed_power) / emitted, 100.0 * channel_sum(r.escaped_power) / emitted);
+    for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
+    std::fflush(stdout);
+    return r.form_factor_method == rad::FormFactorMethod::monte_carlo && r.element_count == city.facets();
+  } catch (const rad::Error& e) {
+    std::printf("  refused after %.2f s (peak RSS %.1f MiB): %s%s\n", seconds_since(t0), peak_rss_mib(),
+                e.code() == rad::ErrorCode::memory_budget ? "memory budget: " : "", e.what());
+    std::fflush(stdout);
+    // Refused by the defaults means refused by the issue's configuration too (the same rows).
+    return true;
+  }
+}
+
+/// Runs `run` in a child process (its own peak RSS): 0 when it returned true, 3 when false, 1
+/// when it failed.
+int in_child(const Args& a, const rad::SolveOptions& opt, const char* label, bool print_city) {
+  std::fflush(stdout);  // the child must not inherit (and print again) buffered output
+  const pid_t pid = fork();
+  if (pid == 0) {
+    try {
+      _exit(run(a, opt, label, print_city) ? 0 : 3);
+    } catch (const std::exception& e) {
+      std::printf("  error: %s\n", e.what());
+      std::fflush(stdout);
+      _exit(1);
+    }
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+}
+
+int usage(const char* bad) {
+  if (bad) std::fprintf(stderr, "bench_city: bad argument '%s'\n", bad);
+  std::fprintf(stderr,
+               "usage: bench_city [22k|246k|1M] [--blocks N] [--facet METRES] [--seed K] [--threads T]\n"
+               "                  [--memory-budget MIB] [--city-only]\n"
+               "  presets: 22k = --blocks 3 --facet 2.25 (23.5k facets), 246k = --blocks 10 --facet 2.25 (250k),\n"
+               "           1M = --blocks 20 --facet 2.25 (991k)\n");
+  return bad ? 2 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    char* end = nullptr;
+    if (arg == "--help" || arg == "-h") return usage(nullptr);
+    if (arg == "22k" || arg == "246k" || arg == "1M") {
+      a.city.blocks = arg == "22k" ? 3 : arg == "246k" ? 10 : 20;
+      a.city.facet_size = 2.25;
+    } else if (arg == "--blocks" && has_value) {
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || v < 1 || v > 1000) return usage(argv[i]);
+      a.city.blocks = static_cast<int>(v);
+    } else if (arg == "--facet" && has_value) {
+      const double v = std::strtod(argv[++i], &end);
+      if (*end != '\0' || !(v > 0.0) || !std::isfinite(v)) return usage(argv[i]);
+      a.city.facet_size = v;
+    } else if (arg == "--seed" && has_value) {
+      a.city.seed = std::strtoull(argv[++i], &end, 10);
+      if (*end != '\0') return usage(argv[i]);
+    } else if (arg == "--memory-budget" && has_value) {
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || v < 1) return usage(argv[i]);
+      a.memory_budget_bytes = static_cast<std::size_t>(v) << 20;
+    } else if (arg == "--city-only") {
+      a.solve = false;
+    } else if (arg == "--threads" && has_value) {
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || v < 0) return usage(argv[i]);
+      a.threads = static_cast<unsigned>(v);
+    } else {
+      return usage(argv[i]);
+    }
+  }
+  std::printf("bench_city: radiosity %s, procedural city under a uniform sky of %g W/m^2\n", rad::version(),
+              static_cast<double>(bench::kCitySkyIrradiance));
+  rad::SolveOptions defaults;
+  defaults.threads = a.threads;
+  defaults.memory_budget_bytes = a.memory_budget_bytes;
+  const int first = in_child(a, defaults, "default solve (gauss-seidel, automatic form factors, tolerance 1e-3)", true);
+  if (first == 3)
+    in_child(a, issue_options(a),
+             "the issue's configuration (gauss-seidel, monte-carlo 1024 rays, one element per facet)", false);
+  return first == 1 ? 1 : 0;
+}
