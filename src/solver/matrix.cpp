@@ -20,6 +20,19 @@ double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z
 
 }  // namespace
 
+void check_row_memory(std::size_t rows, std::size_t unknowns, std::size_t patches, bool sparse,
+                      std::size_t max_row_entries, std::size_t budget) {
+  const std::size_t row_bytes = sparse ? std::min(patches, max_row_entries) * 2 * sizeof(float) : patches * sizeof(float);
+  const std::size_t bytes = rows * row_bytes;
+  if (bytes <= budget) return;
+  std::ostringstream s;
+  s << "the form-factor matrix of " << unknowns << " elements x " << patches << " patches needs "
+    << (sparse ? "up to " : "") << bytes / (1024.0 * 1024.0) << " MiB, more than the memory budget of "
+    << budget / (1024.0 * 1024.0) << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive"
+    << (sparse ? "" : ", FormFactorMethod::monte_carlo (sparse rows)") << " or a coarser mesh";
+  throw Error(ErrorCode::memory_budget, s.str());
+}
+
 SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixStore& store,
                           const std::vector<Rgb>& B0) {
   const RadiositySystem& sys = ctx.system;
@@ -38,24 +51,13 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   std::vector<std::uint32_t> missing;
   for (std::size_t u = 0; u < m; ++u)
     if (slot_of(u) == kNone) missing.push_back(static_cast<std::uint32_t>(u));
-  // Memory, stated before anything is computed: dense rows hold a float per patch, sparse rows
-  // an index and a float per entry, at most max_row_entries() of them.
-  // Rows with backs come from the sparse calls (the dense ones keep to fronts).
+  // Memory, stated before anything is computed. Rows with backs come from the sparse calls
+  // (the dense ones keep to fronts).
   const bool sparse = ctx.estimator.sparse() || sys.has_backs();
-  const std::size_t row_bytes =
-      sparse ? std::min(n, ctx.estimator.max_row_entries()) * 2 * sizeof(float) : n * sizeof(float);
   std::size_t rows_held = 0;
   for (const FactorVector& r : store.rows) rows_held += r.empty() ? 0 : 1;
-  const std::size_t bytes = (rows_held + missing.size()) * row_bytes;
-  if (bytes > ctx.options.memory_budget_bytes) {
-    std::ostringstream s;
-    s << "the form-factor matrix of " << m << " elements x " << n << " patches needs "
-      << (sparse ? "up to " : "") << bytes / (1024.0 * 1024.0) << " MiB, more than the memory budget of "
-      << ctx.options.memory_budget_bytes / (1024.0 * 1024.0)
-      << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive"
-      << (sparse ? "" : ", FormFactorMethod::monte_carlo (sparse rows)") << " or a coarser mesh";
-    throw Error(ErrorCode::memory_budget, s.str());
-  }
+  check_row_memory(rows_held + missing.size(), m, n, sparse, ctx.estimator.max_row_entries(),
+                   ctx.options.memory_budget_bytes);
   std::vector<std::uint32_t> slots(missing.size());
   for (std::size_t k = 0; k < missing.size(); ++k) {
     if (!store.free_slots.empty()) {

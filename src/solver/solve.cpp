@@ -273,6 +273,15 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
                     std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));
   }
 
+  // The matrix methods' memory is known before the lights' first shot, which can take as long
+  // as the form factors: a scene that cannot fit is refused at once, by the figure
+  // solve_matrix() would give (one row per leaf; with backs, whose rows solve_matrix() counts
+  // itself, only there).
+  if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
+  if (o.method != SolverMethod::progressive && store.rows.empty() && !translucency)
+    detail::check_row_memory(hierarchy.leaves().size(), hierarchy.leaves().size(), estimator->target_count(),
+                             estimator->sparse(), estimator->max_row_entries(), o.memory_budget_bytes);
+
   // The lights' first shot (once per Problem): their direct irradiance on every element.
   const double light_seconds = light_shot.seconds;
   const bool shot = group_light_shot != nullptr || shoot_lights(hierarchy.leaves(), gate);

@@ -160,6 +160,13 @@ struct ColumnStore {
   std::size_t leaf_count = 0;
 };
 
+/// The memory of `rows` form-factor rows over `patches` targets (dense: a float per target;
+/// sparse: an index and a float per entry, at most `max_row_entries`), checked against
+/// `budget` before anything is computed. Throws Error{memory_budget} naming the figure, the
+/// budget and what to do instead.
+void check_row_memory(std::size_t rows, std::size_t unknowns, std::size_t patches, bool sparse,
+                      std::size_t max_row_entries, std::size_t budget);
+
 /// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
 /// of them on the first call), then iterates from `B0` (per unknown; empty = start from E).
 SolverResult solve_matrix(const SolverContext& context, bool gauss_seidel, MatrixStore& store,

@@ -156,6 +156,28 @@ TEST_SUITE("solver") {
     }
   }
 
+  TEST_CASE("a matrix over the budget is refused before the lights' first shot - which can take as long as the factors") {
+    rad::Scene scene = rad::cornell_box();
+    rad::Light sky;
+    sky.type = rad::LightType::sky;
+    sky.intensity = 100.0f;
+    scene.add_light(sky);
+    rad::SolveOptions o;
+    o.memory_budget_bytes = 1024;
+    bool lights_started = false;
+    o.on_progress = [&](const rad::Progress& p) {
+      lights_started = lights_started || p.phase == rad::Phase::lights;
+      return true;
+    };
+    CHECK_THROWS_AS(rad::solve(scene, o), rad::Error);
+    CHECK_FALSE(lights_started);
+    // Within the budget the same scene shoots its lights first.
+    o.memory_budget_bytes = 0;  // the default
+    o.mesh.max_patch_area = 20000.0f;
+    rad::solve(scene, o);
+    CHECK(lights_started);
+  }
+
   TEST_CASE("group_radiosity of an unknown group names it") {
     const rad::Scene scene = test::closed_box(furnace_material());
     rad::Solution sol = rad::solve(scene, coarse(rad::SolverMethod::gauss_seidel));
