@@ -263,6 +263,44 @@ TEST_CASE("glTF bake: a mesh placed by a mirroring node and by a plain one gets 
   CHECK(mean_colour("mirrored") == doctest::Approx(mean_colour("plain")).epsilon(0.05));
 }
 
+TEST_CASE("glTF bake: split vertices carry morph targets (with their bounds); material variants are dropped with the materials") {
+  test::GltfBuilder b;
+  const int white = b.material({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}, {"emissiveFactor", {1.0, 1.0, 1.0}}});
+  nlohmann::json box = b.box({0, 0, 0}, {1, 1, 1}, white);
+  std::vector<glm::vec3> delta(8);
+  for (std::size_t k = 0; k < 8; ++k) delta[k] = glm::vec3(0.0f, 0.1f * static_cast<float>(k), 0.0f);
+  box["targets"] = nlohmann::json::array({{{"POSITION", b.positions(delta)}}});
+  box["extensions"] = {{"KHR_materials_variants", {{"mappings", nlohmann::json::array({{{"material", 0}, {"variants", {0}}}})}}}};
+  b.doc["extensions"] = {{"KHR_materials_variants", {{"variants", nlohmann::json::array({{{"name", "v"}}})}}}};
+  b.doc["extensionsUsed"] = {"KHR_materials_variants"};
+  b.scene({b.node({{"name", "box"}, {"mesh", b.mesh(box)}})});
+  fs::create_directories(kTmp);
+  const fs::path source = test::write_file(kTmp / "morph.glb", b.glb());
+  rad::Scene scene = test::load(source);
+  rad::LightmapUvOptions uo;
+  uo.resolution = 32;
+  uo.padding = 1;
+  rad::generate_lightmap_uvs(scene, 0, uo);
+  const std::vector<std::uint32_t> origin = scene.meshes()[0].vertex_origin;
+  REQUIRE(origin.size() > 8);
+  const rad::Solution sol = rad::solve(scene, quick_solve());
+  const fs::path out = kTmp / "morph_lit.glb";
+  rad::write_baked_gltf(source, scene, sol, out);
+  const tinygltf::Model lit = read_model(out);
+  CHECK(lit.extensionsUsed == std::vector<std::string>{"KHR_materials_unlit"});
+  CHECK(lit.extensions.count("KHR_materials_variants") == 0);
+  const tinygltf::Primitive& p = lit.meshes.at(0).primitives.at(0);
+  CHECK(p.extensions.count("KHR_materials_variants") == 0);
+  REQUIRE(p.targets.size() == 1);
+  const int target = p.targets[0].at("POSITION");
+  const std::vector<float> moved = floats(lit, target);
+  REQUIRE(moved.size() == 3 * origin.size());
+  for (std::size_t v = 0; v < origin.size(); ++v) CHECK(moved[3 * v + 1] == doctest::Approx(0.1f * static_cast<float>(origin[v])));
+  const tinygltf::Accessor& a = lit.accessors.at(static_cast<std::size_t>(target));
+  REQUIRE(a.maxValues.size() == 3);
+  CHECK(a.maxValues[1] == doctest::Approx(0.7));
+}
+
 TEST_CASE("glTF bake: a scene from elsewhere (the Cornell box) becomes a new file of a node per group") {
   rad::Scene scene = rad::cornell_box();
   scene.add_group_meshes();

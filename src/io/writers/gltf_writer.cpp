@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <string>
@@ -325,7 +326,8 @@ int gather_accessor(const GltfAccessors& accessors, const tinygltf::Model& model
     std::memcpy(&out[v * element], &dense[origin[v] * element], element);
   }
   std::vector<double> lo, hi;
-  if (role == "POSITION" && !origin.empty()) {
+  // POSITION accessors, a morph target's too, must give their bounds (section 3.7.2.1).
+  if (role.size() >= 8 && role.compare(role.size() - 8, 8, "POSITION") == 0 && !origin.empty()) {
     const auto n = static_cast<std::size_t>(c.components);
     lo.assign(n, HUGE_VAL);
     hi.assign(n, -HUGE_VAL);
@@ -364,14 +366,22 @@ void write_from_gltf(const fs::path& source, const Scene& scene, Writer& writer,
   model.textures.clear();
   model.images.clear();
   model.samplers.clear();
-  for (tinygltf::Mesh& m : model.meshes)
-    for (tinygltf::Primitive& p : m.primitives) p.material = -1;
-  // Extensions of what was dropped are no longer used; Draco data would stand for the old
-  // attributes, so primitives lose it (the reader needs the uncompressed fallback anyway).
+  // Extensions of what was dropped are no longer used (KHR_materials_variants' mappings name
+  // the old materials); Draco data would stand for the old attributes, so primitives lose it
+  // (the reader needs the uncompressed fallback anyway).
   auto dropped = [](const std::string& e) {
     return e.rfind("KHR_materials_", 0) == 0 || e.rfind("KHR_texture_", 0) == 0 || e.rfind("EXT_texture_", 0) == 0 ||
            e == "KHR_draco_mesh_compression";
   };
+  auto drop_from = [&](tinygltf::ExtensionMap& extensions) {
+    for (auto it = extensions.begin(); it != extensions.end();) it = dropped(it->first) ? extensions.erase(it) : std::next(it);
+  };
+  for (tinygltf::Mesh& m : model.meshes)
+    for (tinygltf::Primitive& p : m.primitives) {
+      p.material = -1;
+      drop_from(p.extensions);
+    }
+  drop_from(model.extensions);
   for (auto* list : {&model.extensionsUsed, &model.extensionsRequired})
     list->erase(std::remove_if(list->begin(), list->end(), dropped), list->end());
   writer.prepare_light();
@@ -396,7 +406,7 @@ void write_from_gltf(const fs::path& source, const Scene& scene, Writer& writer,
       const Mesh& mesh = scene.meshes()[id];
       tinygltf::Primitive& out = model.meshes[static_cast<std::size_t>(slot)].primitives[static_cast<std::size_t>(p)];
       out = original.primitives[static_cast<std::size_t>(p)];
-      out.extensions.erase("KHR_draco_mesh_compression");
+      drop_from(out.extensions);
       const int position = out.attributes.count("POSITION") ? out.attributes.at("POSITION") : -1;
       const std::size_t count = accessors.check(position, place, "POSITION", {TINYGLTF_TYPE_VEC3}, false).count;
       std::vector<std::uint32_t> origin = mesh.vertex_origin;
