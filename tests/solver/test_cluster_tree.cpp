@@ -1,0 +1,279 @@
+// The cluster hierarchy of hierarchical radiosity (src/solver/hierarchical/cluster_tree.hpp):
+// the tree's structure, bounds, determinism and depth; the directional moments' energy
+// conservation and exactness for axis-aligned surfaces; the receiving moments.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+#include "solver/hierarchical/cluster_tree.hpp"
+
+namespace rad = radiosity;
+namespace hr = radiosity::detail;
+
+namespace {
+
+constexpr double kPiD = 3.14159265358979323846;
+
+/// One quad of side `size` in the z = 0 plane facing +z, meshed into patches of `patch_area`.
+rad::PatchHierarchy grid(float size, float patch_area) {
+  rad::Scene scene;
+  const rad::MaterialId m = scene.add_material(rad::Material{});
+  scene.add_polygon({{0, 0, 0}, {size, 0, 0}, {size, size, 0}, {0, size, 0}}, m, "grid");
+  return rad::PatchHierarchy(scene, rad::MeshOptions{patch_area, patch_area});
+}
+
+/// The box [0,1]^3 as six outward-facing quads, one patch each.
+rad::PatchHierarchy outward_box() {
+  rad::Scene scene;
+  const rad::MaterialId m = scene.add_material(rad::Material{});
+  const glm::vec3 centre(0.5f);
+  auto add = [&](std::vector<glm::vec3> q) {
+    const glm::vec3 n = glm::cross(q[1] - q[0], q[2] - q[0]);
+    if (glm::dot(n, centre - q[0]) > 0.0f) std::reverse(q.begin(), q.end());
+    scene.add_polygon(q, m);
+  };
+  add({{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}});
+  add({{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}});
+  add({{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}});
+  add({{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}});
+  add({{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}});
+  add({{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}});
+  return rad::PatchHierarchy(scene, rad::MeshOptions{2.0f, 2.0f});
+}
+
+/// Per-patch radiosities, each channel in [0.1, 2), from a fixed seed.
+std::vector<rad::Rgb> random_radiosities(std::size_t count, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> u(0.1f, 2.0f);
+  std::vector<rad::Rgb> B(count);
+  for (auto& b : B) b = rad::Rgb(u(gen), u(gen), u(gen));
+  return B;
+}
+
+/// Integral of I(w) over the sphere: midpoint rule on an equal-area (cos theta, phi) grid.
+glm::dvec3 integrate_intensity(const hr::Moments& P, int steps) {
+  glm::dvec3 sum(0.0);
+  for (int i = 0; i < steps; ++i) {
+    const double z = -1.0 + 2.0 * (i + 0.5) / steps;
+    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    for (int j = 0; j < 2 * steps; ++j) {
+      const double phi = kPiD * (j + 0.5) / steps;
+      const glm::vec3 w(static_cast<float>(s * std::cos(phi)), static_cast<float>(s * std::sin(phi)),
+                        static_cast<float>(z));
+      sum += glm::dvec3(hr::intensity(P, w));
+    }
+  }
+  return sum * (4.0 * kPiD / (2.0 * steps * steps));
+}
+
+std::vector<glm::vec3> random_directions(int count, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::normal_distribution<float> g;
+  std::vector<glm::vec3> out;
+  while (static_cast<int>(out.size()) < count) {
+    const glm::vec3 v(g(gen), g(gen), g(gen));
+    if (glm::length(v) > 1e-3f) out.push_back(glm::normalize(v));
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_SUITE("solver") {
+
+TEST_CASE("node handles put clusters and elements in one id space") {
+  const hr::NodeHandle c = hr::cluster_handle(12345);
+  const hr::NodeHandle e = hr::element_handle(12345);
+  CHECK(hr::is_cluster(c));
+  CHECK_FALSE(hr::is_cluster(e));
+  CHECK(c != e);
+  CHECK(hr::handle_index(c) == 12345u);
+  CHECK(hr::handle_index(e) == 12345u);
+  CHECK(hr::handle_index(hr::cluster_handle(0x7fffffffu)) == 0x7fffffffu);
+}
+
+TEST_CASE("the cluster tree covers every patch once and each node bounds its patches") {
+  const rad::PatchHierarchy h(rad::cornell_box(), rad::MeshOptions{});
+  const hr::ClusterTree tree(h);
+  const std::size_t n = h.patches().size();
+  REQUIRE(n > 100);
+  REQUIRE(tree.nodes().size() == 2 * n - 1);
+
+  // The permutation holds every patch once; each leaf one patch, and leaf_of() finds it.
+  std::vector<int> seen(n, 0);
+  for (std::uint32_t p : tree.order()) ++seen[p];
+  CHECK(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+  const hr::ClusterNode& root = tree.node(hr::ClusterTree::root());
+  CHECK(root.first == 0);
+  CHECK(root.count == n);
+
+  for (std::uint32_t id = 0; id < tree.nodes().size(); ++id) {
+    const hr::ClusterNode& node = tree.node(id);
+    CAPTURE(id);
+    if (node.is_leaf()) {
+      REQUIRE(node.count == 1);
+      CHECK(tree.leaf_of(tree.order()[node.first]) == id);
+    } else {
+      // Children split the parent's range, and come after it.
+      const hr::ClusterNode& l = tree.node(node.children[0]);
+      const hr::ClusterNode& r = tree.node(node.children[1]);
+      CHECK(node.children[0] > id);
+      CHECK(node.children[1] > id);
+      CHECK(l.first == node.first);
+      CHECK(r.first == l.first + l.count);
+      CHECK(l.count + r.count == node.count);
+    }
+    // Bounds and sphere contain every corner of its patches; area is their sum.
+    double area = 0.0;
+    for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+      const rad::Patch& patch = h.patches()[tree.order()[k]];
+      area += patch.area;
+      const rad::Element& e = h.element(patch.root);
+      for (int c = 0; c < e.corner_count(); ++c) {
+        const glm::vec3& v = h.vertices()[e.corners[c]];
+        CHECK(glm::all(glm::lessThanEqual(node.bounds.lower, v)));
+        CHECK(glm::all(glm::lessThanEqual(v, node.bounds.upper)));
+        CHECK(glm::length(v - node.centre) <= node.radius * (1.0f + 1e-5f) + 1e-6f);
+      }
+    }
+    CHECK(node.area == doctest::Approx(area).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("the cluster tree is the same when built twice") {
+  const rad::PatchHierarchy h(rad::cornell_box(), rad::MeshOptions{});
+  const hr::ClusterTree a(h), b(h);
+  REQUIRE(a.nodes().size() == b.nodes().size());
+  CHECK(a.order() == b.order());
+  for (std::size_t i = 0; i < a.nodes().size(); ++i) {
+    const hr::ClusterNode& x = a.nodes()[i];
+    const hr::ClusterNode& y = b.nodes()[i];
+    CHECK(x.children == y.children);
+    CHECK(x.first == y.first);
+    CHECK(x.count == y.count);
+    CHECK(x.bounds.lower == y.bounds.lower);
+    CHECK(x.bounds.upper == y.bounds.upper);
+    CHECK(x.radius == y.radius);
+    CHECK(x.area == y.area);
+  }
+}
+
+TEST_CASE("the cluster tree over 10k patches is ceil(log2 n) deep") {
+  const rad::PatchHierarchy h = grid(100.0f, 1.0f);
+  const std::size_t n = h.patches().size();
+  REQUIRE(n >= 10000);
+  const hr::ClusterTree tree(h);
+  CHECK(tree.depth() == static_cast<int>(std::ceil(std::log2(static_cast<double>(n)))));
+}
+
+TEST_CASE("a tree over no patches is empty and over one patch is a single leaf") {
+  const hr::ClusterTree none{rad::PatchHierarchy()};
+  CHECK(none.empty());
+  const rad::PatchHierarchy one = grid(1.0f, 2.0f);
+  REQUIRE(one.patches().size() == 1);
+  const hr::ClusterTree tree(one);
+  REQUIRE(tree.nodes().size() == 1);
+  CHECK(tree.node(0).is_leaf());
+  CHECK(tree.depth() == 0);
+}
+
+TEST_CASE("sending moments conserve energy: I integrates to sum B A over the sphere (relative 1e-3)") {
+  // The Cornell box's blocks are turned about y, so their normals are off the axes.
+  const rad::PatchHierarchy h(rad::cornell_box(), rad::MeshOptions{});
+  const hr::ClusterTree tree(h);
+  const std::vector<rad::Rgb> B = random_radiosities(h.patches().size(), 7);
+  std::vector<hr::Moments> P;
+  hr::sending_moments(tree, h, B, 2, P);
+  glm::dvec3 power(0.0);
+  for (std::size_t p = 0; p < B.size(); ++p) power += glm::dvec3(B[p]) * static_cast<double>(h.patches()[p].area);
+  const glm::dvec3 integral = integrate_intensity(P[hr::ClusterTree::root()], 600);
+  for (int c = 0; c < 3; ++c) CHECK(integral[c] == doctest::Approx(power[c]).epsilon(1e-3));
+
+  // Tilted normals too: one surface along (1, -2, 3).
+  hr::Moments tilted{};
+  hr::add_surface(tilted, glm::vec3(1.0f, -2.0f, 3.0f), rad::Rgb(2.0f, 1.0f, 0.5f));
+  const glm::dvec3 t = integrate_intensity(tilted, 600);
+  CHECK(t.x == doctest::Approx(2.0).epsilon(1e-3));
+  CHECK(t.y == doctest::Approx(1.0).epsilon(1e-3));
+  CHECK(t.z == doctest::Approx(0.5).epsilon(1e-3));
+}
+
+TEST_CASE("sending moments are the same at 1 and 2 threads") {
+  const rad::PatchHierarchy h = grid(100.0f, 1.0f);
+  const hr::ClusterTree tree(h);
+  const std::vector<rad::Rgb> B = random_radiosities(h.patches().size(), 3);
+  std::vector<hr::Moments> one, two;
+  hr::sending_moments(tree, h, B, 1, one);
+  hr::sending_moments(tree, h, B, 2, two);
+  CHECK(one == two);
+}
+
+TEST_CASE("an axis-aligned patch sends exactly B A max(0, n.w) / pi in every direction") {
+  for (const glm::vec3& n : {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, -1, 0),
+                             glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)}) {
+    CAPTURE(n);
+    const float A = 0.75f;
+    const rad::Rgb B(1.0f, 2.0f, 3.0f);
+    hr::Moments P{};
+    hr::add_surface(P, n, B * A);
+    for (const glm::vec3& w : random_directions(200, 11)) {
+      const rad::Rgb exact = B * A * std::max(0.0f, glm::dot(n, w)) / static_cast<float>(kPiD);
+      const rad::Rgb I = hr::intensity(P, w);
+      for (int c = 0; c < 3; ++c) CHECK(I[c] == doctest::Approx(exact[c]).epsilon(1e-6));
+    }
+  }
+}
+
+TEST_CASE("a box cluster sends what its six faces send") {
+  const rad::PatchHierarchy h = outward_box();
+  REQUIRE(h.patches().size() == 6);
+  const hr::ClusterTree tree(h);
+  const std::vector<rad::Rgb> B = random_radiosities(6, 5);
+  std::vector<hr::Moments> P;
+  hr::sending_moments(tree, h, B, 1, P);
+  std::vector<glm::vec3> directions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const glm::vec3& w : random_directions(50, 13)) directions.push_back(w);
+  for (const glm::vec3& w : directions) {
+    CAPTURE(w);
+    rad::Rgb faces(0.0f);
+    for (std::size_t p = 0; p < 6; ++p) {
+      const rad::Patch& patch = h.patches()[p];
+      faces += B[p] * patch.area * std::max(0.0f, glm::dot(patch.normal, w)) / static_cast<float>(kPiD);
+    }
+    const rad::Rgb I = hr::intensity(P[hr::ClusterTree::root()], w);
+    for (int c = 0; c < 3; ++c) CHECK(I[c] == doctest::Approx(faces[c]).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("an axis-aligned element receives flux x cos from the side it faces and nothing from behind") {
+  const rad::Rgb flux(4.0f, 2.0f, 1.0f);
+  const glm::vec3 d = glm::normalize(glm::vec3(0.6f, 0.8f, 0.0f));  // toward the source
+  hr::Moments E{};
+  hr::add_irradiance(E, d, flux);
+  const rad::Rgb facing = hr::element_irradiance(E, glm::vec3(1, 0, 0));
+  const rad::Rgb up = hr::element_irradiance(E, glm::vec3(0, 1, 0));
+  for (int c = 0; c < 3; ++c) {
+    CHECK(facing[c] == doctest::Approx(flux[c] * d.x).epsilon(1e-6));
+    CHECK(up[c] == doctest::Approx(flux[c] * d.y).epsilon(1e-6));
+  }
+  CHECK(hr::element_irradiance(E, glm::vec3(-1, 0, 0)) == rad::Rgb(0.0f));
+  CHECK(hr::element_irradiance(E, glm::vec3(0, -1, 0)) == rad::Rgb(0.0f));
+  CHECK(hr::element_irradiance(E, glm::vec3(0, 0, 1)) == rad::Rgb(0.0f));
+
+  // Head-on: the element facing the source gets the whole flux; two links add up.
+  hr::Moments head_on{};
+  hr::add_irradiance(head_on, glm::vec3(0, 0, -1), flux);
+  hr::add_irradiance(head_on, glm::vec3(0, 0, -1), flux);
+  CHECK(hr::element_irradiance(head_on, glm::vec3(0, 0, -1)) == 2.0f * flux);
+  CHECK(hr::element_irradiance(head_on, glm::vec3(0, 0, 1)) == rad::Rgb(0.0f));
+}
+
+}  // TEST_SUITE
