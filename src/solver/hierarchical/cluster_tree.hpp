@@ -16,6 +16,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/assert.hpp"
 #include "radiosity/common.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
@@ -25,12 +26,20 @@ namespace radiosity::detail {
 // ---- Node handles -------------------------------------------------------------------------
 
 /// A node of the link hierarchy: a cluster (ClusterTree node id with kClusterTag set) or an
-/// element (PatchHierarchy element id, tag clear), so a link is two handles and a float.
+/// element (PatchHierarchy element id, tag clear), so a link is two handles and a float. kNone
+/// is no valid handle.
 using NodeHandle = std::uint32_t;
 inline constexpr NodeHandle kClusterTag = 0x80000000u;
 
-inline NodeHandle cluster_handle(std::uint32_t cluster) { return cluster | kClusterTag; }
-inline NodeHandle element_handle(std::uint32_t element) { return element; }
+/// Handles of cluster and element ids below 2^31 (a billion elements; the tag bit is the 32nd).
+inline NodeHandle cluster_handle(std::uint32_t cluster) {
+  RADIOSITY_ASSERT(cluster < kClusterTag);
+  return cluster | kClusterTag;
+}
+inline NodeHandle element_handle(std::uint32_t element) {
+  RADIOSITY_ASSERT(element < kClusterTag);
+  return element;
+}
 inline bool is_cluster(NodeHandle h) { return (h & kClusterTag) != 0; }
 /// The cluster or element id a handle names.
 inline std::uint32_t handle_index(NodeHandle h) { return h & ~kClusterTag; }
@@ -51,6 +60,7 @@ struct ClusterNode {
 
   bool is_leaf() const { return children[0] == kNone; }
 };
+static_assert(sizeof(ClusterNode) == 60, "the memory per node stated above");
 
 /// Binary volume hierarchy over the patches of a PatchHierarchy, built once: each inner node
 /// splits its patches at the median centroid along the longest axis of their centroids' bounds
@@ -103,7 +113,8 @@ Rgb intensity(const Moments& P, const glm::vec3& w);
 /// Sending moments of every cluster of `tree` from per-patch radiosities `B` (indexed by patch
 /// id, W/m^2): leaves from their patch (B A split by its normal), inner nodes the sum of their
 /// two children. Deterministic at any thread count (leaves in parallel, then inner nodes in a
-/// fixed order). `out` is resized to the node count.
+/// fixed order). `out` is resized to the node count. Front sides only: TODO(#15) the back
+/// sides of two-sided and translucent patches (a node per side, as the matrix solvers number them).
 /// Thread safety: pure; `out` is the caller's.
 void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& B,
                      unsigned threads, std::vector<Moments>& out);
