@@ -13,6 +13,7 @@
 
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
+#include "city.hpp"
 #include "solver/hierarchical/cluster_tree.hpp"
 
 namespace rad = radiosity;
@@ -47,6 +48,14 @@ rad::PatchHierarchy outward_box() {
   add({{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}});
   add({{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}});
   return rad::PatchHierarchy(scene, rad::MeshOptions{2.0f, 2.0f});
+}
+
+/// A city of issue #15's benchmark (`blocks` x `blocks`, facets of 2.25 m): buildings, streets
+/// and many coplanar facets, one patch each.
+rad::PatchHierarchy city_patches(int blocks) {
+  bench::CityOptions o;
+  o.blocks = blocks;
+  return rad::PatchHierarchy(bench::city(o).scene, rad::MeshOptions{1e4f, 1e4f});
 }
 
 /// Per-patch radiosities, each channel in [0.1, 2), from a fixed seed.
@@ -101,50 +110,54 @@ TEST_CASE("node handles put clusters and elements in one id space") {
 }
 
 TEST_CASE("the cluster tree covers every patch once and each node bounds its patches") {
-  const rad::PatchHierarchy h(rad::cornell_box(), rad::MeshOptions{});
-  const hr::ClusterTree tree(h);
-  const std::size_t n = h.patches().size();
-  REQUIRE(n > 100);
-  REQUIRE(tree.nodes().size() == 2 * n - 1);
+  for (const bool cornell : {true, false}) {
+    CAPTURE(cornell);
+    const rad::PatchHierarchy h =
+        cornell ? rad::PatchHierarchy(rad::cornell_box(), rad::MeshOptions{}) : city_patches(1);
+    const hr::ClusterTree tree(h);
+    const std::size_t n = h.patches().size();
+    REQUIRE(n > 100);
+    REQUIRE(tree.nodes().size() == 2 * n - 1);
 
-  // The permutation holds every patch once; each leaf one patch, and leaf_of() finds it.
-  std::vector<int> seen(n, 0);
-  for (std::uint32_t p : tree.order()) ++seen[p];
-  CHECK(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
-  const hr::ClusterNode& root = tree.node(hr::ClusterTree::root());
-  CHECK(root.first == 0);
-  CHECK(root.count == n);
+    // The permutation holds every patch once; each leaf one patch, and leaf_of() finds it.
+    std::vector<int> seen(n, 0);
+    for (std::uint32_t p : tree.order()) ++seen[p];
+    CHECK(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+    const hr::ClusterNode& root = tree.node(hr::ClusterTree::root());
+    CHECK(root.first == 0);
+    CHECK(root.count == n);
 
-  for (std::uint32_t id = 0; id < tree.nodes().size(); ++id) {
-    const hr::ClusterNode& node = tree.node(id);
-    CAPTURE(id);
-    if (node.is_leaf()) {
-      REQUIRE(node.count == 1);
-      CHECK(tree.leaf_of(tree.order()[node.first]) == id);
-    } else {
-      // Children split the parent's range, and come after it.
-      const hr::ClusterNode& l = tree.node(node.children[0]);
-      const hr::ClusterNode& r = tree.node(node.children[1]);
-      CHECK(node.children[0] > id);
-      CHECK(node.children[1] > id);
-      CHECK(l.first == node.first);
-      CHECK(r.first == l.first + l.count);
-      CHECK(l.count + r.count == node.count);
-    }
-    // Bounds and sphere contain every corner of its patches; area is their sum.
-    double area = 0.0;
-    for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-      const rad::Patch& patch = h.patches()[tree.order()[k]];
-      area += patch.area;
-      const rad::Element& e = h.element(patch.root);
-      for (int c = 0; c < e.corner_count(); ++c) {
-        const glm::vec3& v = h.vertices()[e.corners[c]];
-        CHECK(glm::all(glm::lessThanEqual(node.bounds.lower, v)));
-        CHECK(glm::all(glm::lessThanEqual(v, node.bounds.upper)));
-        CHECK(glm::length(v - node.centre) <= node.radius * (1.0f + 1e-5f) + 1e-6f);
+    for (std::uint32_t id = 0; id < tree.nodes().size(); ++id) {
+      const hr::ClusterNode& node = tree.node(id);
+      CAPTURE(id);
+      if (node.is_leaf()) {
+        REQUIRE(node.count == 1);
+        CHECK(tree.leaf_of(tree.order()[node.first]) == id);
+      } else {
+        // Children split the parent's range, and come after it.
+        const hr::ClusterNode& l = tree.node(node.children[0]);
+        const hr::ClusterNode& r = tree.node(node.children[1]);
+        CHECK(node.children[0] > id);
+        CHECK(node.children[1] > id);
+        CHECK(l.first == node.first);
+        CHECK(r.first == l.first + l.count);
+        CHECK(l.count + r.count == node.count);
       }
+      // Bounds and sphere contain every corner of its patches; area is their sum.
+      double area = 0.0;
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+        const rad::Patch& patch = h.patches()[tree.order()[k]];
+        area += patch.area;
+        const rad::Element& e = h.element(patch.root);
+        for (int c = 0; c < e.corner_count(); ++c) {
+          const glm::vec3& v = h.vertices()[e.corners[c]];
+          CHECK(glm::all(glm::lessThanEqual(node.bounds.lower, v)));
+          CHECK(glm::all(glm::lessThanEqual(v, node.bounds.upper)));
+          CHECK(glm::length(v - node.centre) <= node.radius * (1.0f + 1e-5f) + 1e-6f);
+        }
+      }
+      CHECK(node.area == doctest::Approx(area).epsilon(1e-5));
     }
-    CHECK(node.area == doctest::Approx(area).epsilon(1e-5));
   }
 }
 
@@ -166,12 +179,17 @@ TEST_CASE("the cluster tree is the same when built twice") {
   }
 }
 
-TEST_CASE("the cluster tree over 10k patches is ceil(log2 n) deep") {
+TEST_CASE("the cluster tree over 10k patches is ceil(log2 n) deep on a grid and a city") {
   const rad::PatchHierarchy h = grid(100.0f, 1.0f);
   const std::size_t n = h.patches().size();
   REQUIRE(n >= 10000);
   const hr::ClusterTree tree(h);
   CHECK(tree.depth() == static_cast<int>(std::ceil(std::log2(static_cast<double>(n)))));
+
+  // The same on a city, whose coplanar facets tie on every axis but one.
+  const rad::PatchHierarchy c = city_patches(2);
+  REQUIRE(c.patches().size() >= 10000);
+  CHECK(hr::ClusterTree(c).depth() == static_cast<int>(std::ceil(std::log2(static_cast<double>(c.patches().size())))));
 }
 
 TEST_CASE("a tree over no patches is empty and over one patch is a single leaf") {
