@@ -55,14 +55,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string lower_extension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-std::string in_quotes(const std::string& s) { return "'" + s + "'"; }
-
 /// A number as the messages show it: 6 significant digits, no trailing zeros.
 std::string number_text(double v) {
   std::ostringstream s;

@@ -543,8 +543,7 @@ GltfFile read_gltf_file(const fs::path& path) {
 
   // Binary by its magic, whatever the extension says; a .glb must be binary.
   const bool binary = bytes.size() >= 4 && le32(reinterpret_cast<const unsigned char*>(bytes.data())) == kGlbMagic;
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lower_extension(path);
   std::optional<Glb> glb;
   if (binary || ext == ".glb") glb = split_glb(src, bytes);
   const std::string_view text = glb ? glb->json : std::string_view(bytes);

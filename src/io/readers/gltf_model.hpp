@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/readers/reader_files.hpp"
 #include "radiosity/common.hpp"
 
 namespace radiosity::detail {
@@ -25,8 +26,6 @@ namespace radiosity::detail {
 inline std::uint32_t le32(const unsigned char* p) {
   return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
 }
-
-inline std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
 
 inline bool is_data_uri(std::string_view uri) { return uri.compare(0, 5, "data:") == 0; }
 

@@ -1,9 +1,8 @@
 // load_scene(): chooses a reader by the file's extension, so callers need not know formats: our
 // own for OBJ, JSON and glTF, Assimp for every other format it reads.
-#include <algorithm>
-#include <cctype>
 #include <string>
 
+#include "io/readers/reader_files.hpp"
 #include "io/readers/readers.hpp"
 #include "radiosity/io.hpp"
 
@@ -11,9 +10,7 @@ namespace radiosity {
 inline namespace v1 {
 
 Scene load_scene(const std::filesystem::path& path, const LoadOptions& options) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = detail::lower_extension(path);
   if (ext == ".obj") return detail::load_obj(path, options);
   if (ext == ".json") return detail::load_scene_json(path, options);
   if (ext == ".gltf" || ext == ".glb") return detail::load_gltf(path, options);

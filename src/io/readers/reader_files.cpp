@@ -2,6 +2,7 @@
 #include "io/readers/reader_files.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <system_error>
@@ -24,6 +25,12 @@ std::string read_file(const fs::path& path, const char* what) {
   bytes << in.rdbuf();
   if (in.bad()) throw Error(ErrorCode::file_not_found, std::string("load_scene: cannot read ") + what + " '" + path.string() + "'");
   return bytes.str();
+}
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
 }
 
 std::string line_column(std::string_view text, std::size_t pos) {

@@ -14,6 +14,13 @@ namespace radiosity::detail {
 /// fails; `what` names the kind of file ("OBJ file", "glTF file").
 std::string read_file(const std::filesystem::path& path, const char* what);
 
+/// The extension of `path` in lower case, with its dot (".glb"), or empty: what the readers and
+/// writers choose a format by.
+std::string lower_extension(const std::filesystem::path& path);
+
+/// `s` in single quotes, as messages name files, materials and nodes.
+inline std::string in_quotes(std::string_view s) { return "'" + std::string(s) + "'"; }
+
 /// "line:column" (both 1-based) of the byte at 0-based offset `pos` of `text`.
 std::string line_column(std::string_view text, std::size_t pos);
 
