@@ -278,14 +278,19 @@ bool parse_place(const std::string& source, PrimitivePlace& out) {
          out.node >= 0 && out.mesh >= 0 && out.primitive >= 0;
 }
 
-/// Whether node `n`'s world matrix mirrors (a negative determinant: the reader swapped its
-/// triangles' corners to keep them facing out, which the written indices must undo). The
-/// determinant's sign is the product of the local matrices' signs; a TRS node's is its scale's.
-bool mirrors(const tinygltf::Model& model, int n) {
+/// Each node's parent, or -1 for a root.
+std::vector<int> node_parents(const tinygltf::Model& model) {
   std::vector<int> parent(model.nodes.size(), -1);
   for (std::size_t p = 0; p < model.nodes.size(); ++p)
     for (int c : model.nodes[p].children)
       if (c >= 0 && static_cast<std::size_t>(c) < parent.size()) parent[static_cast<std::size_t>(c)] = static_cast<int>(p);
+  return parent;
+}
+
+/// Whether node `n`'s world matrix mirrors (a negative determinant: the reader swapped its
+/// triangles' corners to keep them facing out, which the written indices must undo). The
+/// determinant's sign is the product of the local matrices' signs; a TRS node's is its scale's.
+bool mirrors(const tinygltf::Model& model, const std::vector<int>& parent, int n) {
   bool negative = false;
   std::size_t steps = 0;
   for (int k = n; k >= 0 && steps <= model.nodes.size(); k = parent[static_cast<std::size_t>(k)], ++steps) {
@@ -387,6 +392,7 @@ void write_from_gltf(const fs::path& source, const Scene& scene, Writer& writer,
   writer.prepare_light();
   writer.use_unlit();
 
+  const std::vector<int> parent = node_parents(in);
   std::vector<bool> mesh_taken(in.meshes.size(), false);
   for (const auto& [n, primitives] : by_node) {
     const int m = in.nodes[static_cast<std::size_t>(n)].mesh;
@@ -399,7 +405,7 @@ void write_from_gltf(const fs::path& source, const Scene& scene, Writer& writer,
       model.nodes[static_cast<std::size_t>(n)].mesh = slot;
     }
     mesh_taken[static_cast<std::size_t>(m)] = true;
-    const bool mirrored = mirrors(in, n);
+    const bool mirrored = mirrors(in, parent, n);
     for (const auto& [p, id] : primitives) {
       const std::string place =
           "nodes[" + std::to_string(n) + "]: meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
@@ -521,8 +527,7 @@ void write_baked_gltf(const std::filesystem::path& source, const Scene& scene, c
     throw Error(ErrorCode::invalid_argument, where + "the solution has " + std::to_string(solution.meshes().size()) +
                                                  " meshes, the scene " + std::to_string(scene.meshes().size()) +
                                                  " (solve the scene after adding its meshes)");
-  std::string ext = output.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = detail::lower_extension(output);
   if (ext != ".glb" && ext != ".gltf")
     throw Error(ErrorCode::invalid_argument, where + "the output must be a .glb or .gltf file");
   const bool binary = ext == ".glb";
