@@ -50,6 +50,19 @@ void refine_randomly(PatchHierarchy& h, Uniform& u, int splits) {
   }
 }
 
+// After `splits` random subdivisions, random element values interpolate without a crack inside
+// a polygon and continuously across the scene's one smooth seam.
+void check_one_continuous_seam(const Scene& scene, PatchHierarchy& h, int splits) {
+  Uniform u;
+  refine_randomly(h, u, splits);
+  const std::vector<Rgb> vv = h.vertex_values(random_values(h, u));
+  CHECK(test::largest_crack(h, vv) < 1e-5f);
+  const test::SeamJump jump = test::largest_seam_jump(scene, h, vv, 30.0f, 1e-3f);
+  CHECK(jump.edges == 1);
+  CHECK(jump.complete);
+  CHECK(jump.largest < 1e-5);
+}
+
 // Hierarchy vertices at exactly this position.
 std::vector<std::uint32_t> vertices_at(const PatchHierarchy& h, const glm::vec3& p) {
   std::vector<std::uint32_t> out;
@@ -193,14 +206,7 @@ TEST_CASE("smooth neighbours that cut their edge into different numbers of patch
     const std::size_t lattices = static_cast<std::size_t>((k_left + 1) * (k_left + 2) / 2 + (k_right + 1) * (k_right + 2) / 2);
     // Corners always shared; inner points of the edge only when the cuts are the same.
     CHECK(h.vertices().size() == lattices - 2 - (k_left == k_right ? static_cast<std::size_t>(k_left - 1) : 0u));
-    Uniform u;
-    refine_randomly(h, u, 40);
-    const std::vector<Rgb> vv = h.vertex_values(random_values(h, u));
-    CHECK(test::largest_crack(h, vv) < 1e-5f);
-    const test::SeamJump jump = test::largest_seam_jump(scene, h, vv, 30.0f, 1e-3f);
-    CHECK(jump.edges == 1);
-    CHECK(jump.complete);
-    CHECK(jump.largest < 1e-5);
+    check_one_continuous_seam(scene, h, 40);
   }
   SUBCASE("quads: a unit square and a trapezoid cut the common edge into 2 and 8") {
     Scene scene;
@@ -209,14 +215,7 @@ TEST_CASE("smooth neighbours that cut their edge into different numbers of patch
     scene.add_polygon({{1, 0, 0}, {3, -3, 0}, {3, 4, 0}, {1, 1, 0}}, m, "pair");
     PatchHierarchy h(scene, options(0.25f, 0.25f, 30.0f));
     CHECK(vertices_at(h, {1, 0.5f, 0}).size() == 2);  // a common knot, one vertex per side
-    Uniform u;
-    refine_randomly(h, u, 60);
-    const std::vector<Rgb> vv = h.vertex_values(random_values(h, u));
-    CHECK(test::largest_crack(h, vv) < 1e-5f);
-    const test::SeamJump jump = test::largest_seam_jump(scene, h, vv, 30.0f, 1e-3f);
-    CHECK(jump.edges == 1);
-    CHECK(jump.complete);
-    CHECK(jump.largest < 1e-5);
+    check_one_continuous_seam(scene, h, 60);
   }
 }
 
@@ -232,14 +231,7 @@ TEST_CASE("edge points that two neighbours round differently are not shared but 
   PatchHierarchy h(scene, options(0.28f, 0.28f, 30.0f));
   REQUIRE(h.patches().size() == 18);  // k = 3 on both
   CHECK(h.vertices().size() == 10 + 10 - 2);
-  Uniform u;
-  refine_randomly(h, u, 40);
-  const std::vector<Rgb> vv = h.vertex_values(random_values(h, u));
-  CHECK(test::largest_crack(h, vv) < 1e-5f);
-  const test::SeamJump jump = test::largest_seam_jump(scene, h, vv, 30.0f, 1e-3f);
-  CHECK(jump.edges == 1);
-  CHECK(jump.complete);
-  CHECK(jump.largest < 1e-5);
+  check_one_continuous_seam(scene, h, 40);
 }
 
 TEST_CASE("welding changes no patch or element - only which vertices are shared") {
