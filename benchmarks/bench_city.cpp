@@ -44,6 +44,9 @@ struct Args {
   unsigned threads = 2;
   std::size_t memory_budget_bytes = 0;  ///< SolveOptions::memory_budget_bytes (0: the library's 4 GiB)
   bool solve = true;                    ///< false: print the city only
+  bool monte_carlo = true;              ///< run the Monte Carlo path (the defaults / the issue's configuration)
+  bool hierarchical = true;             ///< run SolverMethod::hierarchical
+  float epsilon = rad::HierarchicalOptions{}.epsilon;
 };
 
 /// The issue's configuration: Gauss-Seidel, monte_carlo at 1024 rays, one element per facet.
@@ -92,8 +95,8 @@ bool run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pr
     std::printf("  time %.2f s: meshing %.2f s, sky (first shot) %.2f s, set-up %.2f s, form factors %.2f s, "
                 "solving %.2f s\n",
                 total, r.seconds_meshing, r.seconds_lights, setup, r.seconds_form_factors, r.seconds_solving);
-    std::printf("  peak RSS %.1f MiB, form factors %.1f MiB\n", peak_rss_mib(),
-                static_cast<double>(r.form_factor_bytes) / (1024.0 * 1024.0));
+    std::printf("  peak RSS %.1f MiB, form factors %.1f MiB, %zu links\n", peak_rss_mib(),
+                static_cast<double>(r.form_factor_bytes) / (1024.0 * 1024.0), r.link_count);
     std::printf("  group means B (W/m^2):");
     for (const char* group : {"ground", "streets", "walls", "roofs", "under_buildings"}) {
       const rad::Rgb b = sol.group_radiosity(group);
@@ -170,6 +173,15 @@ int main(int argc, char** argv) {
       const long v = std::strtol(argv[++i], &end, 10);
       if (*end != '\0' || v < 1) return usage(argv[i]);
       a.memory_budget_bytes = static_cast<std::size_t>(v) << 20;
+    } else if (arg == "--epsilon" && has_value) {
+      const double v = std::strtod(argv[++i], &end);
+      if (*end != '\0' || !(v > 0.0) || v > 1.0) return usage(argv[i]);
+      a.epsilon = static_cast<float>(v);
+    } else if (arg == "--only" && has_value) {
+      const std::string which = argv[++i];
+      if (which != "monte-carlo" && which != "hierarchical") return usage(argv[i]);
+      a.monte_carlo = which == "monte-carlo";
+      a.hierarchical = which == "hierarchical";
     } else if (arg == "--city-only") {
       a.solve = false;
     } else if (arg == "--threads" && has_value) {
@@ -185,9 +197,20 @@ int main(int argc, char** argv) {
   rad::SolveOptions defaults;
   defaults.threads = a.threads;
   defaults.memory_budget_bytes = a.memory_budget_bytes;
-  const int first = in_child(a, defaults, "default solve (gauss-seidel, automatic form factors, tolerance 1e-3)", true);
-  if (first == 3)
-    in_child(a, issue_options(a),
-             "the issue's configuration (gauss-seidel, monte-carlo 1024 rays, one element per facet)", false);
+  int first = 0;
+  if (a.monte_carlo) {
+    first = in_child(a, defaults, "default solve (gauss-seidel, automatic form factors, tolerance 1e-3)", true);
+    if (first == 3)
+      in_child(a, issue_options(a),
+               "the issue's configuration (gauss-seidel, monte-carlo 1024 rays, one element per facet)", false);
+  }
+  if (a.hierarchical) {
+    rad::SolveOptions hr = issue_options(a);
+    hr.method = rad::SolverMethod::hierarchical;
+    hr.hierarchical.epsilon = a.epsilon;
+    const std::string label = "hierarchical (epsilon " + std::to_string(a.epsilon) + ", one element per facet)";
+    const int second = in_child(a, hr, label.c_str(), !a.monte_carlo);
+    if (second == 1) first = 1;
+  }
   return first == 1 ? 1 : 0;
 }

@@ -20,6 +20,23 @@ enum class SolverMethod {
   jacobi,        ///< all F precomputed; B' = E + rho F B from the previous sweep
   gauss_seidel,  ///< all F precomputed; each element uses the newest values
   progressive,   ///< shooting, brightest unshot power first (Cohen et al. 1988)
+  /// Links between nodes of a cluster hierarchy over the patches and the element quadtrees,
+  /// refined where they carry more than HierarchicalOptions::epsilon (Hanrahan, Salzman &
+  /// Aupperle 1991, with clustering); Jacobi sweeps with push-pull. No form-factor matrix: the
+  /// links' memory grows about linearly with the scene (docs/HIERARCHICAL.md).
+  hierarchical,
+};
+
+/// SolverMethod::hierarchical's refinement (docs/HIERARCHICAL.md).
+struct HierarchicalOptions {
+  /// A link is refined (its larger end split) while the radiosity it may bring to its
+  /// receiver, reflectance x irradiance, exceeds epsilon x the scene's mean radiosity estimate
+  /// (the lights' and emitters' power per area times the mean interreflection factor). In
+  /// (0, 1]; smaller is more accurate and costs more links.
+  float epsilon = 0.05f;
+  /// Refinement passes at most: the first links against the emitted light, each later one
+  /// refines them against the radiosity solved so far (multigridding), until no link changes.
+  int max_passes = 3;
 };
 
 /// Adaptive subdivision of elements where radiosity varies fast (shadow boundaries, near
@@ -53,7 +70,11 @@ struct SolveOptions {
   std::uint64_t seed = 1;        ///< overrides form_factors.seed
   /// Largest form-factor matrix the matrix methods may allocate, in bytes; 0 = 4 GiB.
   std::size_t memory_budget_bytes = 0;
+  /// With SolverMethod::hierarchical, refinement stays within the meshed elements
+  /// (MeshOptions) unless adaptive.enabled, which lets it split elements adaptive.max_depth
+  /// levels further (up to adaptive.max_elements leaves); adaptive.threshold is not used there.
   AdaptiveOptions adaptive;
+  HierarchicalOptions hierarchical;
   /// Also solve each light group's contribution on its own (one more solve per group, sharing
   /// the form factors and the hierarchy), kept in the Solution (Solution::light_groups()) so
   /// that Solution::relight() recombines them for any weights without solving. The light group
@@ -94,7 +115,8 @@ struct SolveReport {
   std::size_t element_count = 0;         ///< leaves (after adaptive refinement)
   std::size_t refined_elements = 0;      ///< leaves split by adaptive subdivision
   int refinement_passes = 0;
-  std::size_t form_factor_bytes = 0;     ///< memory held by form factors at the peak
+  std::size_t form_factor_bytes = 0;     ///< memory held by form factors (or links) at the peak
+  std::size_t link_count = 0;            ///< SolverMethod::hierarchical: links at the end (0 otherwise)
   /// The estimator that ran: SolveOptions' form_factors.method with automatic resolved
   /// (choose_form_factor_method()).
   FormFactorMethod form_factor_method = FormFactorMethod::automatic;

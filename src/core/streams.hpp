@@ -34,6 +34,8 @@ enum class Stream : std::uint64_t {
   light_front = 0xc0000000000ull,        ///< + light: the first shot's rays from an element's front
   light_back = 0xc0100000000ull,         ///< + light: the same from an element's back
   two_pass_sky = 0xd1ec7001ull,          ///< per element: sky rays of the direct part of pass 1
+  // Hierarchical radiosity (key_a: the link's receiver and source handles, 32 bits each).
+  hierarchical_link = 0xe0000000000ull,  ///< a link's visibility rays
 };
 
 /// The key of `stream`, `offset` into its range.
@@ -58,7 +60,7 @@ constexpr Range kRanges[] = {
     {stream_key(Stream::two_pass_direct), 1},               {stream_key(Stream::photon), 1},
     {stream_key(Stream::lightmap_gather), 1},               {stream_key(Stream::lightmap_light), 1ull << 31},
     {stream_key(Stream::light_front), 1ull << 31},          {stream_key(Stream::light_back), 1ull << 31},
-    {stream_key(Stream::two_pass_sky), 1},
+    {stream_key(Stream::two_pass_sky), 1},                  {stream_key(Stream::hierarchical_link), 1},
 };
 
 constexpr bool disjoint() {

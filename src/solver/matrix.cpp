@@ -53,10 +53,10 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
     if (slot_of(u) == kNone) missing.push_back(static_cast<std::uint32_t>(u));
   // Memory, stated before anything is computed. Rows with backs come from the sparse calls
   // (the dense ones keep to fronts).
-  const bool sparse = ctx.estimator.sparse() || sys.has_backs();
+  const bool sparse = ctx.estimator->sparse() || sys.has_backs();
   std::size_t rows_held = 0;
   for (const FactorVector& r : store.rows) rows_held += r.empty() ? 0 : 1;
-  check_row_memory(rows_held + missing.size(), m, n, sparse, ctx.estimator.max_row_entries(),
+  check_row_memory(rows_held + missing.size(), m, n, sparse, ctx.estimator->max_row_entries(),
                    ctx.options.memory_budget_bytes);
   std::vector<std::uint32_t> slots(missing.size());
   for (std::size_t k = 0; k < missing.size(); ++k) {
@@ -82,8 +82,8 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
     for (std::size_t k = begin; k < end; ++k)
       (missing[k] < sys.fronts() ? rows : backs).push_back(sys.element(missing[k]));
     if (sparse) {
-      ctx.estimator.sparse_element_rows(rows, sparse_rows);
-      if (!backs.empty()) ctx.estimator.sparse_back_rows(backs, back_rows);
+      ctx.estimator->sparse_element_rows(rows, sparse_rows);
+      if (!backs.empty()) ctx.estimator->sparse_back_rows(backs, back_rows);
       std::size_t front = 0, back = 0;  // fronts come before backs in `missing`
       for (std::size_t k = begin; k < end; ++k) {
         SparseFactors& from = missing[k] < sys.fronts() ? sparse_rows[front++] : back_rows[back++];
@@ -96,7 +96,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       }
     } else {
       buffer.resize(rows.size() * n);
-      ctx.estimator.element_rows(rows, buffer.data());
+      ctx.estimator->element_rows(rows, buffer.data());
       for (std::size_t k = begin; k < end; ++k) {
         FactorVector& r = store.rows[slots[k]];
         r.index.clear();

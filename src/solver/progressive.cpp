@@ -44,7 +44,7 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   // Columns with backs come from the sparse calls (the dense ones keep to fronts).
   // They are kept in `store` for the next solve of the same Problem (relighting), unless the
   // leaves changed since they were computed.
-  const bool sparse = ctx.estimator.sparse() || sys.has_backs();
+  const bool sparse = ctx.estimator->sparse() || sys.has_backs();
   if (store.leaf_count != sys.fronts() || store.columns.size() != n) {
     store = ColumnStore{};
     store.columns.resize(n);
@@ -139,7 +139,7 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
                            [&](std::uint32_t a, std::uint32_t b) { return power[a] > power[b] || (power[a] == power[b] && a < b); });
           batch.insert(batch.end(), candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(extra));
         }
-        ctx.estimator.sparse_patch_columns(batch, sys.leaves, fetched);
+        ctx.estimator->sparse_patch_columns(batch, sys.leaves, fetched);
         for (std::size_t k = 0; k < batch.size(); ++k) {
           FactorVector column;
           column.index = std::move(fetched[k].index);
@@ -158,7 +158,7 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
         F = cached[shooter] ? &cache[shooter] : &scratch;
       } else {
         scratch.value.resize(sys.fronts());
-        ctx.estimator.patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, scratch.value.data());
+        ctx.estimator->patch_column(static_cast<std::uint32_t>(shooter), sys.leaves, scratch.value.data());
         if (cached_bytes + scratch.bytes() <= ctx.options.memory_budget_bytes) {
           cached_bytes += scratch.bytes();
           cache[shooter] = std::move(scratch);

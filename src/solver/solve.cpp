@@ -12,6 +12,7 @@
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
 #include "form_factors/pass1_material.hpp"
+#include "solver/hierarchical/link_hierarchy.hpp"
 #include "solver/light_groups.hpp"
 #include "solver/light_shot.hpp"
 #include "solver/system.hpp"
@@ -105,6 +106,19 @@ void validate(const SolveOptions& o) {
       throw Error(ErrorCode::invalid_argument,
                   "adaptive.max_depth must be >= 1, got " + std::to_string(o.adaptive.max_depth));
   }
+  if (o.method == SolverMethod::hierarchical) {
+    if (!(o.hierarchical.epsilon > 0.0f && o.hierarchical.epsilon <= 1.0f))
+      throw Error(ErrorCode::invalid_argument,
+                  "hierarchical.epsilon must be in (0, 1], got " + std::to_string(o.hierarchical.epsilon));
+    if (o.hierarchical.max_passes < 1)
+      throw Error(ErrorCode::invalid_argument,
+                  "hierarchical.max_passes must be >= 1, got " + std::to_string(o.hierarchical.max_passes));
+    if (o.form_factors.specular_depth > 0)
+      throw Error(ErrorCode::invalid_argument,
+                  "form_factors.specular_depth > 0 (mirror and window paths between diffuse surfaces) needs the "
+                  "Monte Carlo rows of the matrix or progressive methods; SolverMethod::hierarchical's links do "
+                  "not carry them");
+  }
   detail::resolve(o.form_factors);
 }
 
@@ -120,6 +134,7 @@ struct Problem::Impl {
   std::size_t initial_leaves = 0;
   std::unique_ptr<FormFactorEstimator> estimator;  ///< made by the first solve with emission
   detail::MatrixStore store;                       ///< the matrix methods' rows, kept
+  std::unique_ptr<detail::LinkHierarchy> links;    ///< SolverMethod::hierarchical's links, kept
   detail::ColumnStore columns;                     ///< progressive refinement's columns, kept
   /// The lights' first shot (made by the first solve of a scene with lights) and its values per
   /// element, kept: the lights and the geometry do not change between solves.
@@ -277,8 +292,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // as the form factors: a scene that cannot fit is refused at once, by the figure
   // solve_matrix() would give (one row per leaf; with backs, whose rows solve_matrix() counts
   // itself, only there).
-  if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
-  if (o.method != SolverMethod::progressive && store.rows.empty() && !translucency)
+  const bool hierarchical = o.method == SolverMethod::hierarchical;
+  if (!estimator && !hierarchical) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
+  if (o.method != SolverMethod::progressive && !hierarchical && store.rows.empty() && !translucency)
     detail::check_row_memory(hierarchy.leaves().size(), hierarchy.leaves().size(), estimator->target_count(),
                              estimator->sparse(), estimator->max_row_entries(), o.memory_budget_bytes);
 
@@ -306,9 +322,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
                     std::move(no_direct));
   }
 
-  if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
   // Both number the backs with find_back_patches().
-  RADIOSITY_ASSERT(estimator->target_count() == system->patches());
+  RADIOSITY_ASSERT(hierarchical || estimator->target_count() == system->patches());
   const bool progressive = o.method == SolverMethod::progressive;
   auto t1 = std::chrono::steady_clock::now();
 
@@ -343,16 +358,112 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     report.seconds_form_factors += res.seconds_form_factors;
   };
 
+  // New leaves (the children of `split`, just subdivided) become unknowns: they start from
+  // their parent's values (a warm start), get their share of the lights, and the system is
+  // made again. False when the lights' shot was cancelled.
+  auto adopt_children = [&](const std::vector<std::uint32_t>& split) {
+    std::vector<std::uint32_t> created;
+    for (std::uint32_t e : split)
+      for (std::uint32_t c = hierarchy.element(e).first_child; c < hierarchy.element(e).first_child + 4; ++c)
+        created.push_back(c);
+    resize();
+    for (std::uint32_t c : created) {
+      const std::uint32_t parent = hierarchy.element(c).parent;
+      B_elements[c] = B_elements[parent];
+      H_elements[c] = H_elements[parent];
+      if (translucency) {
+        B_back[c] = B_back[parent];
+        H_back[c] = H_back[parent];
+      }
+    }
+    // The new leaves' share of the lights (their parents' values averaged them).
+    const double before = light_shot.seconds;
+    const bool lit = shoot_lights(created, gate);
+    report.seconds_lights += light_shot.seconds - before;
+    if (!lit) {
+      // Cancelled: the parents' values stand for their children in this solution's balance
+      // (a later solve computes them).
+      for (std::uint32_t c : created) {
+        const std::uint32_t parent = hierarchy.element(c).parent;
+        light_shot.done[c] = 0;
+        light_shot.front[c] = light_shot.front[parent];
+        light_shot.back[c] = light_shot.back[parent];
+      }
+    }
+    system.emplace(scene, hierarchy, translucency, emission, light_shot_of);
+    return std::make_pair(lit, std::move(created));
+  };
+  // Side values per unknown, for a warm start.
+  auto current_B = [&] {
+    std::vector<Rgb> B0(system->unknowns());
+    for (std::size_t i = 0; i < system->unknowns(); ++i) B0[i] = B_of(i);
+    return B0;
+  };
+
   detail::SolverResult r;
-  {
-    detail::SolverContext context{scene, hierarchy, *system, *estimator, o, gate};
+  SolveStatus status = SolveStatus::converged;
+  if (hierarchical) {
+    // Links refined against the emitted light, solved, refined again against the solution
+    // (multigridding) until no link changes (docs/HIERARCHICAL.md).
+    if (!links) links = std::make_unique<detail::LinkHierarchy>(scene, hierarchy, o.seed, o.threads);
+    detail::SubdivisionLimits limits;
+    if (o.adaptive.enabled) {
+      limits.max_depth = static_cast<std::uint8_t>(std::min(250, initial_depth + o.adaptive.max_depth));
+      limits.max_leaves = o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * initial_leaves;
+    }
+    std::vector<Rgb> B_now = system->source;
+    bool solved = false;
+    for (int pass = 1; pass <= o.hierarchical.max_passes; ++pass) {
+      // The oracle's scale: the scene's mean radiosity estimate, power emitted (lights
+      // included) per area times the mean interreflection factor.
+      double source_power = 0.0;
+      for (std::size_t u = 0; u < system->unknowns(); ++u)
+        source_power += system->area[u] * (system->source[u].x + system->source[u].y + system->source[u].z) / 3.0;
+      const Rgb& k = system->interreflection;
+      const double mean_B = source_power / system->total_area * (k.x + k.y + k.z) / 3.0;
+      const auto threshold = static_cast<float>(o.hierarchical.epsilon * mean_B);
+      std::vector<std::uint32_t> split;
+      detail::RefineStats stats;
+      const auto tf = std::chrono::steady_clock::now();
+      const bool refined = links->refine(hierarchy, *system, B_now, threshold, limits, gate, split, stats);
+      report.seconds_form_factors += seconds_since(tf);
+      bool lit = true;
+      if (!split.empty()) {
+        lit = adopt_children(split).first;
+        report.refined_elements += split.size();
+      }
+      if (!refined || !lit) {
+        status = SolveStatus::cancelled;
+        if (!solved) {
+          // Nothing solved yet: the emitted light alone is this solution (consistent).
+          r = detail::SolverResult{};
+          r.B = system->source;
+          r.H.assign(system->unknowns(), Rgb(0.0f));
+          keep(r);
+        }
+        break;
+      }
+      if (solved && split.empty() && stats.links_replaced == 0) break;  // nothing changed
+      report.refinement_passes = pass;
+      detail::SolverContext context{scene, hierarchy, *system, nullptr, o, gate};
+      r = links->solve(context, solved ? current_B() : std::vector<Rgb>{});
+      keep(r);
+      status = r.status;
+      solved = true;
+      if (status == SolveStatus::cancelled) break;
+      B_now = r.B;
+    }
+    report.link_count = links->link_count();
+    report.form_factor_bytes = std::max(report.form_factor_bytes, links->bytes());
+  } else {
+    detail::SolverContext context{scene, hierarchy, *system, estimator.get(), o, gate};
     r = progressive ? detail::solve_progressive(context, columns)
                     : detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, {});
+    keep(r);
+    status = r.status;
   }
-  keep(r);
-  SolveStatus status = r.status;
 
-  if (o.adaptive.enabled && status != SolveStatus::cancelled) {
+  if (o.adaptive.enabled && !hierarchical && status != SolveStatus::cancelled) {
     const auto max_depth = static_cast<std::uint8_t>(std::min(250, initial_depth + o.adaptive.max_depth));
     const std::size_t budget =
         o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * initial_leaves;
@@ -360,40 +471,13 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       const std::vector<std::uint32_t> split =
           detail::leaves_to_refine(hierarchy, B_elements, o.adaptive, max_depth, budget);
       if (split.empty()) break;
-      std::vector<std::uint32_t> created;
       for (std::uint32_t e : split) {
         store.release(e);
-        const std::uint32_t first = hierarchy.subdivide(e);
-        for (std::uint32_t c = first; c < first + 4; ++c) created.push_back(c);
-      }
-      // Children start from their parent's value (a warm start for the next sweeps).
-      resize();
-      for (std::uint32_t c : created) {
-        const std::uint32_t parent = hierarchy.element(c).parent;
-        B_elements[c] = B_elements[parent];
-        H_elements[c] = H_elements[parent];
-        if (translucency) {
-          B_back[c] = B_back[parent];
-          H_back[c] = H_back[parent];
-        }
+        hierarchy.subdivide(e);
       }
       report.refined_elements += split.size();
       report.refinement_passes = pass;
-      // The new leaves' share of the lights (their parents' values averaged them).
-      const double before = light_shot.seconds;
-      const bool lit = shoot_lights(created, gate);
-      report.seconds_lights += light_shot.seconds - before;
-      if (!lit) {
-        // Cancelled: the parents' values stand for their children in this solution's balance
-        // (a later solve computes them).
-        for (std::uint32_t c : created) {
-          const std::uint32_t parent = hierarchy.element(c).parent;
-          light_shot.done[c] = 0;
-          light_shot.front[c] = light_shot.front[parent];
-          light_shot.back[c] = light_shot.back[parent];
-        }
-      }
-      system.emplace(scene, hierarchy, translucency, emission, light_shot_of);
+      auto [lit, created] = adopt_children(split);
       if (!lit) {
         status = SolveStatus::cancelled;
         break;
@@ -406,10 +490,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
 
       if (!progressive) {
         // Matrix methods: rows for the new elements only, then sweeps from the warm start.
-        std::vector<Rgb> B0(system->unknowns());
-        for (std::size_t i = 0; i < system->unknowns(); ++i) B0[i] = B_of(i);
-        detail::SolverContext context{scene, hierarchy, *system, *estimator, o, gate};
-        r = detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, B0);
+        detail::SolverContext context{scene, hierarchy, *system, estimator.get(), o, gate};
+        r = detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, current_B());
         keep(r);
         status = r.status;
         if (status == SolveStatus::cancelled) break;
@@ -491,7 +573,16 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // What arrived straight from the emitters; not for a cancelled solve, which may lack rows.
   std::vector<Rgb> H_direct;
   if (status != SolveStatus::cancelled) {
-    const std::vector<Rgb> direct = direct_irradiance(*system, *estimator, progressive, store, columns);
+    std::vector<Rgb> direct;
+    if (hierarchical) {
+      // What the emitters alone send along the links, plus the lights' first shot.
+      direct = links->irradiance(hierarchy, *system, system->emission);
+      direct.resize(system->fronts());
+      if (!system->light.empty())
+        for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->light[u];
+    } else {
+      direct = direct_irradiance(*system, *estimator, progressive, store, columns);
+    }
     H_direct.assign(hierarchy.elements().size(), Rgb(0.0f));
     for (std::size_t u = 0; u < system->fronts(); ++u) H_direct[system->leaves[u]] = direct[u];
     hierarchy.aggregate(H_direct);

@@ -94,7 +94,7 @@ struct SolverContext {
   const Scene& scene;
   const PatchHierarchy& hierarchy;
   const RadiositySystem& system;
-  const FormFactorEstimator& estimator;
+  const FormFactorEstimator* estimator;  ///< null for SolverMethod::hierarchical (no form factors)
   const SolveOptions& options;  ///< with max_iterations and memory_budget_bytes resolved
   ProgressGate& progress;
 };

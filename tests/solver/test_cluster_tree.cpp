@@ -209,7 +209,7 @@ TEST_CASE("sending moments conserve energy: I integrates to sum B A over the sph
   const hr::ClusterTree tree(h);
   const std::vector<rad::Rgb> B = random_radiosities(h.patches().size(), 7);
   std::vector<hr::Moments> P;
-  hr::sending_moments(tree, h, B, 2, P);
+  hr::sending_moments(tree, h, B, {}, 2, P);
   glm::dvec3 power(0.0);
   for (std::size_t p = 0; p < B.size(); ++p) power += glm::dvec3(B[p]) * static_cast<double>(h.patches()[p].area);
   const glm::dvec3 integral = integrate_intensity(P[hr::ClusterTree::root()], 600);
@@ -229,8 +229,8 @@ TEST_CASE("sending moments are the same at 1 and 2 threads") {
   const hr::ClusterTree tree(h);
   const std::vector<rad::Rgb> B = random_radiosities(h.patches().size(), 3);
   std::vector<hr::Moments> one, two;
-  hr::sending_moments(tree, h, B, 1, one);
-  hr::sending_moments(tree, h, B, 2, two);
+  hr::sending_moments(tree, h, B, {}, 1, one);
+  hr::sending_moments(tree, h, B, {}, 2, two);
   CHECK(one == two);
 }
 
@@ -256,7 +256,7 @@ TEST_CASE("a box cluster sends what its six faces send") {
   const hr::ClusterTree tree(h);
   const std::vector<rad::Rgb> B = random_radiosities(6, 5);
   std::vector<hr::Moments> P;
-  hr::sending_moments(tree, h, B, 1, P);
+  hr::sending_moments(tree, h, B, {}, 1, P);
   std::vector<glm::vec3> directions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   for (const glm::vec3& w : random_directions(50, 13)) directions.push_back(w);
   for (const glm::vec3& w : directions) {

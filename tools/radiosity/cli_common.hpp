@@ -189,6 +189,7 @@ struct SolveArgs {
   bool adaptive = false;
   float adaptive_threshold = 0.3f;
   int adaptive_passes = 3;
+  float epsilon = rad::HierarchicalOptions{}.epsilon;
   bool strict = false;
   bool photometric = false;
   bool two_sided = false;
@@ -266,7 +267,7 @@ inline void add_photometric_flag(CLI::App& cmd, bool& photometric) {
 
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
-  std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive"};
+  std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive", "hierarchical"};
   if (with_path) methods.push_back("path");
   cmd.add_option("--method", a.method, with_path ? "Solver, or path for the reference path tracer" : "Solver")
       ->check(CLI::IsMember(methods))
@@ -301,6 +302,11 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--adaptive-passes", a.adaptive_passes, "Refinement passes at most")
       ->check(in_range<int>(1, 16))
       ->capture_default_str();
+  cmd.add_option("--epsilon", a.epsilon,
+                 "Hierarchical: refine a link while the radiosity it brings exceeds this fraction of the scene's "
+                 "mean radiosity, (0, 1]; smaller is more accurate and costs more links")
+      ->check(in_range<float>(1e-6f, 1.0f))
+      ->capture_default_str();
   cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)")->check(any_number<unsigned>());
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->check(any_number<std::uint64_t>())
@@ -320,6 +326,7 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   rad::SolveOptions o;
   o.method = a.method == "jacobi"        ? rad::SolverMethod::jacobi
              : a.method == "progressive" ? rad::SolverMethod::progressive
+             : a.method == "hierarchical" ? rad::SolverMethod::hierarchical
                                          : rad::SolverMethod::gauss_seidel;
   o.form_factors.method = form_factor_method(a.form_factors);
   o.form_factors.hemisphere_rays = a.hemisphere_rays;
@@ -333,6 +340,7 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.adaptive.enabled = a.adaptive;
   o.adaptive.threshold = a.adaptive_threshold;
   o.adaptive.max_passes = a.adaptive_passes;
+  o.hierarchical.epsilon = a.epsilon;
   o.separate_light_groups = a.light_groups;
   o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
   return o;
@@ -393,7 +401,11 @@ inline void print_summary(const rad::Solution& sol) {
                                                                          : "cancelled";
   std::printf("solved: %zu patches, %zu elements, %d iterations, residual %.3g (%s)\n", r.patch_count,
               r.element_count, r.iterations, r.residual, status);
-  if (r.refinement_passes > 0)
+  if (r.link_count > 0)
+    std::printf("hierarchical: %zu links (%.1f MiB with the cluster tree), %d refinement passes, %zu elements split\n",
+                r.link_count, static_cast<double>(r.form_factor_bytes) / (1024.0 * 1024.0), r.refinement_passes,
+                r.refined_elements);
+  else if (r.refinement_passes > 0)
     std::printf("adaptive: %zu elements split in %d passes\n", r.refined_elements, r.refinement_passes);
   std::printf("time: meshing %.3f s, form factors %.3f s, solving %.3f s\n", r.seconds_meshing,
               r.seconds_form_factors, r.seconds_solving);
@@ -411,6 +423,10 @@ inline void print_summary(const rad::Solution& sol) {
 /// Says which estimator ran, and why when the choice was automatic.
 inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
   const rad::SolveReport& r = sol.report();
+  if (options.method == rad::SolverMethod::hierarchical) {
+    std::printf("form factors: links of the hierarchy (point-to-polygon and cluster transport, shadow rays)\n");
+    return;
+  }
   if (options.form_factors.method != rad::FormFactorMethod::automatic) {
     std::printf("form factors: %s\n", rad::to_string(r.form_factor_method));
     return;

@@ -46,6 +46,7 @@ const char* method_name(SolverMethod m) {
     case SolverMethod::jacobi: return "jacobi";
     case SolverMethod::gauss_seidel: return "gauss_seidel";
     case SolverMethod::progressive: return "progressive";
+    case SolverMethod::hierarchical: return "hierarchical";
   }
   return "unknown";
 }
@@ -80,6 +81,7 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   j["patches"] = r.patch_count;
   j["elements"] = r.element_count;
   j["form_factor_bytes"] = r.form_factor_bytes;
+  j["link_count"] = r.link_count;
   j["mesh"] = Json{{"max_patch_area", number(solution.hierarchy().options().max_patch_area)},
                    {"max_element_area", number(solution.hierarchy().options().max_element_area)}};
   j["emitted_power"] = rgb(r.emitted_power);

@@ -132,15 +132,19 @@ Rgb intensity(const Moments& P, const glm::vec3& w) {
   return kInvPi * I;
 }
 
-void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& B,
-                     unsigned threads, std::vector<Moments>& out) {
+void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& front,
+                     const std::vector<Rgb>& back, unsigned threads, std::vector<Moments>& out) {
   const std::vector<Patch>& patches = hierarchy.patches();
-  RADIOSITY_ASSERT(B.size() == patches.size());
+  RADIOSITY_ASSERT(front.size() == patches.size());
+  RADIOSITY_ASSERT(back.empty() || back.size() == patches.size());
   out.assign(tree.nodes().size(), Moments{});
   // Leaves: each patch's B A split by its normal, every leaf written by one index alone.
   parallel_for(threads, patches.size(), 1024, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p)
-      add_surface(out[tree.leaf_of(static_cast<std::uint32_t>(p))], patches[p].normal, B[p] * patches[p].area);
+    for (std::size_t p = begin; p < end; ++p) {
+      Moments& leaf = out[tree.leaf_of(static_cast<std::uint32_t>(p))];
+      add_surface(leaf, patches[p].normal, front[p] * patches[p].area);
+      if (!back.empty()) add_surface(leaf, -patches[p].normal, back[p] * patches[p].area);
+    }
   });
   // Inner nodes: children before parents (depth-first ids), left child then right, so every sum
   // runs in one fixed order.

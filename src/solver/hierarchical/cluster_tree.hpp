@@ -110,14 +110,14 @@ void add_surface(Moments& P, const glm::vec3& n, const Rgb& power);
 /// moments, and it is exact for surfaces whose normals lie along the axes.
 Rgb intensity(const Moments& P, const glm::vec3& w);
 
-/// Sending moments of every cluster of `tree` from per-patch radiosities `B` (indexed by patch
-/// id, W/m^2): leaves from their patch (B A split by its normal), inner nodes the sum of their
-/// two children. Deterministic at any thread count (leaves in parallel, then inner nodes in a
-/// fixed order). `out` is resized to the node count. Front sides only: TODO(#15) the back
-/// sides of two-sided and translucent patches (a node per side, as the matrix solvers number them).
+/// Sending moments of every cluster of `tree` from per-patch radiosities (indexed by patch id,
+/// W/m^2): leaves from their patch (front B A split by its normal, and back B A by the reversed
+/// normal), inner nodes the sum of their two children. `back` is empty when no patch has a back
+/// side (else one value per patch, 0 where a patch has none). Deterministic at any thread count
+/// (leaves in parallel, then inner nodes in a fixed order). `out` is resized to the node count.
 /// Thread safety: pure; `out` is the caller's.
-void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& B,
-                     unsigned threads, std::vector<Moments>& out);
+void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& front,
+                     const std::vector<Rgb>& back, unsigned threads, std::vector<Moments>& out);
 
 /// Adds to irradiance moments `E` a link's irradiance `flux` (W/m^2, as received by a surface
 /// facing the source) arriving from the unit direction `d` (from the receiver toward the

@@ -1,0 +1,695 @@
+// Hierarchical radiosity's links: refinement and the sweeps (link_hierarchy.hpp,
+// docs/HIERARCHICAL.md).
+// Based on: P. Hanrahan, D. Salzman & L. Aupperle, "A rapid hierarchical radiosity algorithm",
+// SIGGRAPH 1991; B. Smits, J. Arvo & D. Greenberg, "A clustering algorithm for radiosity in
+// complex environments", SIGGRAPH 1994; F. Sillion, "A unified hierarchical algorithm for global
+// illumination with scattering volumes and object clusters", IEEE TVCG 1(3), 1995.
+#include "solver/hierarchical/link_hierarchy.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/assert.hpp"
+#include "core/constants.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
+#include "core/streams.hpp"
+#include "form_factors/estimators.hpp"
+
+namespace radiosity::detail {
+namespace {
+
+/// Visibility rays per link: a first pass, and more when it is mixed (a penumbra). A link
+/// whose first pass is all clear or all blocked is taken as fully visible or hidden.
+constexpr int kFirstRays = 4;
+constexpr int kPenumbraRays = 12;
+/// Tries per wanted ray to find a pair of points that face each other (cluster surfaces face
+/// many ways); a link with no such pair in all its tries carries nothing.
+constexpr int kTriesPerRay = 8;
+/// Pairs per block of a refinement round: blocks are the unit of parallel work and of output
+/// order, so results do not depend on the thread count.
+constexpr std::size_t kBlock = 1024;
+/// Links with a cluster end are taken only when the two nodes' radii add up to at most this
+/// fraction of their distance (unless they carry less than kSeparationFloor x the threshold):
+/// a cluster's transport is taken from its centre, whose error grows with (r / d)^2.
+constexpr float kSeparation = 0.3f;
+constexpr float kSeparationFloor = 0.1f;
+/// Receiver points per side for the closed form between touching elements (n x n).
+constexpr int kTouchingGrid = 2;
+
+float mean(const Rgb& c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z); }
+
+struct Pair {
+  NodeHandle receiver, source;
+};
+
+struct LinkRecord {
+  NodeHandle receiver, source;
+  float coefficient;
+};
+
+/// One block's output of a refinement round, in the order it was made.
+struct BlockOutput {
+  std::vector<LinkRecord> links;
+  std::vector<Pair> next;                   ///< children's pairs, and pairs waiting for a split
+  std::vector<std::uint32_t> subdivide;     ///< element leaves to split before the next round
+  std::size_t examined = 0, refined = 0;
+  std::uint64_t rays = 0;
+};
+
+}  // namespace
+
+struct LinkHierarchy::Impl {
+  const Scene& scene;
+  ClusterTree tree;
+  RayScene occluders;
+  std::uint64_t seed;
+  unsigned threads;
+  float ray_epsilon;
+  /// Per position of tree.order(): the area of the patches before it, for sampling a
+  /// cluster's surface by area.
+  std::vector<double> cumulative_area;
+
+  /// Per patch: 1 when it has a back side (refresh_patch_data(), at every refine()).
+  std::vector<std::uint8_t> has_back;
+
+  // The links, by receiver: receiver index r (receiver_index()) has the links
+  // [offsets[r], offsets[r + 1]) of sources[] and coefficients[].
+  std::vector<std::uint64_t> offsets;
+  std::vector<NodeHandle> sources;
+  std::vector<float> coefficients;
+  std::uint32_t linked_elements = 0;  ///< the element count the receiver indices were made for
+  bool linked = false;
+
+  /// Node radiosity for the oracle and the sweeps.
+  struct Values {
+    std::vector<Rgb> front, back;   ///< per element id (inner nodes: area-weighted means)
+    std::vector<Moments> sending;   ///< per cluster
+  };
+
+  Impl(const Scene& s, const PatchHierarchy& hierarchy, std::uint64_t seed_, unsigned threads_)
+      : scene(s),
+        tree(hierarchy),
+        occluders(RayScene::from_polygons(s)),
+        seed(seed_),
+        threads(threads_),
+        ray_epsilon(1e-5f * std::max(s.bounds().diagonal(), 1e-6f)) {
+    const std::vector<std::uint32_t>& order = tree.order();
+    cumulative_area.resize(order.size() + 1, 0.0);
+    for (std::size_t k = 0; k < order.size(); ++k)
+      cumulative_area[k + 1] = cumulative_area[k] + hierarchy.patches()[order[k]].area;
+  }
+
+  std::uint32_t cluster_count() const { return static_cast<std::uint32_t>(tree.nodes().size()); }
+
+  /// Dense receiver index: clusters, then element fronts, then element backs.
+  std::uint64_t receiver_index(NodeHandle h, std::uint32_t elements) const {
+    if (is_cluster(h)) return handle_index(h);
+    return std::uint64_t{cluster_count()} + (is_back(h) ? elements : 0u) + element_of(h);
+  }
+  NodeHandle receiver_handle(std::uint64_t index, std::uint32_t elements) const {
+    if (index < cluster_count()) return cluster_handle(static_cast<std::uint32_t>(index));
+    index -= cluster_count();
+    return index < elements ? side_handle(static_cast<std::uint32_t>(index), false)
+                            : side_handle(static_cast<std::uint32_t>(index - elements), true);
+  }
+
+  void refresh_patch_data(const PatchHierarchy& hierarchy, const RadiositySystem& sys) {
+    has_back.assign(hierarchy.patches().size(), 0);
+    for (std::size_t u = sys.fronts(); u < sys.unknowns(); ++u) has_back[hierarchy.element(sys.element(u)).patch] = 1;
+  }
+
+  /// Element values from side values per unknown, then the clusters' sending moments.
+  void node_values(const PatchHierarchy& hierarchy, const RadiositySystem& sys, const std::vector<Rgb>& B,
+                   Values& v) const {
+    const std::size_t count = hierarchy.elements().size();
+    v.front.assign(count, Rgb(0.0f));
+    v.back.assign(sys.has_backs() ? count : 0, Rgb(0.0f));
+    for (std::size_t u = 0; u < sys.unknowns(); ++u) (u < sys.fronts() ? v.front : v.back)[sys.element(u)] = B[u];
+    hierarchy.aggregate(v.front);
+    if (!v.back.empty()) hierarchy.aggregate(v.back);
+    const std::vector<Patch>& patches = hierarchy.patches();
+    std::vector<Rgb> patch_front(patches.size()), patch_back(v.back.empty() ? 0 : patches.size());
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      patch_front[p] = v.front[patches[p].root];
+      if (!v.back.empty()) patch_back[p] = v.back[patches[p].root];
+    }
+    sending_moments(tree, hierarchy, patch_front, patch_back, threads, v.sending);
+  }
+
+  // ---- Node geometry ------------------------------------------------------------------------
+
+  static float element_radius(const PatchHierarchy& h, std::uint32_t e) {
+    const Element& el = h.element(e);
+    float r = 0.0f;
+    for (int k = 0; k < el.corner_count(); ++k) r = std::max(r, glm::length(h.vertices()[el.corners[k]] - el.centroid));
+    return r;
+  }
+  glm::vec3 centre(const PatchHierarchy& h, NodeHandle n) const {
+    return is_cluster(n) ? tree.node(handle_index(n)).centre : h.element(element_of(n)).centroid;
+  }
+  float radius(const PatchHierarchy& h, NodeHandle n) const {
+    return is_cluster(n) ? tree.node(handle_index(n)).radius : element_radius(h, element_of(n));
+  }
+  static glm::vec3 side_normal(const PatchHierarchy& h, NodeHandle n) {
+    const glm::vec3& normal = h.normal(element_of(n));
+    return is_back(n) ? -normal : normal;
+  }
+  /// Largest of dot(n, x - p) over the points x of node `h`.
+  float support(const PatchHierarchy& hierarchy, NodeHandle h, const glm::vec3& n, const glm::vec3& p) const {
+    if (is_cluster(h)) {
+      const Bounds& b = tree.node(handle_index(h)).bounds;
+      const glm::vec3 mid = 0.5f * (b.lower + b.upper), half = 0.5f * (b.upper - b.lower);
+      return glm::dot(n, mid - p) + std::abs(n.x) * half.x + std::abs(n.y) * half.y + std::abs(n.z) * half.z;
+    }
+    const Element& e = hierarchy.element(element_of(h));
+    float s = -std::numeric_limits<float>::infinity();
+    for (int k = 0; k < e.corner_count(); ++k) s = std::max(s, glm::dot(n, hierarchy.vertices()[e.corners[k]] - p));
+    return s;
+  }
+
+  /// Radiant intensity (W/sr) of node `h` toward the unit direction `w`.
+  Rgb source_intensity(const PatchHierarchy& hierarchy, const Values& v, NodeHandle h, const glm::vec3& w) const {
+    if (is_cluster(h)) return intensity(v.sending[handle_index(h)], w);
+    const std::uint32_t e = element_of(h);
+    const float cosine = std::max(0.0f, glm::dot(side_normal(hierarchy, h), w));
+    const Rgb& B = (is_back(h) ? v.back : v.front)[e];
+    return B * (hierarchy.element(e).area * cosine * kInvPi);
+  }
+  /// The children of a node in the link hierarchy: a cluster's two, a one-patch cluster's root
+  /// element (both sides when the patch has a back), an element's four (same side). Returns
+  /// the count (0 for a leaf element).
+  int children(const PatchHierarchy& hierarchy, NodeHandle h, std::array<NodeHandle, 4>& out) const {
+    if (is_cluster(h)) {
+      const ClusterNode& c = tree.node(handle_index(h));
+      if (!c.is_leaf()) {
+        out[0] = cluster_handle(c.children[0]);
+        out[1] = cluster_handle(c.children[1]);
+        return 2;
+      }
+      const std::uint32_t p = tree.order()[c.first];
+      const std::uint32_t root = hierarchy.patches()[p].root;
+      out[0] = side_handle(root, false);
+      if (!has_back[p]) return 1;
+      out[1] = side_handle(root, true);
+      return 2;
+    }
+    const Element& e = hierarchy.element(element_of(h));
+    if (e.is_leaf()) return 0;
+    for (std::uint32_t k = 0; k < 4; ++k) out[k] = side_handle(e.first_child + k, is_back(h));
+    return 4;
+  }
+
+  bool is_leaf_cluster(NodeHandle h) const { return is_cluster(h) && tree.node(handle_index(h)).is_leaf(); }
+
+  // ---- Visibility ---------------------------------------------------------------------------
+
+  /// A point of node `h`, area-uniform, with the normal of the side it lies on (a cluster's
+  /// patch with a back takes the side facing `toward`; with toward == point, the front).
+  void sample(const PatchHierarchy& hierarchy, NodeHandle h, Rng& rng, glm::vec3& point, glm::vec3& normal,
+              bool& two_sided) const {
+    if (!is_cluster(h)) {
+      point = hierarchy.sample_point(element_of(h), rng.uniform2());
+      normal = side_normal(hierarchy, h);
+      two_sided = false;
+      return;
+    }
+    const ClusterNode& c = tree.node(handle_index(h));
+    const double lo = cumulative_area[c.first], hi = cumulative_area[c.first + c.count];
+    const double target = lo + static_cast<double>(rng.uniform()) * (hi - lo);
+    auto it = std::upper_bound(cumulative_area.begin() + c.first + 1, cumulative_area.begin() + c.first + c.count + 1,
+                               target);
+    const auto k = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(
+        it - cumulative_area.begin() - 1, static_cast<std::ptrdiff_t>(c.first + c.count - 1)));
+    const std::uint32_t p = tree.order()[k];
+    const Patch& patch = hierarchy.patches()[p];
+    point = hierarchy.sample_point(patch.root, rng.uniform2());
+    normal = patch.normal;
+    two_sided = has_back[p] != 0;
+  }
+
+  /// Fraction of clear rays between facing points of the two nodes; -1 when no facing pair
+  /// was found. Adds the rays cast to `rays`.
+  float visibility(const PatchHierarchy& hierarchy, NodeHandle r, NodeHandle s, std::uint64_t& rays) const {
+    thread_local std::vector<glm::vec3> origin, direction;
+    thread_local std::vector<std::uint8_t> blocked;
+    Rng rng(seed, (std::uint64_t{r} << 32) | s, stream_key(Stream::hierarchical_link));
+    auto draw = [&](int wanted) {
+      origin.clear();
+      direction.clear();
+      for (int tries = 0; tries < kTriesPerRay * wanted && static_cast<int>(origin.size()) < wanted; ++tries) {
+        glm::vec3 x, nx, y, ny;
+        bool two_x, two_y;
+        sample(hierarchy, s, rng, x, nx, two_x);
+        sample(hierarchy, r, rng, y, ny, two_y);
+        const glm::vec3 d = y - x;
+        if (two_x && glm::dot(nx, d) < 0.0f) nx = -nx;
+        if (two_y && glm::dot(ny, d) > 0.0f) ny = -ny;
+        if (!(glm::dot(nx, d) > 0.0f) || !(glm::dot(ny, d) < 0.0f)) continue;
+        const glm::vec3 o = x + ray_epsilon * nx;
+        origin.push_back(o);
+        direction.push_back((y + ray_epsilon * ny) - o);
+      }
+      blocked.resize(origin.size());
+      occluders.occluded(origin.size(), origin.data(), direction.data(), 0.0f, 1.0f - 1e-4f, blocked.data());
+      rays += origin.size();
+      int clear = 0;
+      for (std::uint8_t b : blocked) clear += b == 0 ? 1 : 0;
+      return std::pair<int, int>(clear, static_cast<int>(origin.size()));
+    };
+    const auto [clear, cast] = draw(kFirstRays);
+    if (cast == 0) return -1.0f;
+    if (clear == 0) return 0.0f;
+    if (clear == cast) return 1.0f;
+    const auto [more_clear, more_cast] = draw(kPenumbraRays);
+    return static_cast<float>(clear + more_clear) / static_cast<float>(cast + more_cast);
+  }
+
+  /// Element-to-element factor: the point-to-polygon closed form from receiver points to the
+  /// source element, averaged over an n x n grid of area-uniform cells of the receiver (n = 1:
+  /// its centroid), 0 at points behind the source's side.
+  static float element_factor(const PatchHierarchy& h, NodeHandle r, NodeHandle s, int n) {
+    const std::uint32_t re = element_of(r);
+    const Element& es = h.element(element_of(s));
+    const glm::vec3 nr = side_normal(h, r), ns = side_normal(h, s);
+    std::array<glm::vec3, 4> polygon{};
+    for (int k = 0; k < es.corner_count(); ++k) polygon[static_cast<std::size_t>(k)] = h.vertices()[es.corners[k]];
+    auto at = [&](const glm::vec3& x) {
+      if (!(glm::dot(ns, x - es.centroid) > 0.0f)) return 0.0f;
+      return point_to_polygon_factor_fast(x, nr, polygon.data(), es.corner_count());
+    };
+    if (n == 1) return at(h.element(re).centroid);
+    float sum = 0.0f;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        sum += at(h.sample_point(re, glm::vec2((static_cast<float>(i) + 0.5f) / static_cast<float>(n),
+                                                (static_cast<float>(j) + 0.5f) / static_cast<float>(n))));
+    return sum / static_cast<float>(n * n);
+  }
+
+  // ---- Refinement ---------------------------------------------------------------------------
+
+  struct RoundContext {
+    const PatchHierarchy& hierarchy;
+    const Values& values;
+    float threshold;
+    const SubdivisionLimits& limits;
+    bool subdivision_closed;
+  };
+
+  bool can_split(const RoundContext& rc, NodeHandle h) const {
+    if (is_cluster(h)) return true;
+    const Element& e = rc.hierarchy.element(element_of(h));
+    if (!e.is_leaf()) return true;
+    return !rc.subdivision_closed && e.depth < rc.limits.max_depth && e.area > 0.0f;
+  }
+
+  /// The oracle's two estimates for link (r <- s), irradiance at the receiver (mean channel,
+  /// W/m^2): `bound`, the most the link may bring (the source's intensity toward r over the
+  /// nearest distance squared), and `spread`, how much that varies over the pair (between the
+  /// nearest and the farthest distance): the error of taking the transport as uniform over the
+  /// nodes. Both infinite when the nodes' spheres overlap. Irradiance rather than the
+  /// radiosity it makes (Hanrahan et al.'s rho B F): lightmaps store irradiance, which a black
+  /// receiver has too.
+  struct LinkError {
+    float bound, spread;
+  };
+  LinkError link_error(const RoundContext& rc, NodeHandle r, NodeHandle s) const {
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    const glm::vec3 cr = centre(rc.hierarchy, r), cs = centre(rc.hierarchy, s);
+    const float d = glm::length(cr - cs);
+    const float reach = radius(rc.hierarchy, r) + radius(rc.hierarchy, s);
+    const float gap = d - reach;
+    if (!(gap > 0.0f)) return {kInf, kInf};
+    const float transport = mean(source_intensity(rc.hierarchy, rc.values, s, (cr - cs) / d));
+    const float far = d + reach;
+    return {transport / (gap * gap), transport * (1.0f / (gap * gap) - 1.0f / (far * far))};
+  }
+
+  /// True when nothing can pass between the two nodes: one is an element side wholly in front
+  /// of which the other does not reach, or both are elements of one patch.
+  bool cannot_exchange(const PatchHierarchy& h, NodeHandle r, NodeHandle s, float scale) const {
+    const float tolerance = 1e-5f * scale;
+    if (!is_cluster(r) && !is_cluster(s) && h.element(element_of(r)).patch == h.element(element_of(s)).patch)
+      return true;
+    if (!is_cluster(s) && support(h, r, side_normal(h, s), h.element(element_of(s)).centroid) <= tolerance)
+      return true;
+    if (!is_cluster(r) && support(h, s, side_normal(h, r), h.element(element_of(r)).centroid) <= tolerance)
+      return true;
+    return false;
+  }
+
+  void process(const RoundContext& rc, const Pair& pair, BlockOutput& out) const {
+    const PatchHierarchy& h = rc.hierarchy;
+    const NodeHandle r = pair.receiver, s = pair.source;
+    std::array<NodeHandle, 4> kids{};
+    ++out.examined;
+    if (r == s) {
+      // A cluster's light to itself: between its children, each to itself too; a single patch
+      // (planar) sends nothing to itself.
+      if (is_leaf_cluster(r)) return;
+      const int n = children(h, r, kids);
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) out.next.push_back({kids[static_cast<std::size_t>(a)], kids[static_cast<std::size_t>(b)]});
+      ++out.refined;
+      return;
+    }
+    // A one-patch cluster stands for its patch's element(s): links to clusters are for groups.
+    for (const NodeHandle leaf : {r, s}) {
+      if (!is_leaf_cluster(leaf)) continue;
+      const int n = children(h, leaf, kids);
+      for (int k = 0; k < n; ++k)
+        out.next.push_back(leaf == r ? Pair{kids[static_cast<std::size_t>(k)], s} : Pair{r, kids[static_cast<std::size_t>(k)]});
+      return;
+    }
+    const float rr = radius(h, r), rs = radius(h, s);
+    if (cannot_exchange(h, r, s, rr + rs)) return;
+
+    const bool split_r = can_split(rc, r), split_s = can_split(rc, s);
+    // Splits the larger node (by radius) that can be split; false when neither can.
+    auto refine = [&] {
+      if (!split_r && !split_s) return false;
+      const NodeHandle split = split_r && (!split_s || rr >= rs) ? r : s;
+      const int n = children(h, split, kids);
+      if (n == 0) {
+        // An element leaf that may be subdivided: split it, then look at this pair again.
+        out.subdivide.push_back(element_of(split));
+        out.next.push_back(pair);
+        return true;
+      }
+      for (int k = 0; k < n; ++k)
+        out.next.push_back(split == r ? Pair{kids[static_cast<std::size_t>(k)], s} : Pair{r, kids[static_cast<std::size_t>(k)]});
+      ++out.refined;
+      return true;
+    };
+    const LinkError error = link_error(rc, r, s);
+    if (error.spread > rc.threshold && refine()) return;
+    // A cluster's transport is taken from its centre: accurate only when the nodes are small
+    // for their distance (as in Barnes & Hut's multipole acceptance).
+    if ((is_cluster(r) || is_cluster(s)) && rr + rs > kSeparation * glm::length(centre(h, r) - centre(h, s)) &&
+        error.bound > kSeparationFloor * rc.threshold && refine())
+      return;
+
+    // Link. Element pairs take the closed form (averaged over the receiver when close), the
+    // rest the point-to-point transport of the nodes' centres over distance squared.
+    const glm::vec3 cr = centre(h, r), cs = centre(h, s);
+    const float d = glm::length(cr - cs);
+    float coefficient = 0.0f;
+    if (!is_cluster(r) && !is_cluster(s)) {
+      // Receiver points: one when far, more when close, most when touching (where the
+      // factor varies fastest, near a shared edge).
+      const int n = d >= 4.0f * (rr + rs) ? 1 : d > rr + rs ? 2 : kTouchingGrid;
+      coefficient = element_factor(h, r, s, n);
+    } else {
+      coefficient = d > 0.0f ? 1.0f / (d * d) : 0.0f;
+    }
+    if (!(coefficient > 0.0f)) return;
+    const float v = visibility(h, r, s, out.rays);
+    if (!(v > 0.0f)) return;
+    // A partly hidden link hides a shadow boundary somewhere in its nodes: refined while the
+    // most it may bring exceeds the threshold (a fully visible or hidden one never is).
+    if (v < 1.0f && error.bound > rc.threshold && refine()) return;
+    out.links.push_back({r, s, coefficient * v});
+  }
+
+  /// Runs refinement rounds from `frontier` until it is empty; new links go to `links`.
+  bool run_rounds(PatchHierarchy& hierarchy, Values& values, std::vector<Pair> frontier, float threshold, const SubdivisionLimits& limits, ProgressGate& gate,
+                  std::vector<LinkRecord>& links, std::vector<std::uint32_t>& split, RefineStats& stats) {
+    bool subdivision_closed = limits.max_depth == 0;
+    std::size_t done = 0;
+    std::vector<BlockOutput> blocks;
+    while (!frontier.empty()) {
+      const RoundContext rc{hierarchy, values, threshold, limits, subdivision_closed};
+      const std::size_t block_count = (frontier.size() + kBlock - 1) / kBlock;
+      blocks.assign(block_count, BlockOutput{});
+      parallel_for(threads, block_count, 1, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t b = begin; b < end; ++b) {
+          const std::size_t first = b * kBlock, last = std::min(frontier.size(), first + kBlock);
+          for (std::size_t k = first; k < last; ++k) process(rc, frontier[k], blocks[b]);
+        }
+      });
+      done += frontier.size();
+      std::vector<Pair> next;
+      std::vector<std::uint32_t> subdivide;
+      for (BlockOutput& b : blocks) {
+        links.insert(links.end(), b.links.begin(), b.links.end());
+        next.insert(next.end(), b.next.begin(), b.next.end());
+        subdivide.insert(subdivide.end(), b.subdivide.begin(), b.subdivide.end());
+        stats.examined += b.examined;
+        stats.refined += b.refined;
+        stats.rays += b.rays;
+      }
+      blocks.clear();
+      if (!subdivide.empty()) {
+        // Split in increasing id order (deterministic ids); children take their parent's
+        // values until the next solve.
+        std::sort(subdivide.begin(), subdivide.end());
+        subdivide.erase(std::unique(subdivide.begin(), subdivide.end()), subdivide.end());
+        for (std::uint32_t e : subdivide) {
+          if (hierarchy.leaves().size() + 3 > limits.max_leaves) {
+            subdivision_closed = true;
+            break;
+          }
+          const std::uint32_t first = hierarchy.subdivide(e);
+          split.push_back(e);
+          values.front.resize(hierarchy.elements().size());
+          for (std::uint32_t c = first; c < first + 4; ++c) values.front[c] = values.front[e];
+          if (!values.back.empty()) {
+            values.back.resize(hierarchy.elements().size());
+            for (std::uint32_t c = first; c < first + 4; ++c) values.back[c] = values.back[e];
+          }
+        }
+      }
+      frontier.swap(next);
+      Progress p;
+      p.phase = Phase::form_factors;
+      p.fraction = static_cast<double>(done) / static_cast<double>(done + frontier.size());
+      if (!gate.report(p, frontier.empty())) return false;
+    }
+    return true;
+  }
+
+  /// Makes the receiver-ordered arrays from `links` (a stable counting sort by receiver).
+  void store(std::vector<LinkRecord>& links, std::uint32_t elements) {
+    const std::uint64_t receivers = std::uint64_t{cluster_count()} + 2ull * elements;
+    offsets.assign(receivers + 1, 0);
+    for (const LinkRecord& l : links) ++offsets[receiver_index(l.receiver, elements) + 1];
+    for (std::uint64_t r = 0; r < receivers; ++r) offsets[r + 1] += offsets[r];
+    std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
+    sources.assign(links.size(), 0);
+    coefficients.assign(links.size(), 0.0f);
+    for (const LinkRecord& l : links) {
+      const std::uint64_t at = fill[receiver_index(l.receiver, elements)]++;
+      sources[at] = l.source;
+      coefficients[at] = l.coefficient;
+    }
+    sources.shrink_to_fit();
+    coefficients.shrink_to_fit();
+    linked_elements = elements;
+    linked = true;
+  }
+
+  // ---- Sweeps -------------------------------------------------------------------------------
+
+  /// Gather and push: the irradiance per unknown from the links with node values `v`.
+  void gather(const PatchHierarchy& hierarchy, const RadiositySystem& sys, const Values& v,
+              std::vector<Rgb>& H) const {
+    const std::uint32_t elements = linked_elements;
+    RADIOSITY_ASSERT(hierarchy.elements().size() == elements);
+    const std::uint32_t C = cluster_count();
+    std::vector<Moments> received(C, Moments{});
+    std::vector<Rgb> front(elements, Rgb(0.0f)), back(sys.has_backs() ? elements : 0, Rgb(0.0f));
+    const std::uint64_t receivers = offsets.size() - 1;
+    parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint64_t first = offsets[i], last = offsets[i + 1];
+        if (first == last) continue;
+        const NodeHandle r = receiver_handle(i, elements);
+        const glm::vec3 cr = centre(hierarchy, r);
+        if (is_cluster(r)) {
+          Moments& E = received[handle_index(r)];
+          for (std::uint64_t k = first; k < last; ++k) {
+            const NodeHandle s = sources[k];
+            const glm::vec3 w = glm::normalize(cr - centre(hierarchy, s));
+            add_irradiance(E, -w, coefficients[k] * source_intensity(hierarchy, v, s, w));
+          }
+          continue;
+        }
+        const glm::vec3 nr = side_normal(hierarchy, r);
+        Rgb sum(0.0f);
+        for (std::uint64_t k = first; k < last; ++k) {
+          const NodeHandle s = sources[k];
+          if (!is_cluster(s)) {
+            sum += coefficients[k] * (is_back(s) ? v.back : v.front)[element_of(s)];
+            continue;
+          }
+          const glm::vec3 w = glm::normalize(cr - centre(hierarchy, s));
+          sum += (coefficients[k] * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
+        }
+        (is_back(r) ? back : front)[element_of(r)] = sum;
+      }
+    });
+    // Push: clusters to their children (ids increase downward), one-patch clusters to their
+    // patch's root element by its normal, elements to their children.
+    for (std::uint32_t c = 0; c < C; ++c) {
+      const ClusterNode& node = tree.node(c);
+      if (!node.is_leaf()) {
+        for (std::uint32_t child : node.children)
+          for (int a = 0; a < 6; ++a) received[child][a] += received[c][a];
+        continue;
+      }
+      const std::uint32_t p = tree.order()[node.first];
+      const Patch& patch = hierarchy.patches()[p];
+      front[patch.root] += element_irradiance(received[c], patch.normal);
+      if (!back.empty() && has_back[p]) back[patch.root] += element_irradiance(received[c], -patch.normal);
+    }
+    for (std::uint32_t e = 0; e < elements; ++e) {
+      const Element& el = hierarchy.element(e);
+      if (el.is_leaf()) continue;
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        front[el.first_child + k] += front[e];
+        if (!back.empty()) back[el.first_child + k] += back[e];
+      }
+    }
+    H.resize(sys.unknowns());
+    for (std::size_t u = 0; u < sys.unknowns(); ++u) H[u] = (u < sys.fronts() ? front : back)[sys.element(u)];
+  }
+};
+
+LinkHierarchy::LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed,
+                             unsigned threads)
+    : impl_(std::make_unique<Impl>(scene, hierarchy, seed, threads)) {}
+LinkHierarchy::~LinkHierarchy() = default;
+
+bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& system, const std::vector<Rgb>& B,
+                           float threshold, const SubdivisionLimits& limits, ProgressGate& gate,
+                           std::vector<std::uint32_t>& split, RefineStats& stats) {
+  Impl& m = *impl_;
+  if (m.tree.empty()) return true;
+  m.refresh_patch_data(hierarchy, system);
+  Impl::Values values;
+  m.node_values(hierarchy, system, B, values);
+
+  std::vector<LinkRecord> kept;
+  std::vector<Pair> frontier;
+  if (!m.linked) {
+    frontier.push_back({cluster_handle(ClusterTree::root()), cluster_handle(ClusterTree::root())});
+  } else {
+    // Multigridding: every link looked at again with the radiosity solved so far; those that
+    // now carry too much are refined, in receiver order (deterministic).
+    const Impl::RoundContext rc{hierarchy, values, threshold, limits, limits.max_depth == 0};
+    const std::uint64_t receivers = m.offsets.size() - 1;
+    const std::size_t block_count = (receivers + kBlock - 1) / kBlock;
+    std::vector<std::vector<LinkRecord>> keep_blocks(block_count);
+    std::vector<std::vector<Pair>> refine_blocks(block_count);
+    parallel_for(m.threads, block_count, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t b = begin; b < end; ++b)
+        for (std::uint64_t i = b * kBlock; i < std::min<std::uint64_t>(receivers, (b + 1) * kBlock); ++i) {
+          const NodeHandle r = m.receiver_handle(i, m.linked_elements);
+          for (std::uint64_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
+            const NodeHandle s = m.sources[k];
+            if (m.link_error(rc, r, s).spread > threshold && (m.can_split(rc, r) || m.can_split(rc, s)))
+              refine_blocks[b].push_back({r, s});
+            else
+              keep_blocks[b].push_back({r, s, m.coefficients[k]});
+          }
+        }
+    });
+    for (std::size_t b = 0; b < block_count; ++b) {
+      kept.insert(kept.end(), keep_blocks[b].begin(), keep_blocks[b].end());
+      frontier.insert(frontier.end(), refine_blocks[b].begin(), refine_blocks[b].end());
+    }
+    stats.links_replaced += frontier.size();
+    if (frontier.empty()) return true;
+  }
+  std::vector<LinkRecord> added;
+  if (!m.run_rounds(hierarchy, values, std::move(frontier), threshold, limits, gate, added, split, stats))
+    return false;
+  stats.links_added += added.size();
+  kept.insert(kept.end(), added.begin(), added.end());
+  added = {};
+  m.store(kept, static_cast<std::uint32_t>(hierarchy.elements().size()));
+  return true;
+}
+
+SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rgb>& B0) const {
+  const Impl& m = *impl_;
+  const RadiositySystem& sys = ctx.system;
+  const std::size_t n = sys.unknowns();
+  SolverResult result;
+  result.B = B0.empty() ? sys.source : B0;
+  result.H.assign(n, Rgb(0.0f));
+  result.form_factor_bytes = bytes();
+  if (!m.linked) return result;
+  auto t0 = std::chrono::steady_clock::now();
+  Impl::Values values;
+  std::vector<Rgb> next(n);
+  const int max_iterations = ctx.options.max_iterations;
+  result.status = SolveStatus::iteration_cap;
+  for (int it = 1; it <= max_iterations; ++it) {
+    m.node_values(ctx.hierarchy, sys, result.B, values);
+    m.gather(ctx.hierarchy, sys, values, result.H);
+    // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp), from the previous sweep's values.
+    double change = 0.0;
+    for (std::size_t u = 0; u < n; ++u) {
+      Rgb b = sys.source[u] + sys.reflectance[u] * result.H[u];
+      if (sys.twin[u] != kNone) b += sys.transmittance[u] * result.H[sys.twin[u]];
+      next[u] = b;
+      change += sys.area[u] * l1(b - result.B[u]);
+    }
+    result.B.swap(next);
+    result.iterations = it;
+    result.residual = change / sys.emitted;
+    result.residual_history.push_back(result.residual);
+    result.time_history.push_back(seconds_since(t0));
+    const bool done = result.residual < ctx.options.tolerance;
+    if (done) result.status = SolveStatus::converged;
+    Progress p;
+    p.phase = Phase::solving;
+    p.iteration = it;
+    p.residual = result.residual;
+    p.fraction = done ? 1.0 : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
+    p.hierarchy = &ctx.hierarchy;
+    p.leaf_radiosity = result.B.data();
+    if (!ctx.progress.report(p, done)) {
+      result.status = SolveStatus::cancelled;
+      break;
+    }
+    if (done) break;
+  }
+  // Irradiance for the energy balance, from the final radiosity.
+  m.node_values(ctx.hierarchy, sys, result.B, values);
+  m.gather(ctx.hierarchy, sys, values, result.H);
+  return result;
+}
+
+std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
+                                           const std::vector<Rgb>& B) const {
+  std::vector<Rgb> H(system.unknowns(), Rgb(0.0f));
+  if (!impl_->linked) return H;
+  Impl::Values values;
+  impl_->node_values(hierarchy, system, B, values);
+  impl_->gather(hierarchy, system, values, H);
+  return H;
+}
+
+std::size_t LinkHierarchy::link_count() const { return impl_->sources.size(); }
+
+std::size_t LinkHierarchy::bytes() const {
+  const Impl& m = *impl_;
+  const std::size_t clusters = m.tree.nodes().size();
+  return m.sources.capacity() * sizeof(NodeHandle) + m.coefficients.capacity() * sizeof(float) +
+         m.offsets.capacity() * sizeof(std::uint64_t) + clusters * (sizeof(ClusterNode) + 2 * sizeof(Moments)) +
+         m.cumulative_area.capacity() * sizeof(double);
+}
+
+const ClusterTree& LinkHierarchy::tree() const { return impl_->tree; }
+
+}  // namespace radiosity::detail

@@ -1,0 +1,97 @@
+// Hierarchical radiosity's links (docs/HIERARCHICAL.md, issue #15): energy moves along links
+// between nodes of the cluster tree and the element quadtrees, refined by the "BF" oracle
+// from one self-link of the root cluster, then Jacobi sweeps of gather and push-pull over them.
+// Private to the library; solve() runs it for SolverMethod::hierarchical.
+// Based on: P. Hanrahan, D. Salzman & L. Aupperle, "A rapid hierarchical radiosity algorithm",
+// SIGGRAPH 1991 (links, BF refinement, gather, push-pull, multigridding); B. Smits, J. Arvo &
+// D. Greenberg, "A clustering algorithm for radiosity in complex environments", SIGGRAPH 1994
+// (starting from the root cluster's self-link); F. Sillion, "A unified hierarchical algorithm
+// for global illumination with scattering volumes and object clusters", IEEE TVCG 1(3), 1995
+// (cluster links as point-to-point transport between directional distributions).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "geometry/ray_scene.hpp"
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+#include "solver/hierarchical/cluster_tree.hpp"
+#include "solver/system.hpp"
+
+namespace radiosity::detail {
+
+// ---- Sides ----------------------------------------------------------------------------------
+
+/// An element handle's side bit: the back of a two-sided or translucent element is a node of
+/// its own (as the matrix solvers number backs). Element ids stay below 2^30.
+inline constexpr NodeHandle kBackTag = 0x40000000u;
+inline NodeHandle side_handle(std::uint32_t element, bool back) {
+  RADIOSITY_ASSERT(element < kBackTag);
+  return element | (back ? kBackTag : 0u);
+}
+inline bool is_back(NodeHandle h) { return !is_cluster(h) && (h & kBackTag) != 0; }
+/// The element of an element handle (either side).
+inline std::uint32_t element_of(NodeHandle h) { return h & ~(kClusterTag | kBackTag); }
+
+/// How far refinement may split elements below the meshed ones: never when max_depth is 0.
+struct SubdivisionLimits {
+  std::uint8_t max_depth = 0;   ///< Element::depth of the finest element refinement may make
+  std::size_t max_leaves = 0;   ///< stop splitting when the hierarchy has this many leaves
+};
+
+/// What refinement did, for the report and the benchmarks.
+struct RefineStats {
+  std::size_t examined = 0;   ///< pairs the oracle looked at
+  std::size_t refined = 0;    ///< of those, split into their children's pairs
+  std::size_t links_added = 0;
+  std::size_t links_replaced = 0;  ///< existing links that a later pass refined
+  std::uint64_t rays = 0;     ///< visibility rays
+};
+
+/// The links of a scene and the solve over them. Built empty; refine() makes and refines the
+/// links, solve() sweeps them. Keeps the cluster tree (over the patches, which subdivision does
+/// not change), the ray scene and the links between the solves of one Problem.
+/// Thread safety: refine() needs exclusive access; solve() and the const members may be called
+/// concurrently with each other.
+class LinkHierarchy {
+ public:
+  LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads);
+  ~LinkHierarchy();
+  LinkHierarchy(const LinkHierarchy&) = delete;
+  LinkHierarchy& operator=(const LinkHierarchy&) = delete;
+
+  /// One refinement pass against the radiosity `B` of `system` (per unknown): the first call
+  /// links the root cluster to itself and refines from there; later calls re-examine every link
+  /// with the new radiosity and refine those that now exceed `threshold` (W/m^2: the radiosity
+  /// a link may bring to its receiver). Splits elements of `hierarchy` within `limits`; their
+  /// ids are appended to `split` (the caller makes their children unknowns). Returns false when
+  /// `gate` cancels: the links are then those before the call (elements split so far stay split).
+  bool refine(PatchHierarchy& hierarchy, const RadiositySystem& system, const std::vector<Rgb>& B, float threshold,
+              const SubdivisionLimits& limits, ProgressGate& gate, std::vector<std::uint32_t>& split,
+              RefineStats& stats);
+
+  /// Jacobi sweeps (gather, push, B = E + rho H + tau H', pull) from `B0` (per unknown) until
+  /// the residual is below the tolerance or the iteration cap (SolveOptions), with progress and
+  /// cancel. H in the result is the irradiance from surfaces only.
+  SolverResult solve(const SolverContext& context, const std::vector<Rgb>& B0) const;
+
+  /// The irradiance per unknown that radiosity `B` (per unknown) sends along the links: one
+  /// gather and push. With B = the emission it is the direct irradiance from the emitters.
+  std::vector<Rgb> irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
+                              const std::vector<Rgb>& B) const;
+
+  std::size_t link_count() const;
+  /// Memory of the links, the cluster tree and the sweeps' per-node arrays, bytes.
+  std::size_t bytes() const;
+  const ClusterTree& tree() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace radiosity::detail
