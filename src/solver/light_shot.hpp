@@ -72,6 +72,9 @@ class LightShooter {
   Rgb element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays,
                          const std::vector<char>* only = nullptr) const;
 
+  /// The scene's polygons as shadow-ray occluders (shared with hierarchical radiosity's links).
+  const RayScene& occluders() const { return occluders_; }
+
  private:
   const PatchHierarchy& hierarchy_;
   SceneLights lights_;

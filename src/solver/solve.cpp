@@ -134,12 +134,13 @@ struct Problem::Impl {
   std::size_t initial_leaves = 0;
   std::unique_ptr<FormFactorEstimator> estimator;  ///< made by the first solve with emission
   detail::MatrixStore store;                       ///< the matrix methods' rows, kept
-  std::unique_ptr<detail::LinkHierarchy> links;    ///< SolverMethod::hierarchical's links, kept
   detail::ColumnStore columns;                     ///< progressive refinement's columns, kept
   /// The lights' first shot (made by the first solve of a scene with lights) and its values per
   /// element, kept: the lights and the geometry do not change between solves.
   std::unique_ptr<detail::LightShooter> light_shooter;
   detail::LightShot light_shot;
+  /// SolverMethod::hierarchical's links, kept (after light_shooter: they share its ray scene).
+  std::unique_ptr<detail::LinkHierarchy> links;
   /// During a light group's solve: that group's lights alone (solve_light_groups()).
   const detail::LightShot* group_light_shot = nullptr;
 
@@ -405,7 +406,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   if (hierarchical) {
     // Links refined against the emitted light, solved, refined again against the solution
     // (multigridding) until no link changes (docs/HIERARCHICAL.md).
-    if (!links) links = std::make_unique<detail::LinkHierarchy>(scene, hierarchy, o.seed, o.threads);
+    if (!links)
+      links = std::make_unique<detail::LinkHierarchy>(scene, hierarchy, o.seed, o.threads,
+                                                      light_shooter ? &light_shooter->occluders() : nullptr);
     detail::SubdivisionLimits limits;
     if (o.adaptive.enabled) {
       limits.max_depth = static_cast<std::uint8_t>(std::min(250, initial_depth + o.adaptive.max_depth));

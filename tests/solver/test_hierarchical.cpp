@@ -133,13 +133,13 @@ TEST_SUITE("solver") {
     const rad::Scene scene = test::closed_box(m);
     const rad::Rgb expected = m.emission / (rad::Rgb(1.0f) - m.reflectance);
     // A link's error is a share of its transport, and rho = 0.8 multiplies the rows' error by
-    // up to 1 / (1 - 0.8) = 5. Measured at epsilon 0.05 / 0.004: worst leaf 12.1 % / 0.38 %,
-    // mean 1.6 % / 0.30 %, absorbed / emitted 1.019 / 1.0037 (green channel).
+    // up to 1 / (1 - 0.8) = 5. Measured at epsilon 0.05 / 0.004: worst leaf 7.7 % / 0.38 %,
+    // mean 0.76 % / 0.30 %, absorbed / emitted 1.0095 / 1.0037 (green channel).
     struct Case {
       float eps;
       double worst, mean, balance;
     };
-    for (const Case& k : {Case{0.05f, 0.15, 0.025, 0.03}, Case{0.004f, 0.01, 0.005, 0.006}}) {
+    for (const Case& k : {Case{0.05f, 0.12, 0.012, 0.015}, Case{0.004f, 0.01, 0.005, 0.006}}) {
       CAPTURE(k.eps);
       rad::SolveOptions o = hierarchical(k.eps);
       o.mesh.max_patch_area = 0.26f;
@@ -186,32 +186,38 @@ TEST_SUITE("solver") {
     }
   }
 
-  TEST_CASE("hierarchical: the Cornell box agrees with Gauss-Seidel, closer as epsilon shrinks") {
-    // Reference: Gauss-Seidel over ray-cast factors (exact unoccluded factors; Monte Carlo
-    // rows at 16384 rays agree with it within 0.12 % per group and channel). Measured worst
-    // group and channel: 1.7 % at epsilon 0.05 (the default), 1.3 % at 0.005.
+  TEST_CASE("hierarchical: the Cornell box agrees with Gauss-Seidel over element-to-element factors") {
+    // The reference's targets are the elements themselves (patches = elements), as the links'
+    // finest ends are: with element-to-patch factors a patch half hidden under a block sends its
+    // mean radiosity from its visible half too, an error of the reference of up to 40 % on the
+    // leaves next to the blocks (measured). Monte Carlo rows at 16384 rays (their noise on a
+    // group mean is below 0.1 %). Measured worst group and channel: 1.23 % (the red wall, red)
+    // at epsilon 0.05, 0.99 % at 0.005; the direct part alone is within 0.63 %. The goal
+    // is 0.5 %: not met yet (docs/HIERARCHICAL.md, "Accuracy").
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;
-    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.hemisphere_rays = 16384;
     o.tolerance = 1e-5;
+    o.mesh.max_patch_area = o.mesh.max_element_area = 10000.0f;  // 100 mm
     const rad::Solution gs = rad::solve(scene, o);
     for (float eps : {0.05f, 0.005f}) {
       CAPTURE(eps);
       rad::SolveOptions h = hierarchical(eps);
       h.tolerance = 1e-5;
+      h.mesh = o.mesh;
       const rad::Solution hr = rad::solve(scene, h);
       REQUIRE(hr.status() == rad::SolveStatus::converged);
       CHECK(hr.report().link_count > 0);
-      double worst = 0.0;
       for (const std::string& g : scene.groups()) {
+        CAPTURE(g);
         const rad::Rgb a = gs.group_radiosity(g), b = hr.group_radiosity(g);
-        for (int c = 0; c < 3; ++c) worst = std::max(worst, relative(b[c], a[c]));
+        for (int c = 0; c < 3; ++c) CHECK(relative(b[c], a[c]) < 0.015);
       }
-      CHECK(worst < (eps > 0.01f ? 0.025 : 0.02));
       // The energy balance: the open front lets out about 31 % of the light in both.
-      const rad::SolveReport& a = gs.report();
-      const rad::SolveReport& b = hr.report();
-      CHECK(std::abs(b.escaped_power.y / b.emitted_power.y - a.escaped_power.y / a.emitted_power.y) < 0.01);
+      const rad::SolveReport& ra = gs.report();
+      const rad::SolveReport& rb = hr.report();
+      CHECK(std::abs(rb.escaped_power.y / rb.emitted_power.y - ra.escaped_power.y / ra.emitted_power.y) < 0.01);
     }
   }
 
@@ -286,22 +292,22 @@ TEST_SUITE("solver") {
     const rad::Solution hr = rad::solve(scene, o);
     REQUIRE(hr.status() == rad::SolveStatus::converged);
     REQUIRE(!hr.back_radiosity().empty());
-    // Measured: within 2.3 % on every group, side and channel, mostly below: a cluster's
-    // moments send a little of the inside's light to the outer backs of two-sided walls (the
-    // link's direction is taken between the nodes' centres), 1.1 % of the power.
+    // Measured: within 1.4 % on every group, side and channel; 0.13-0.61 % of the power
+    // escapes: a cluster's moments send a little of the inside's light to the outer backs of
+    // two-sided walls (a link's direction is taken between the nodes' centroids).
     for (const std::string& g : scene.groups()) {
       CAPTURE(g);
       for (int c = 0; c < 3; ++c) {
         CAPTURE(c);
-        CHECK(relative(hr.group_radiosity(g)[c], gs.group_radiosity(g)[c]) < 0.03);
+        CHECK(relative(hr.group_radiosity(g)[c], gs.group_radiosity(g)[c]) < 0.025);
         const double back = gs.group_back_radiosity(g)[c];
-        if (back > 0.0) CHECK(relative(hr.group_back_radiosity(g)[c], back) < 0.03);
+        if (back > 0.0) CHECK(relative(hr.group_back_radiosity(g)[c], back) < 0.025);
       }
     }
     // What the lights put on the sides is the same first shot; a closed box absorbs it all.
     for (int c = 0; c < 3; ++c) {
       CHECK(relative(hr.report().light_power[c], gs.report().light_power[c]) < 1e-6);
-      CHECK(std::abs(hr.report().escaped_power[c]) < 0.02 * hr.report().emitted_power[c]);
+      CHECK(std::abs(hr.report().escaped_power[c]) < 0.012 * hr.report().emitted_power[c]);
     }
   }
 

@@ -11,6 +11,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <cstdio>
+#include <cstdlib>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -69,13 +71,18 @@ struct BlockOutput {
 struct LinkHierarchy::Impl {
   const Scene& scene;
   ClusterTree tree;
-  RayScene occluders;
+  std::unique_ptr<RayScene> own_occluders;  ///< when none was shared
+  const RayScene& occluders;
   std::uint64_t seed;
   unsigned threads;
   float ray_epsilon;
   /// Per position of tree.order(): the area of the patches before it, for sampling a
   /// cluster's surface by area.
   std::vector<double> cumulative_area;
+  std::vector<glm::vec3> cluster_centroid;  ///< per cluster: the area centroid of its patches
+  /// Per position of tree.order(): the power (mean channel of B A, both sides) of the patches
+  /// before it, from the radiosity of the current refine() pass.
+  std::vector<double> cumulative_power;
 
   /// Per patch: 1 when it has a back side (refresh_patch_data(), at every refine()).
   std::vector<std::uint8_t> has_back;
@@ -84,7 +91,7 @@ struct LinkHierarchy::Impl {
   // [offsets[r], offsets[r + 1]) of sources[] and coefficients[].
   std::vector<std::uint64_t> offsets;
   std::vector<NodeHandle> sources;
-  std::vector<float> coefficients;
+  std::vector<float> coefficients;  ///< negative for a partly hidden link (the factor is the magnitude)
   std::uint32_t linked_elements = 0;  ///< the element count the receiver indices were made for
   bool linked = false;
 
@@ -92,12 +99,64 @@ struct LinkHierarchy::Impl {
   struct Values {
     std::vector<Rgb> front, back;   ///< per element id (inner nodes: area-weighted means)
     std::vector<Moments> sending;   ///< per cluster
+    /// Refinement only (node_variation()): how far the radiosity below a node strays from the
+    /// node's mean, relative to that mean (mean channel; per element side and per cluster).
+    std::vector<float> variation_front, variation_back, variation_cluster;
   };
 
-  Impl(const Scene& s, const PatchHierarchy& hierarchy, std::uint64_t seed_, unsigned threads_)
+  /// Values::variation_*: for each node the largest |B(leaf) - B(node)| over the leaves below
+  /// it (bounded by summing the steps down the tree), over B(node). A link from a node whose
+  /// radiosity is far from uniform (a floor patch half hidden under a block) misplaces light
+  /// when its receiver sees only part of it, so the oracle counts it.
+  void node_variation(const PatchHierarchy& hierarchy, Values& v) const {
+    const std::size_t count = hierarchy.elements().size();
+    std::vector<float> front(count, 0.0f), back(v.back.empty() ? 0 : count, 0.0f);
+    for (std::size_t id = count; id-- > 0;) {
+      const Element& e = hierarchy.element(static_cast<std::uint32_t>(id));
+      if (e.is_leaf()) continue;
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const std::uint32_t c = e.first_child + k;
+        front[id] = std::max(front[id], std::abs(mean(v.front[c]) - mean(v.front[id])) + front[c]);
+        if (!back.empty()) back[id] = std::max(back[id], std::abs(mean(v.back[c]) - mean(v.back[id])) + back[c]);
+      }
+    }
+    const std::uint32_t C = cluster_count();
+    std::vector<float> cluster(C, 0.0f), cluster_mean(C, 0.0f);
+    for (std::uint32_t i = C; i-- > 0;) {
+      const ClusterNode& c = tree.node(i);
+      float power = 0.0f;
+      for (const Rgb& m : v.sending[i]) power += mean(m);
+      cluster_mean[i] = c.area > 0.0f ? power / c.area : 0.0f;
+      if (c.is_leaf()) {
+        const std::uint32_t p = tree.order()[c.first];
+        const std::uint32_t root = hierarchy.patches()[p].root;
+        cluster[i] = std::abs(mean(v.front[root]) - cluster_mean[i]) + front[root];
+        if (!back.empty() && has_back[p])
+          cluster[i] = std::max(cluster[i], std::abs(mean(v.back[root]) - cluster_mean[i]) + back[root]);
+      } else {
+        for (std::uint32_t child : c.children)
+          cluster[i] = std::max(cluster[i], std::abs(cluster_mean[child] - cluster_mean[i]) + cluster[child]);
+      }
+    }
+    auto relative = [](std::vector<float>& var, auto mean_of) {
+      for (std::size_t k = 0; k < var.size(); ++k) {
+        const float m = mean_of(k);
+        var[k] = m > 0.0f ? var[k] / m : 0.0f;
+      }
+    };
+    relative(front, [&](std::size_t k) { return mean(v.front[k]); });
+    if (!back.empty()) relative(back, [&](std::size_t k) { return mean(v.back[k]); });
+    relative(cluster, [&](std::size_t k) { return cluster_mean[k]; });
+    v.variation_front = std::move(front);
+    v.variation_back = std::move(back);
+    v.variation_cluster = std::move(cluster);
+  }
+
+  Impl(const Scene& s, const PatchHierarchy& hierarchy, std::uint64_t seed_, unsigned threads_, const RayScene* shared)
       : scene(s),
         tree(hierarchy),
-        occluders(RayScene::from_polygons(s)),
+        own_occluders(shared ? nullptr : std::make_unique<RayScene>(RayScene::from_polygons(s))),
+        occluders(shared ? *shared : *own_occluders),
         seed(seed_),
         threads(threads_),
         ray_epsilon(1e-5f * std::max(s.bounds().diagonal(), 1e-6f)) {
@@ -105,6 +164,23 @@ struct LinkHierarchy::Impl {
     cumulative_area.resize(order.size() + 1, 0.0);
     for (std::size_t k = 0; k < order.size(); ++k)
       cumulative_area[k + 1] = cumulative_area[k] + hierarchy.patches()[order[k]].area;
+    // Centroids bottom-up (children have larger ids), area-weighted in double.
+    std::vector<glm::dvec3> moment(tree.nodes().size(), glm::dvec3(0.0));
+    std::vector<double> area(tree.nodes().size(), 0.0);
+    for (std::size_t i = tree.nodes().size(); i-- > 0;) {
+      const ClusterNode& c = tree.node(static_cast<std::uint32_t>(i));
+      if (c.is_leaf()) {
+        const Patch& p = hierarchy.patches()[order[c.first]];
+        area[i] = p.area;
+        moment[i] = static_cast<double>(p.area) * glm::dvec3(p.centroid);
+      } else {
+        area[i] = area[c.children[0]] + area[c.children[1]];
+        moment[i] = moment[c.children[0]] + moment[c.children[1]];
+      }
+    }
+    cluster_centroid.resize(tree.nodes().size());
+    for (std::size_t i = 0; i < tree.nodes().size(); ++i)
+      cluster_centroid[i] = area[i] > 0.0 ? glm::vec3(moment[i] / area[i]) : tree.node(static_cast<std::uint32_t>(i)).centre;
   }
 
   std::uint32_t cluster_count() const { return static_cast<std::uint32_t>(tree.nodes().size()); }
@@ -152,6 +228,12 @@ struct LinkHierarchy::Impl {
     for (int k = 0; k < el.corner_count(); ++k) r = std::max(r, glm::length(h.vertices()[el.corners[k]] - el.centroid));
     return r;
   }
+  /// Where a node's transport is taken from and to: its area centroid (a cluster's bounding
+  /// sphere is centred on its box, which can lie far from where its surfaces are).
+  glm::vec3 centroid(const PatchHierarchy& h, NodeHandle n) const {
+    return is_cluster(n) ? cluster_centroid[handle_index(n)] : h.element(element_of(n)).centroid;
+  }
+  /// The centre of a node's bounding sphere (the oracle's bounds).
   glm::vec3 centre(const PatchHierarchy& h, NodeHandle n) const {
     return is_cluster(n) ? tree.node(handle_index(n)).centre : h.element(element_of(n)).centroid;
   }
@@ -211,66 +293,91 @@ struct LinkHierarchy::Impl {
 
   // ---- Visibility ---------------------------------------------------------------------------
 
+  /// A point of an element for (u, v) in [0,1)^2: the bilinear map of a quad, the folded
+  /// barycentric map of a triangle. Not area-uniform on a non-parallelogram quad (the
+  /// estimators' CellSampler is, at several times the cost): visibility rays only need points
+  /// spread over the element.
+  static glm::vec3 element_point(const PatchHierarchy& h, std::uint32_t element, glm::vec2 uv) {
+    const Element& e = h.element(element);
+    const std::vector<glm::vec3>& v = h.vertices();
+    const glm::vec3 &a = v[e.corners[0]], &b = v[e.corners[1]], &c = v[e.corners[2]];
+    if (e.corner_count() == 3) {
+      if (uv.x + uv.y > 1.0f) uv = glm::vec2(1.0f) - uv;
+      return a + uv.x * (b - a) + uv.y * (c - a);
+    }
+    const glm::vec3& d = v[e.corners[3]];
+    const glm::vec3 ab = a + uv.x * (b - a), dc = d + uv.x * (c - d);
+    return ab + uv.y * (dc - ab);
+  }
+
   /// A point of node `h`, area-uniform, with the normal of the side it lies on (a cluster's
   /// patch with a back takes the side facing `toward`; with toward == point, the front).
-  void sample(const PatchHierarchy& hierarchy, NodeHandle h, Rng& rng, glm::vec3& point, glm::vec3& normal,
-              bool& two_sided) const {
+  void sample(const PatchHierarchy& hierarchy, NodeHandle h, bool by_power, Rng& rng, glm::vec3& point,
+              glm::vec3& normal, bool& two_sided) const {
     if (!is_cluster(h)) {
-      point = hierarchy.sample_point(element_of(h), rng.uniform2());
+      point = element_point(hierarchy, element_of(h), rng.uniform2());
       normal = side_normal(hierarchy, h);
       two_sided = false;
       return;
     }
     const ClusterNode& c = tree.node(handle_index(h));
-    const double lo = cumulative_area[c.first], hi = cumulative_area[c.first + c.count];
+    // A source's points by the power its patches send (dark patches, such as ground hidden
+    // under a building, send nothing and must not count in its visibility), a receiver's by
+    // area; by area too where the cluster sends nothing yet.
+    const std::vector<double>* cumulative = &cumulative_area;
+    if (by_power && cumulative_power[c.first + c.count] > cumulative_power[c.first]) cumulative = &cumulative_power;
+    const double lo = (*cumulative)[c.first], hi = (*cumulative)[c.first + c.count];
     const double target = lo + static_cast<double>(rng.uniform()) * (hi - lo);
-    auto it = std::upper_bound(cumulative_area.begin() + c.first + 1, cumulative_area.begin() + c.first + c.count + 1,
-                               target);
+    auto it = std::upper_bound(cumulative->begin() + c.first + 1, cumulative->begin() + c.first + c.count + 1, target);
     const auto k = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(
-        it - cumulative_area.begin() - 1, static_cast<std::ptrdiff_t>(c.first + c.count - 1)));
+        it - cumulative->begin() - 1, static_cast<std::ptrdiff_t>(c.first + c.count - 1)));
     const std::uint32_t p = tree.order()[k];
     const Patch& patch = hierarchy.patches()[p];
-    point = hierarchy.sample_point(patch.root, rng.uniform2());
+    point = element_point(hierarchy, patch.root, rng.uniform2());
     normal = patch.normal;
     two_sided = has_back[p] != 0;
   }
 
-  /// Fraction of clear rays between facing points of the two nodes; -1 when no facing pair
-  /// was found. Adds the rays cast to `rays`.
-  float visibility(const PatchHierarchy& hierarchy, NodeHandle r, NodeHandle s, std::uint64_t& rays) const {
-    thread_local std::vector<glm::vec3> origin, direction;
-    thread_local std::vector<std::uint8_t> blocked;
-    Rng rng(seed, (std::uint64_t{r} << 32) | s, stream_key(Stream::hierarchical_link));
-    auto draw = [&](int wanted) {
+  /// Shadow rays between facing points of two nodes, drawn from the link's own stream.
+  class ShadowSampler {
+   public:
+    ShadowSampler(const Impl& m, const PatchHierarchy& h, NodeHandle r, NodeHandle s)
+        : m_(m), h_(h), r_(r), s_(s), rng_(m.seed, (std::uint64_t{r} << 32) | s, stream_key(Stream::hierarchical_link)) {}
+    /// Casts up to `wanted` rays (as many facing pairs as `wanted` x kTriesPerRay tries find);
+    /// returns {clear, cast}.
+    std::pair<int, int> draw(int wanted, std::uint64_t& rays) {
+      thread_local std::vector<glm::vec3> origin, direction;
+      thread_local std::vector<std::uint8_t> blocked;
       origin.clear();
       direction.clear();
       for (int tries = 0; tries < kTriesPerRay * wanted && static_cast<int>(origin.size()) < wanted; ++tries) {
         glm::vec3 x, nx, y, ny;
         bool two_x, two_y;
-        sample(hierarchy, s, rng, x, nx, two_x);
-        sample(hierarchy, r, rng, y, ny, two_y);
+        m_.sample(h_, s_, true, rng_, x, nx, two_x);
+        m_.sample(h_, r_, false, rng_, y, ny, two_y);
         const glm::vec3 d = y - x;
         if (two_x && glm::dot(nx, d) < 0.0f) nx = -nx;
         if (two_y && glm::dot(ny, d) > 0.0f) ny = -ny;
         if (!(glm::dot(nx, d) > 0.0f) || !(glm::dot(ny, d) < 0.0f)) continue;
-        const glm::vec3 o = x + ray_epsilon * nx;
+        const glm::vec3 o = x + m_.ray_epsilon * nx;
         origin.push_back(o);
-        direction.push_back((y + ray_epsilon * ny) - o);
+        direction.push_back((y + m_.ray_epsilon * ny) - o);
       }
       blocked.resize(origin.size());
-      occluders.occluded(origin.size(), origin.data(), direction.data(), 0.0f, 1.0f - 1e-4f, blocked.data());
+      m_.occluders.occluded_incoherent(origin.size(), origin.data(), direction.data(), 0.0f, 1.0f - 1e-4f,
+                                       blocked.data());
       rays += origin.size();
       int clear = 0;
       for (std::uint8_t b : blocked) clear += b == 0 ? 1 : 0;
-      return std::pair<int, int>(clear, static_cast<int>(origin.size()));
-    };
-    const auto [clear, cast] = draw(kFirstRays);
-    if (cast == 0) return -1.0f;
-    if (clear == 0) return 0.0f;
-    if (clear == cast) return 1.0f;
-    const auto [more_clear, more_cast] = draw(kPenumbraRays);
-    return static_cast<float>(clear + more_clear) / static_cast<float>(cast + more_cast);
-  }
+      return {clear, static_cast<int>(origin.size())};
+    }
+
+   private:
+    const Impl& m_;
+    const PatchHierarchy& h_;
+    NodeHandle r_, s_;
+    Rng rng_;
+  };
 
   /// Element-to-element factor: the point-to-polygon closed form from receiver points to the
   /// source element, averaged over an n x n grid of area-uniform cells of the receiver (n = 1:
@@ -330,7 +437,29 @@ struct LinkHierarchy::Impl {
     if (!(gap > 0.0f)) return {kInf, kInf};
     const float transport = mean(source_intensity(rc.hierarchy, rc.values, s, (cr - cs) / d));
     const float far = d + reach;
-    return {transport / (gap * gap), transport * (1.0f / (gap * gap) - 1.0f / (far * far))};
+    const float bound = transport / (gap * gap);
+    const Values& v = rc.values;
+    const float variation = is_cluster(s) ? v.variation_cluster[handle_index(s)]
+                            : is_back(s)  ? v.variation_back[element_of(s)]
+                                          : v.variation_front[element_of(s)];
+    return {bound, transport * (1.0f / (gap * gap) - 1.0f / (far * far)) + bound * variation};
+  }
+
+  /// The oracle (docs/HIERARCHICAL.md, "Links and refinement"): refine a link when its
+  /// transport varies over its nodes by more than the threshold; when it has a cluster end
+  /// and its nodes are large for their distance (a cluster's transport is taken from its
+  /// centre, accurate only when the nodes are small for their distance, as in Barnes & Hut's
+  /// multipole acceptance), unless it carries little; or when it is partly hidden (a shadow
+  /// boundary somewhere in its nodes) and may bring more than the threshold. A fully visible or
+  /// fully hidden link is never refined for visibility.
+  bool needs_refinement(const RoundContext& rc, NodeHandle r, NodeHandle s, bool partly_hidden) const {
+    const LinkError error = link_error(rc, r, s);
+    if (error.spread > rc.threshold) return true;
+    if (partly_hidden && error.bound > rc.threshold) return true;
+    if (!is_cluster(r) && !is_cluster(s)) return false;
+    const float reach = radius(rc.hierarchy, r) + radius(rc.hierarchy, s);
+    return reach > kSeparation * glm::length(centre(rc.hierarchy, r) - centre(rc.hierarchy, s)) &&
+           error.bound > kSeparationFloor * rc.threshold;
   }
 
   /// True when nothing can pass between the two nodes: one is an element side wholly in front
@@ -389,18 +518,11 @@ struct LinkHierarchy::Impl {
       ++out.refined;
       return true;
     };
-    const LinkError error = link_error(rc, r, s);
-    if (error.spread > rc.threshold && refine()) return;
-    // A cluster's transport is taken from its centre: accurate only when the nodes are small
-    // for their distance (as in Barnes & Hut's multipole acceptance).
-    if ((is_cluster(r) || is_cluster(s)) && rr + rs > kSeparation * glm::length(centre(h, r) - centre(h, s)) &&
-        error.bound > kSeparationFloor * rc.threshold && refine())
-      return;
+    if (needs_refinement(rc, r, s, false) && refine()) return;
 
     // Link. Element pairs take the closed form (averaged over the receiver when close), the
     // rest the point-to-point transport of the nodes' centres over distance squared.
-    const glm::vec3 cr = centre(h, r), cs = centre(h, s);
-    const float d = glm::length(cr - cs);
+    const float d = glm::length(centroid(h, r) - centroid(h, s));
     float coefficient = 0.0f;
     if (!is_cluster(r) && !is_cluster(s)) {
       // Receiver points: one when far, more when close, most when touching (where the
@@ -411,12 +533,22 @@ struct LinkHierarchy::Impl {
       coefficient = d > 0.0f ? 1.0f / (d * d) : 0.0f;
     }
     if (!(coefficient > 0.0f)) return;
-    const float v = visibility(h, r, s, out.rays);
-    if (!(v > 0.0f)) return;
-    // A partly hidden link hides a shadow boundary somewhere in its nodes: refined while the
-    // most it may bring exceeds the threshold (a fully visible or hidden one never is).
-    if (v < 1.0f && error.bound > rc.threshold && refine()) return;
-    out.links.push_back({r, s, coefficient * v});
+    // Visibility: a pilot pass decides, fresh rays estimate. A partly hidden pilot (a shadow
+    // boundary somewhere in the nodes) refines the link while it may bring more than the
+    // threshold, and a kept one gets the larger second pass; a fully visible or fully hidden
+    // pilot is never refined for visibility. The estimate comes from rays drawn after the
+    // decision, so it is unbiased: deciding and estimating with the same rays would favour the
+    // extremes (a pilot all clear or all blocked happens with probability V^n or (1 - V)^n).
+    ShadowSampler shadows(*this, h, r, s);
+    const auto [pilot_clear, pilot_cast] = shadows.draw(kFirstRays, out.rays);
+    if (pilot_cast == 0) return;  // no facing pair found: nothing passes
+    const bool partly_hidden = pilot_clear > 0 && pilot_clear < pilot_cast;
+    if (partly_hidden && needs_refinement(rc, r, s, true) && refine()) return;
+    const auto [clear, cast] = shadows.draw(partly_hidden ? kPenumbraRays : kFirstRays, out.rays);
+    if (cast == 0 || clear == 0) return;
+    const float v = static_cast<float>(clear) / static_cast<float>(cast);
+    // The sign records a partly hidden link, for the next pass's look at it.
+    out.links.push_back({r, s, partly_hidden ? -coefficient * v : coefficient * v});
   }
 
   /// Runs refinement rounds from `frontier` until it is empty; new links go to `links`.
@@ -445,6 +577,7 @@ struct LinkHierarchy::Impl {
         stats.examined += b.examined;
         stats.refined += b.refined;
         stats.rays += b.rays;
+        b = BlockOutput{};  // its memory goes as it is copied, not at the end of the round
       }
       blocks.clear();
       if (!subdivide.empty()) {
@@ -459,10 +592,15 @@ struct LinkHierarchy::Impl {
           }
           const std::uint32_t first = hierarchy.subdivide(e);
           split.push_back(e);
-          values.front.resize(hierarchy.elements().size());
+          // The children take their parent's radiosity (so no variation below them) until
+          // the next solve.
+          const std::size_t count = hierarchy.elements().size();
+          values.front.resize(count);
+          values.variation_front.resize(count, 0.0f);
           for (std::uint32_t c = first; c < first + 4; ++c) values.front[c] = values.front[e];
           if (!values.back.empty()) {
-            values.back.resize(hierarchy.elements().size());
+            values.back.resize(count);
+            values.variation_back.resize(count, 0.0f);
             for (std::uint32_t c = first; c < first + 4; ++c) values.back[c] = values.back[e];
           }
         }
@@ -512,13 +650,13 @@ struct LinkHierarchy::Impl {
         const std::uint64_t first = offsets[i], last = offsets[i + 1];
         if (first == last) continue;
         const NodeHandle r = receiver_handle(i, elements);
-        const glm::vec3 cr = centre(hierarchy, r);
+        const glm::vec3 cr = centroid(hierarchy, r);
         if (is_cluster(r)) {
           Moments& E = received[handle_index(r)];
           for (std::uint64_t k = first; k < last; ++k) {
             const NodeHandle s = sources[k];
-            const glm::vec3 w = glm::normalize(cr - centre(hierarchy, s));
-            add_irradiance(E, -w, coefficients[k] * source_intensity(hierarchy, v, s, w));
+            const glm::vec3 w = glm::normalize(cr - centroid(hierarchy, s));
+            add_irradiance(E, -w, std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w));
           }
           continue;
         }
@@ -527,11 +665,11 @@ struct LinkHierarchy::Impl {
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
           if (!is_cluster(s)) {
-            sum += coefficients[k] * (is_back(s) ? v.back : v.front)[element_of(s)];
+            sum += std::abs(coefficients[k]) * (is_back(s) ? v.back : v.front)[element_of(s)];
             continue;
           }
-          const glm::vec3 w = glm::normalize(cr - centre(hierarchy, s));
-          sum += (coefficients[k] * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
+          const glm::vec3 w = glm::normalize(cr - centroid(hierarchy, s));
+          sum += (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
         }
         (is_back(r) ? back : front)[element_of(r)] = sum;
       }
@@ -564,8 +702,8 @@ struct LinkHierarchy::Impl {
 };
 
 LinkHierarchy::LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed,
-                             unsigned threads)
-    : impl_(std::make_unique<Impl>(scene, hierarchy, seed, threads)) {}
+                             unsigned threads, const RayScene* occluders)
+    : impl_(std::make_unique<Impl>(scene, hierarchy, seed, threads, occluders)) {}
 LinkHierarchy::~LinkHierarchy() = default;
 
 bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& system, const std::vector<Rgb>& B,
@@ -576,6 +714,15 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   m.refresh_patch_data(hierarchy, system);
   Impl::Values values;
   m.node_values(hierarchy, system, B, values);
+  m.node_variation(hierarchy, values);
+  const std::vector<std::uint32_t>& order = m.tree.order();
+  m.cumulative_power.assign(order.size() + 1, 0.0);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Patch& p = hierarchy.patches()[order[k]];
+    double power = mean(values.front[p.root]);
+    if (!values.back.empty()) power += mean(values.back[p.root]);
+    m.cumulative_power[k + 1] = m.cumulative_power[k] + power * p.area;
+  }
 
   std::vector<LinkRecord> kept;
   std::vector<Pair> frontier;
@@ -595,7 +742,7 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
           const NodeHandle r = m.receiver_handle(i, m.linked_elements);
           for (std::uint64_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
             const NodeHandle s = m.sources[k];
-            if (m.link_error(rc, r, s).spread > threshold && (m.can_split(rc, r) || m.can_split(rc, s)))
+            if (m.needs_refinement(rc, r, s, m.coefficients[k] < 0.0f) && (m.can_split(rc, r) || m.can_split(rc, s)))
               refine_blocks[b].push_back({r, s});
             else
               keep_blocks[b].push_back({r, s, m.coefficients[k]});

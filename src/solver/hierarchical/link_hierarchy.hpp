@@ -59,7 +59,10 @@ struct RefineStats {
 /// concurrently with each other.
 class LinkHierarchy {
  public:
-  LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads);
+  /// `occluders`: the scene's polygons as a ray scene, shared with the caller (which keeps it
+  /// alive as long as this), or null to build one.
+  LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
+                const RayScene* occluders = nullptr);
   ~LinkHierarchy();
   LinkHierarchy(const LinkHierarchy&) = delete;
   LinkHierarchy& operator=(const LinkHierarchy&) = delete;
