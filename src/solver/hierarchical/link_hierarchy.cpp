@@ -56,6 +56,8 @@ struct LinkRecord {
   NodeHandle receiver, source;
   float coefficient;
 };
+/// Links as refinement makes them: a chunk per round (or for the links a later pass keeps).
+using LinkChunks = std::vector<std::vector<LinkRecord>>;
 
 /// One block's output of a refinement round, in the order it was made.
 struct BlockOutput {
@@ -552,8 +554,9 @@ struct LinkHierarchy::Impl {
   }
 
   /// Runs refinement rounds from `frontier` until it is empty; new links go to `links`.
-  bool run_rounds(PatchHierarchy& hierarchy, Values& values, std::vector<Pair> frontier, float threshold, const SubdivisionLimits& limits, ProgressGate& gate,
-                  std::vector<LinkRecord>& links, std::vector<std::uint32_t>& split, RefineStats& stats) {
+  bool run_rounds(PatchHierarchy& hierarchy, Values& values, std::vector<Pair> frontier, float threshold,
+                  const SubdivisionLimits& limits, ProgressGate& gate, LinkChunks& chunks,
+                  std::vector<std::uint32_t>& split, RefineStats& stats) {
     bool subdivision_closed = limits.max_depth == 0;
     std::size_t done = 0;
     std::vector<BlockOutput> blocks;
@@ -568,11 +571,21 @@ struct LinkHierarchy::Impl {
         }
       });
       done += frontier.size();
-      std::vector<Pair> next;
+      frontier = {};  // read; its memory goes before the next round's is made
+      // The round's links and next pairs, in block order, each array made at its final size
+      // (no doubling growth: these are the refinement's largest arrays).
+      std::size_t link_count = 0, next_count = 0;
+      for (const BlockOutput& b : blocks) {
+        link_count += b.links.size();
+        next_count += b.next.size();
+      }
+      std::vector<LinkRecord>& links = chunks.emplace_back();
+      links.reserve(link_count);
+      frontier.reserve(next_count);
       std::vector<std::uint32_t> subdivide;
       for (BlockOutput& b : blocks) {
         links.insert(links.end(), b.links.begin(), b.links.end());
-        next.insert(next.end(), b.next.begin(), b.next.end());
+        frontier.insert(frontier.end(), b.next.begin(), b.next.end());
         subdivide.insert(subdivide.end(), b.subdivide.begin(), b.subdivide.end());
         stats.examined += b.examined;
         stats.refined += b.refined;
@@ -581,8 +594,7 @@ struct LinkHierarchy::Impl {
       }
       blocks.clear();
       if (!subdivide.empty()) {
-        // Split in increasing id order (deterministic ids); children take their parent's
-        // values until the next solve.
+        // Split in increasing id order (deterministic ids).
         std::sort(subdivide.begin(), subdivide.end());
         subdivide.erase(std::unique(subdivide.begin(), subdivide.end()), subdivide.end());
         for (std::uint32_t e : subdivide) {
@@ -605,7 +617,6 @@ struct LinkHierarchy::Impl {
           }
         }
       }
-      frontier.swap(next);
       Progress p;
       p.phase = Phase::form_factors;
       p.fraction = static_cast<double>(done) / static_cast<double>(done + frontier.size());
@@ -614,22 +625,33 @@ struct LinkHierarchy::Impl {
     return true;
   }
 
-  /// Makes the receiver-ordered arrays from `links` (a stable counting sort by receiver).
-  void store(std::vector<LinkRecord>& links, std::uint32_t elements) {
+  /// Makes the receiver-ordered arrays from the links in `chunks` (a stable counting sort by
+  /// receiver), freeing the old arrays first and each chunk once it is placed, so the peak is
+  /// the records (12 bytes a link) plus the arrays (8).
+  void store(LinkChunks& chunks, std::uint32_t elements) {
+    offsets = {};
+    sources = {};
+    coefficients = {};
     const std::uint64_t receivers = std::uint64_t{cluster_count()} + 2ull * elements;
-    offsets.assign(receivers + 1, 0);
-    for (const LinkRecord& l : links) ++offsets[receiver_index(l.receiver, elements) + 1];
-    for (std::uint64_t r = 0; r < receivers; ++r) offsets[r + 1] += offsets[r];
-    std::vector<std::uint64_t> fill(offsets.begin(), offsets.end() - 1);
-    sources.assign(links.size(), 0);
-    coefficients.assign(links.size(), 0.0f);
-    for (const LinkRecord& l : links) {
-      const std::uint64_t at = fill[receiver_index(l.receiver, elements)]++;
-      sources[at] = l.source;
-      coefficients[at] = l.coefficient;
+    std::vector<std::uint64_t> at(receivers + 1, 0);
+    std::size_t total = 0;
+    for (const std::vector<LinkRecord>& chunk : chunks) {
+      total += chunk.size();
+      for (const LinkRecord& l : chunk) ++at[receiver_index(l.receiver, elements) + 1];
     }
-    sources.shrink_to_fit();
-    coefficients.shrink_to_fit();
+    for (std::uint64_t r = 0; r < receivers; ++r) at[r + 1] += at[r];
+    offsets = at;
+    sources.resize(total);
+    coefficients.resize(total);
+    for (std::vector<LinkRecord>& chunk : chunks) {
+      for (const LinkRecord& l : chunk) {
+        const std::uint64_t k = at[receiver_index(l.receiver, elements)]++;
+        sources[k] = l.source;
+        coefficients[k] = l.coefficient;
+      }
+      chunk = {};
+    }
+    chunks.clear();
     linked_elements = elements;
     linked = true;
   }
@@ -724,45 +746,50 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
     m.cumulative_power[k + 1] = m.cumulative_power[k] + power * p.area;
   }
 
-  std::vector<LinkRecord> kept;
+  LinkChunks chunks;
   std::vector<Pair> frontier;
   if (!m.linked) {
     frontier.push_back({cluster_handle(ClusterTree::root()), cluster_handle(ClusterTree::root())});
   } else {
     // Multigridding: every link looked at again with the radiosity solved so far; those that
-    // now carry too much are refined, in receiver order (deterministic).
+    // now carry too much are refined, in receiver order (deterministic). A flag per link
+    // first, then the kept links and the pairs to refine at their final sizes.
     const Impl::RoundContext rc{hierarchy, values, threshold, limits, limits.max_depth == 0};
     const std::uint64_t receivers = m.offsets.size() - 1;
-    const std::size_t block_count = (receivers + kBlock - 1) / kBlock;
-    std::vector<std::vector<LinkRecord>> keep_blocks(block_count);
-    std::vector<std::vector<Pair>> refine_blocks(block_count);
-    parallel_for(m.threads, block_count, 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t b = begin; b < end; ++b)
-        for (std::uint64_t i = b * kBlock; i < std::min<std::uint64_t>(receivers, (b + 1) * kBlock); ++i) {
-          const NodeHandle r = m.receiver_handle(i, m.linked_elements);
-          for (std::uint64_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
-            const NodeHandle s = m.sources[k];
-            if (m.needs_refinement(rc, r, s, m.coefficients[k] < 0.0f) && (m.can_split(rc, r) || m.can_split(rc, s)))
-              refine_blocks[b].push_back({r, s});
-            else
-              keep_blocks[b].push_back({r, s, m.coefficients[k]});
-          }
+    std::vector<std::uint8_t> refine(m.sources.size(), 0);
+    parallel_for(m.threads, receivers, kBlock, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const NodeHandle r = m.receiver_handle(i, m.linked_elements);
+        for (std::uint64_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
+          const NodeHandle s = m.sources[k];
+          refine[k] = m.needs_refinement(rc, r, s, m.coefficients[k] < 0.0f) && (m.can_split(rc, r) || m.can_split(rc, s));
         }
+      }
     });
-    for (std::size_t b = 0; b < block_count; ++b) {
-      kept.insert(kept.end(), keep_blocks[b].begin(), keep_blocks[b].end());
-      frontier.insert(frontier.end(), refine_blocks[b].begin(), refine_blocks[b].end());
+    std::size_t refined = 0;
+    for (std::uint8_t f : refine) refined += f;
+    std::vector<LinkRecord>& kept = chunks.emplace_back();
+    kept.reserve(m.sources.size() - refined);
+    frontier.reserve(refined);
+    for (std::uint64_t i = 0; i < receivers; ++i) {
+      const NodeHandle r = m.receiver_handle(i, m.linked_elements);
+      for (std::uint64_t k = m.offsets[i]; k < m.offsets[i + 1]; ++k) {
+        if (refine[k])
+          frontier.push_back({r, m.sources[k]});
+        else
+          kept.push_back({r, m.sources[k], m.coefficients[k]});
+      }
     }
     stats.links_replaced += frontier.size();
     if (frontier.empty()) return true;
   }
-  std::vector<LinkRecord> added;
-  if (!m.run_rounds(hierarchy, values, std::move(frontier), threshold, limits, gate, added, split, stats))
+  const std::size_t before = chunks.empty() ? 0 : chunks.front().size();
+  if (!m.run_rounds(hierarchy, values, std::move(frontier), threshold, limits, gate, chunks, split, stats))
     return false;
-  stats.links_added += added.size();
-  kept.insert(kept.end(), added.begin(), added.end());
-  added = {};
-  m.store(kept, static_cast<std::uint32_t>(hierarchy.elements().size()));
+  std::size_t total = 0;
+  for (const std::vector<LinkRecord>& c : chunks) total += c.size();
+  stats.links_added += total - before;
+  m.store(chunks, static_cast<std::uint32_t>(hierarchy.elements().size()));
   return true;
 }
 
