@@ -25,14 +25,20 @@ enum class SolverMethod {
   /// Aupperle 1991, with clustering); Jacobi sweeps with push-pull. No form-factor matrix: the
   /// links' memory grows about linearly with the scene (docs/HIERARCHICAL.md).
   hierarchical,
+  /// The default: gauss_seidel while its form-factor rows fit SolveOptions::memory_budget_bytes,
+  /// else hierarchical (which keeps no rows), unless form_factors.specular_depth > 0 (only the
+  /// rows carry mirror paths: then the budget error stands). Chosen by a Problem's first solve;
+  /// SolveReport::method says which ran and SolveReport::method_choice why.
+  automatic,
 };
 
 /// SolverMethod::hierarchical's refinement (docs/HIERARCHICAL.md).
 struct HierarchicalOptions {
-  /// A link is refined (its larger end split) while the radiosity it may bring to its
-  /// receiver, reflectance x irradiance, exceeds epsilon x the scene's mean radiosity estimate
-  /// (the lights' and emitters' power per area times the mean interreflection factor). In
-  /// (0, 1]; smaller is more accurate and costs more links.
+  /// A link is refined (its larger end split) while the error of its transport (the spread
+  /// of the irradiance it brings over its two nodes, and more: docs/HIERARCHICAL.md, "The
+  /// oracle") exceeds epsilon x the scene's mean radiosity estimate (the emitters' and the
+  /// lights' power per area times the mean interreflection factor), W/m^2. In (0, 1]; smaller
+  /// is more accurate and costs more links.
   float epsilon = 0.05f;
   /// Refinement passes at most: the first links against the emitted light, each later one
   /// refines them against the radiosity solved so far (multigridding), until no link changes.
@@ -55,7 +61,7 @@ struct AdaptiveOptions {
 
 /// Everything solve() needs; every field has a default.
 struct SolveOptions {
-  SolverMethod method = SolverMethod::gauss_seidel;
+  SolverMethod method = SolverMethod::automatic;
   FormFactorOptions form_factors;
   MeshOptions mesh;
   /// Stop when the residual falls below this. The residual is the power not yet propagated
@@ -117,6 +123,11 @@ struct SolveReport {
   int refinement_passes = 0;
   std::size_t form_factor_bytes = 0;     ///< memory held by form factors (or links) at the peak
   std::size_t link_count = 0;            ///< SolverMethod::hierarchical: links at the end (0 otherwise)
+  /// The solver that ran (never automatic), and, when SolveOptions::method was automatic, why
+  /// (e.g. "the Gauss-Seidel rows could need 7742 MiB, over the memory budget of 4096 MiB");
+  /// empty otherwise.
+  SolverMethod method = SolverMethod::gauss_seidel;
+  std::string method_choice;
   /// The estimator that ran: SolveOptions' form_factors.method with automatic resolved
   /// (choose_form_factor_method()).
   FormFactorMethod form_factor_method = FormFactorMethod::automatic;

@@ -20,15 +20,19 @@ double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z
 
 }  // namespace
 
+std::size_t row_memory_bytes(std::size_t rows, std::size_t patches, bool sparse, std::size_t max_row_entries) {
+  const std::size_t row_bytes = sparse ? std::min(patches, max_row_entries) * 2 * sizeof(float) : patches * sizeof(float);
+  return rows * row_bytes;
+}
+
 void check_row_memory(std::size_t rows, std::size_t unknowns, std::size_t patches, bool sparse,
                       std::size_t max_row_entries, std::size_t budget) {
-  const std::size_t row_bytes = sparse ? std::min(patches, max_row_entries) * 2 * sizeof(float) : patches * sizeof(float);
-  const std::size_t bytes = rows * row_bytes;
+  const std::size_t bytes = row_memory_bytes(rows, patches, sparse, max_row_entries);
   if (bytes <= budget) return;
   std::ostringstream s;
   s << "the form-factor matrix of " << unknowns << " elements x " << patches << " patches needs "
     << (sparse ? "up to " : "") << bytes / (1024.0 * 1024.0) << " MiB, more than the memory budget of "
-    << budget / (1024.0 * 1024.0) << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::progressive"
+    << budget / (1024.0 * 1024.0) << " MiB (SolveOptions::memory_budget_bytes); use SolverMethod::hierarchical, SolverMethod::progressive"
     << (sparse ? "" : ", FormFactorMethod::monte_carlo (sparse rows)") << " or a coarser mesh";
   throw Error(ErrorCode::memory_budget, s.str());
 }

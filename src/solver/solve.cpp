@@ -125,6 +125,9 @@ void validate(const SolveOptions& o) {
 struct Problem::Impl {
   const Scene& scene;
   SolveOptions options;  ///< resolved (see Problem::options())
+  /// SolverMethod::automatic: chosen by the first solve (choose_method()), said in every report.
+  bool automatic_method = false;
+  std::string method_choice;
   PatchHierarchy hierarchy;
   std::vector<std::string> warnings;  ///< the scene's and the z-fighting check's, for every report
   double seconds_meshing = 0.0;       ///< reported by the first solve only
@@ -152,9 +155,40 @@ struct Problem::Impl {
   /// Each light group's own solve (SolveOptions::separate_light_groups) on the current
   /// hierarchy, without refinement; empty when one is cancelled.
   std::vector<LightGroupSolution> solve_light_groups(const std::vector<Rgb>* emission);
+  /// SolverMethod::automatic, at the first solve: Gauss-Seidel while its rows fit the memory
+  /// budget, else hierarchical (unless mirror paths need the rows). Makes the estimator.
+  void choose_method();
   /// The lights' first shot for `elements` that lack it; false when cancelled.
   bool shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate);
 };
+
+void Problem::Impl::choose_method() {
+  if (!automatic_method || !method_choice.empty()) return;
+  SolveOptions& o = options;
+  if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
+  // The rows solve_matrix() would hold: one per leaf, and one per back of a translucent or
+  // two-sided leaf (rows over every target, sparse).
+  std::size_t rows = hierarchy.leaves().size();
+  bool sparse = estimator->sparse();
+  if (o.form_factors.diffuse_transmission) {
+    std::vector<char> has_back(hierarchy.patches().size(), 0);
+    for (std::uint32_t p : detail::find_back_patches(scene, hierarchy)) has_back[p] = 1;
+    for (std::uint32_t e : hierarchy.leaves()) rows += has_back[hierarchy.element(e).patch] ? 1 : 0;
+    sparse = true;
+  }
+  const std::size_t bytes =
+      detail::row_memory_bytes(rows, estimator->target_count(), sparse, estimator->max_row_entries());
+  auto mib = [](std::size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
+  const std::string figure = mib(bytes) + (bytes > o.memory_budget_bytes ? ", over" : ", within") +
+                             " the memory budget of " + mib(o.memory_budget_bytes);
+  if (bytes > o.memory_budget_bytes && o.form_factors.specular_depth == 0) {
+    o.method = SolverMethod::hierarchical;
+    estimator.reset();  // links need none
+    method_choice = "the Gauss-Seidel rows could need " + figure;
+  } else {
+    method_choice = std::string("its rows need ") + (sparse ? "up to " : "") + figure;
+  }
+}
 
 bool Problem::Impl::shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate) {
   if (scene.lights().empty()) return true;
@@ -169,6 +203,11 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), optio
 
   SolveOptions& o = options;
   if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
+  // Automatic starts as Gauss-Seidel; the first solve, which knows the rows' size, may switch.
+  if (o.method == SolverMethod::automatic) {
+    automatic_method = true;
+    o.method = SolverMethod::gauss_seidel;
+  }
   // Translucent and two-sided materials in use switch the back sides on.
   for (const Polygon& polygon : scene.polygons())
     if (detail::pass1_has_back(scene.material(polygon.material))) {
@@ -268,6 +307,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   report.element_count = hierarchy.leaves().size();
   report.specular_depth = o.form_factors.specular_depth;
   report.form_factor_method = o.form_factors.method;
+  report.method = o.method;
   // The Solution owns its hierarchy: the facade's only solve hands over this one, a kept
   // Problem a copy.
   auto result_hierarchy = [&] { return last ? std::move(hierarchy) : PatchHierarchy(hierarchy); };
@@ -293,6 +333,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // as the form factors: a scene that cannot fit is refused at once, by the figure
   // solve_matrix() would give (one row per leaf; with backs, whose rows solve_matrix() counts
   // itself, only there).
+  choose_method();
+  report.method = o.method;
+  report.method_choice = method_choice;
   const bool hierarchical = o.method == SolverMethod::hierarchical;
   if (!estimator && !hierarchical) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
   if (o.method != SolverMethod::progressive && !hierarchical && store.rows.empty() && !translucency)

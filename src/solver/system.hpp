@@ -166,6 +166,8 @@ struct ColumnStore {
 /// budget and what to do instead.
 void check_row_memory(std::size_t rows, std::size_t unknowns, std::size_t patches, bool sparse,
                       std::size_t max_row_entries, std::size_t budget);
+/// The figure check_row_memory() checks: bytes of `rows` rows at most.
+std::size_t row_memory_bytes(std::size_t rows, std::size_t patches, bool sparse, std::size_t max_row_entries);
 
 /// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
 /// of them on the first call), then iterates from `B0` (per unknown; empty = start from E).

@@ -313,6 +313,7 @@ TEST_SUITE("form_factors") {
     scene.add_polygon({{0.4f, 0.99f, 0.4f}, {0.6f, 0.99f, 0.4f}, {0.6f, 0.99f, 0.6f}, {0.4f, 0.99f, 0.6f}}, id, "light");
     rad::SolveOptions o;
     // 676 patches per face and 25 on the light, 4081 in all: a 64 MiB dense matrix.
+    o.method = rad::SolverMethod::gauss_seidel;  // asked for: no automatic fallback
     o.mesh = mesh(0.0016f, 0.0016f);
     o.memory_budget_bytes = 8u << 20;
     o.form_factors.method = rad::FormFactorMethod::ray_cast;

@@ -47,6 +47,8 @@ struct Estimate {
   rad::FormFactorMethod default_method = rad::FormFactorMethod::ray_cast;
   bool default_dense = true;
   std::size_t default_bytes = 0;
+  /// default_bytes is over the memory budget: the default solve is hierarchical.
+  bool default_hierarchical = false;
 };
 
 struct CheckResult {
@@ -138,10 +140,9 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     r.warnings.push_back(std::to_string(r.z_fighting) +
                          " pair(s) of coincident polygons face the same way (z-fighting): which is in front is "
                          "decided by rounding, remove one of each pair (listed under overlaps)");
-  if (r.estimate->default_bytes > kDefaultMemoryBudget)
-    r.error = "the default solve's form factors need " + std::to_string(r.estimate->default_bytes >> 20) +
-              " MiB, more than the memory budget of 4096 MiB: use --method progressive, --form-factors "
-              "monte-carlo or a coarser mesh";
+  // Over the budget the default solve (--method auto) takes the hierarchical solver, which keeps
+  // no rows (SolverMethod::automatic).
+  r.estimate->default_hierarchical = r.estimate->default_bytes > kDefaultMemoryBudget;
   return r;
 }
 
@@ -187,9 +188,15 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
                 e.elements, e.max_patch_area, e.max_element_area);
     std::printf("form factors: dense matrix %zu bytes (%s), sparse rows up to %zu bytes (%s)\n", e.dense_matrix_bytes,
                 mib(e.dense_matrix_bytes).c_str(), e.sparse_rows_bytes, mib(e.sparse_rows_bytes).c_str());
-    std::printf("default solve: gauss-seidel, %s form factors (automatic), %s: %zu bytes (%s)\n",
-                rad::to_string(e.default_method), e.default_dense ? "dense matrix" : "sparse rows up to",
-                e.default_bytes, mib(e.default_bytes).c_str());
+    if (e.default_hierarchical)
+      std::printf("default solve: hierarchical (automatic: gauss-seidel with %s form factors would need %s: %zu "
+                  "bytes (%s), over the memory budget of 4096 MiB)\n",
+                  rad::to_string(e.default_method), e.default_dense ? "a dense matrix" : "sparse rows up to",
+                  e.default_bytes, mib(e.default_bytes).c_str());
+    else
+      std::printf("default solve: gauss-seidel, %s form factors (automatic), %s: %zu bytes (%s)\n",
+                  rad::to_string(e.default_method), e.default_dense ? "dense matrix" : "sparse rows up to",
+                  e.default_bytes, mib(e.default_bytes).c_str());
   }
   if (r.error.empty())
     std::printf("result: ok, the scene can be solved\n");
@@ -234,7 +241,8 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
                          {"sparse_rows_bytes", e.sparse_rows_bytes},
                          {"default_form_factors", rad::to_string(e.default_method)},
                          {"default_storage", e.default_dense ? "dense" : "sparse"},
-                         {"default_bytes", e.default_bytes}};
+                         {"default_bytes", e.default_bytes},
+                         {"default_solver", e.default_hierarchical ? "hierarchical" : "gauss-seidel"}};
   } else {
     j["estimate"] = nullptr;
   }

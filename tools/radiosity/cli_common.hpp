@@ -176,7 +176,7 @@ class ProgressBar {
 
 struct SolveArgs {
   std::string scene;
-  std::string method = "gauss-seidel";
+  std::string method = "auto";
   std::string form_factors = "auto";
   unsigned hemisphere_rays = rad::FormFactorOptions{}.hemisphere_rays;
   unsigned specular_depth = 0;
@@ -267,9 +267,12 @@ inline void add_photometric_flag(CLI::App& cmd, bool& photometric) {
 
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
-  std::vector<std::string> methods = {"jacobi", "gauss-seidel", "progressive", "hierarchical"};
+  std::vector<std::string> methods = {"auto", "jacobi", "gauss-seidel", "progressive", "hierarchical"};
   if (with_path) methods.push_back("path");
-  cmd.add_option("--method", a.method, with_path ? "Solver, or path for the reference path tracer" : "Solver")
+  cmd.add_option("--method", a.method,
+                 std::string("Solver (auto: gauss-seidel while its form-factor rows fit the 4 GiB memory budget, else "
+                             "hierarchical)") +
+                     (with_path ? ", or path for the reference path tracer" : ""))
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
   cmd.add_option("--form-factors", a.form_factors,
@@ -327,7 +330,8 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.method = a.method == "jacobi"        ? rad::SolverMethod::jacobi
              : a.method == "progressive" ? rad::SolverMethod::progressive
              : a.method == "hierarchical" ? rad::SolverMethod::hierarchical
-                                         : rad::SolverMethod::gauss_seidel;
+             : a.method == "gauss-seidel" ? rad::SolverMethod::gauss_seidel
+                                          : rad::SolverMethod::automatic;
   o.form_factors.method = form_factor_method(a.form_factors);
   o.form_factors.hemisphere_rays = a.hemisphere_rays;
   o.form_factors.specular_depth = a.specular_depth;
@@ -423,7 +427,10 @@ inline void print_summary(const rad::Solution& sol) {
 /// Says which estimator ran, and why when the choice was automatic.
 inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
   const rad::SolveReport& r = sol.report();
-  if (options.method == rad::SolverMethod::hierarchical) {
+  if (!r.method_choice.empty())
+    std::printf("method: %s (automatic: %s; --method overrides)\n",
+                r.method == rad::SolverMethod::hierarchical ? "hierarchical" : "gauss-seidel", r.method_choice.c_str());
+  if (r.method == rad::SolverMethod::hierarchical) {
     std::printf("form factors: links of the hierarchy (point-to-polygon and cluster transport, shadow rays)\n");
     return;
   }

@@ -47,6 +47,7 @@ const char* method_name(SolverMethod m) {
     case SolverMethod::gauss_seidel: return "gauss_seidel";
     case SolverMethod::progressive: return "progressive";
     case SolverMethod::hierarchical: return "hierarchical";
+    case SolverMethod::automatic: return "automatic";
   }
   return "unknown";
 }
@@ -82,6 +83,8 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   j["elements"] = r.element_count;
   j["form_factor_bytes"] = r.form_factor_bytes;
   j["link_count"] = r.link_count;
+  j["method_used"] = method_name(r.method);
+  j["method_choice"] = r.method_choice;
   j["mesh"] = Json{{"max_patch_area", number(solution.hierarchy().options().max_patch_area)},
                    {"max_element_area", number(solution.hierarchy().options().max_element_area)}};
   j["emitted_power"] = rgb(r.emitted_power);
