@@ -1,13 +1,15 @@
 // The procedural city of issue #15 (benchmarks/city.hpp: streets, blocks and buildings, every
-// surface cut into quads, under a sky) solved on 2 threads with the default SolveOptions, which
-// for a city are the issue's Monte Carlo configuration: Gauss-Seidel, monte_carlo form factors
-// at 1024 rays per element (the automatic choice above 1e4 element x patch pairs), tolerance
-// 1e-3, one element per facet. When the defaults resolve to something else (a small city with a
-// coarse facet size: ray_cast, or facets split into several elements) that configuration is run
-// as well. Each configuration runs in its own child process, so its peak RSS is its own.
+// surface cut into quads, under a sky) solved on 2 threads, the Monte Carlo path and the
+// hierarchical one side by side. First the default SolveOptions, which for a city are the issue's
+// Monte Carlo configuration (Gauss-Seidel, monte_carlo form factors at 1024 rays per element,
+// tolerance 1e-3, one element per facet) while its rows fit the 4 GiB budget, and the
+// hierarchical solver beyond (SolverMethod::automatic: the 1M city); when the defaults resolve to
+// something else the issue's configuration is run as well. Then SolverMethod::hierarchical at
+// one element per facet (HierarchicalOptions::epsilon from --epsilon), unless the defaults ran it.
+// Each configuration runs in its own child process, so its peak RSS is its own.
 //
 // Usage: bench_city [PRESET] [--blocks N] [--facet S] [--seed K] [--threads T] [--memory-budget MIB]
-//                   [--city-only]
+//                   [--epsilon E] [--only monte-carlo|hierarchical] [--city-only]
 //   PRESET: 22k (3 blocks, 2.25 m facets: 23.5k facets), 246k (10 blocks: 250k), 1M (20 blocks:
 //   991k); the options after a preset change it. Default: 22k. --memory-budget sets
 //   SolveOptions::memory_budget_bytes (default: the library's 4 GiB). --city-only builds the city
@@ -65,9 +67,13 @@ rad::SolveOptions issue_options(const Args& a) {
 
 double channel_sum(const rad::Rgb& c) { return static_cast<double>(c.x) + c.y + c.z; }
 
-/// Builds the city, solves it with `opt` and prints what it measured; true when the solve was the
-/// issue's configuration (monte_carlo, Gauss-Seidel, one element per facet).
-bool run(const Args& a, const rad::SolveOptions& opt, const char* label, bool print_city) {
+/// What run() reports to main() (as its child's exit code).
+enum RunResult : int { kIssueConfiguration = 0, kFailed = 1, kOtherConfiguration = 3, kHierarchical = 4 };
+
+/// Builds the city, solves it with `opt` and prints what it measured: kIssueConfiguration when
+/// the solve was the issue's Monte Carlo configuration (monte_carlo, Gauss-Seidel, one element per
+/// facet), kHierarchical when the hierarchical solver ran, else kOtherConfiguration.
+int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool print_city) {
   auto t0 = std::chrono::steady_clock::now();
   const bench::City city = bench::city(a.city);
   const double build = seconds_since(t0);
@@ -80,7 +86,7 @@ bool run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pr
                 city.roof_facets, city.buildings.size(), city.size, city.scene.total_area(), build, peak_rss_mib());
     std::fflush(stdout);
   }
-  if (!a.solve) return true;
+  if (!a.solve) return kIssueConfiguration;
   std::printf("%s, %u threads:\n", label, a.threads);
   t0 = std::chrono::steady_clock::now();
   try {
@@ -89,9 +95,12 @@ bool run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pr
     const rad::SolveReport& r = sol.report();
     const double setup =
         total - r.seconds_meshing - r.seconds_lights - r.seconds_form_factors - r.seconds_solving;
-    std::printf("  %zu elements, %zu patches, %s form factors, %d sweeps, residual %.2e, %s\n", r.element_count,
-                r.patch_count, rad::to_string(r.form_factor_method), r.iterations, r.residual,
-                sol.status() == rad::SolveStatus::converged ? "converged" : "not converged");
+    const bool hierarchical = r.method == rad::SolverMethod::hierarchical;
+    if (!r.method_choice.empty())
+      std::printf("  method: %s (automatic: %s)\n", hierarchical ? "hierarchical" : "gauss-seidel", r.method_choice.c_str());
+    std::printf("  %zu elements, %zu patches, %s, %d sweeps, residual %.2e, %s\n", r.element_count, r.patch_count,
+                hierarchical ? "links" : (std::string(rad::to_string(r.form_factor_method)) + " form factors").c_str(),
+                r.iterations, r.residual, sol.status() == rad::SolveStatus::converged ? "converged" : "not converged");
     std::printf("  time %.2f s: meshing %.2f s, sky (first shot) %.2f s, set-up %.2f s, form factors %.2f s, "
                 "solving %.2f s\n",
                 total, r.seconds_meshing, r.seconds_lights, setup, r.seconds_form_factors, r.seconds_solving);
@@ -107,24 +116,27 @@ bool run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pr
                 100.0 * channel_sum(r.absorbed_power) / emitted, 100.0 * channel_sum(r.escaped_power) / emitted);
     for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
     std::fflush(stdout);
-    return r.form_factor_method == rad::FormFactorMethod::monte_carlo && r.element_count == city.facets();
+    if (hierarchical) return kHierarchical;
+    return r.form_factor_method == rad::FormFactorMethod::monte_carlo && r.element_count == city.facets()
+               ? kIssueConfiguration
+               : kOtherConfiguration;
   } catch (const rad::Error& e) {
     std::printf("  refused after %.2f s (peak RSS %.1f MiB): %s%s\n", seconds_since(t0), peak_rss_mib(),
                 e.code() == rad::ErrorCode::memory_budget ? "memory budget: " : "", e.what());
     std::fflush(stdout);
     // Refused by the defaults means refused by the issue's configuration too (the same rows).
-    return true;
+    return kIssueConfiguration;
   }
 }
 
-/// Runs `run` in a child process (its own peak RSS): 0 when it returned true, 3 when false, 1
-/// when it failed.
+/// Runs `run` in a child process (its own peak RSS) and returns its RunResult (kFailed when it
+/// failed).
 int in_child(const Args& a, const rad::SolveOptions& opt, const char* label, bool print_city) {
   std::fflush(stdout);  // the child must not inherit (and print again) buffered output
   const pid_t pid = fork();
   if (pid == 0) {
     try {
-      _exit(run(a, opt, label, print_city) ? 0 : 3);
+      _exit(run(a, opt, label, print_city));
     } catch (const std::exception& e) {
       std::printf("  error: %s\n", e.what());
       std::fflush(stdout);
@@ -140,7 +152,7 @@ int usage(const char* bad) {
   if (bad) std::fprintf(stderr, "bench_city: bad argument '%s'\n", bad);
   std::fprintf(stderr,
                "usage: bench_city [22k|246k|1M] [--blocks N] [--facet METRES] [--seed K] [--threads T]\n"
-               "                  [--memory-budget MIB] [--city-only]\n"
+               "                  [--memory-budget MIB] [--epsilon E] [--only monte-carlo|hierarchical] [--city-only]\n"
                "  presets: 22k = --blocks 3 --facet 2.25 (23.5k facets), 246k = --blocks 10 --facet 2.25 (250k),\n"
                "           1M = --blocks 20 --facet 2.25 (991k)\n");
   return bad ? 2 : 0;
@@ -199,18 +211,19 @@ int main(int argc, char** argv) {
   defaults.memory_budget_bytes = a.memory_budget_bytes;
   int first = 0;
   if (a.monte_carlo) {
-    first = in_child(a, defaults, "default solve (gauss-seidel, automatic form factors, tolerance 1e-3)", true);
-    if (first == 3)
+    first = in_child(a, defaults, "default solve (automatic method and form factors, tolerance 1e-3)", true);
+    if (first == kOtherConfiguration || first == kHierarchical)
       in_child(a, issue_options(a),
                "the issue's configuration (gauss-seidel, monte-carlo 1024 rays, one element per facet)", false);
   }
-  if (a.hierarchical) {
+  // The hierarchical solver with one element per facet, unless the defaults just ran it.
+  if (a.hierarchical && first != kHierarchical) {
     rad::SolveOptions hr = issue_options(a);
     hr.method = rad::SolverMethod::hierarchical;
     hr.hierarchical.epsilon = a.epsilon;
     const std::string label = "hierarchical (epsilon " + std::to_string(a.epsilon) + ", one element per facet)";
     const int second = in_child(a, hr, label.c_str(), !a.monte_carlo);
-    if (second == 1) first = 1;
+    if (second == kFailed) first = kFailed;
   }
-  return first == 1 ? 1 : 0;
+  return first == kFailed ? 1 : 0;
 }
