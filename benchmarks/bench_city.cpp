@@ -23,11 +23,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include <radiosity/radiosity.hpp>
 
@@ -49,7 +51,12 @@ struct Args {
   bool monte_carlo = true;              ///< run the Monte Carlo path (the defaults / the issue's configuration)
   bool hierarchical = true;             ///< run SolverMethod::hierarchical
   float epsilon = rad::HierarchicalOptions{}.epsilon;
+  std::string plot;                     ///< --plot FILE: the SVG of time and memory against facets
 };
+
+/// With --plot: each child appends "SERIES FACETS SECONDS PEAK_RSS_MIB REFUSED" here.
+std::string g_record_path;
+std::string g_series;
 
 /// The issue's configuration: Gauss-Seidel, monte_carlo at 1024 rays, one element per facet.
 rad::SolveOptions issue_options(const Args& a) {
@@ -116,6 +123,11 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
                 100.0 * channel_sum(r.absorbed_power) / emitted, 100.0 * channel_sum(r.escaped_power) / emitted);
     for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
     std::fflush(stdout);
+    if (!g_record_path.empty())
+      if (FILE* f = std::fopen(g_record_path.c_str(), "a")) {
+        std::fprintf(f, "%s %zu %.3f %.1f 0\n", g_series.c_str(), city.facets(), total, peak_rss_mib());
+        std::fclose(f);
+      }
     if (hierarchical) return kHierarchical;
     return r.form_factor_method == rad::FormFactorMethod::monte_carlo && r.element_count == city.facets()
                ? kIssueConfiguration
@@ -124,6 +136,11 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
     std::printf("  refused after %.2f s (peak RSS %.1f MiB): %s%s\n", seconds_since(t0), peak_rss_mib(),
                 e.code() == rad::ErrorCode::memory_budget ? "memory budget: " : "", e.what());
     std::fflush(stdout);
+    if (!g_record_path.empty())
+      if (FILE* f = std::fopen(g_record_path.c_str(), "a")) {
+        std::fprintf(f, "%s %zu %.3f %.1f 1\n", g_series.c_str(), city.facets(), seconds_since(t0), peak_rss_mib());
+        std::fclose(f);
+      }
     // Refused by the defaults means refused by the issue's configuration too (the same rows).
     return kIssueConfiguration;
   }
@@ -153,12 +170,90 @@ int usage(const char* bad) {
   std::fprintf(stderr,
                "usage: bench_city [22k|246k|1M] [--blocks N] [--facet METRES] [--seed K] [--threads T]\n"
                "                  [--memory-budget MIB] [--epsilon E] [--only monte-carlo|hierarchical] [--city-only]\n"
+               "                  [--plot FILE.svg]\n"
                "  presets: 22k = --blocks 3 --facet 2.25 (23.5k facets), 246k = --blocks 10 --facet 2.25 (250k),\n"
                "           1M = --blocks 20 --facet 2.25 (991k)\n");
   return bad ? 2 : 0;
 }
 
 }  // namespace
+
+
+/// --plot: the 22k, 246k and 1M cities (at the given facet size), the issue's Monte Carlo
+/// configuration and the hierarchical solver each, then an SVG of time and peak memory against
+/// the facet count (log-log), a refusal drawn as a cross at the time it took.
+int plot(Args a) {
+  char path[] = "/tmp/bench_city_XXXXXX";
+  const int fd = mkstemp(path);
+  if (fd < 0) return 1;
+  close(fd);
+  g_record_path = path;
+  for (int blocks : {3, 10, 20}) {
+    a.city.blocks = blocks;
+    g_series = "monte-carlo";
+    in_child(a, issue_options(a), "the issue's configuration (gauss-seidel, monte-carlo 1024 rays)", true);
+    rad::SolveOptions hr = issue_options(a);
+    hr.method = rad::SolverMethod::hierarchical;
+    hr.hierarchical.epsilon = a.epsilon;
+    g_series = "hierarchical";
+    in_child(a, hr, "hierarchical", false);
+  }
+  struct Point {
+    double facets, seconds, mib;
+    bool refused;
+  };
+  std::vector<Point> series[2];
+  const char* names[2] = {"monte-carlo", "hierarchical"};
+  const char* colours[2] = {"#1f77b4", "#d62728"};
+  if (FILE* f = std::fopen(path, "r")) {
+    char name[64];
+    Point p{};
+    int refused = 0;
+    while (std::fscanf(f, "%63s %lf %lf %lf %d", name, &p.facets, &p.seconds, &p.mib, &refused) == 5) {
+      p.refused = refused != 0;
+      series[std::string(name) == names[0] ? 0 : 1].push_back(p);
+    }
+    std::fclose(f);
+  }
+  std::remove(path);
+  std::FILE* svg = std::fopen(a.plot.c_str(), "w");
+  if (!svg) return 1;
+  std::fprintf(svg, "<svg xmlns='http://www.w3.org/2000/svg' width='880' height='340' font-family='sans-serif'>\n");
+  // Two log-log panels: seconds and MiB against facets (1e4 .. 2e6).
+  auto panel = [&](double ox, const char* y_label, double y_lo, double y_hi, auto value) {
+    const double w = 420, h = 300, x_lo = 1e4, x_hi = 2e6;
+    auto px = [&](double x) { return ox + 60 + (std::log10(x) - std::log10(x_lo)) / (std::log10(x_hi) - std::log10(x_lo)) * (w - 80); };
+    auto py = [&](double y) { return 10 + (std::log10(y_hi) - std::log10(y)) / (std::log10(y_hi) - std::log10(y_lo)) * (h - 60); };
+    std::fprintf(svg, "<rect x='%g' y='10' width='%g' height='%g' fill='none' stroke='#999'/>\n", ox + 60, w - 80, h - 60);
+    for (double y = y_lo; y <= y_hi * 1.001; y *= 10)
+      std::fprintf(svg, "<text x='%g' y='%g' font-size='11'>%g</text>\n", ox + 5, py(y) + 4, y);
+    for (double x : {1e4, 1e5, 1e6})
+      std::fprintf(svg, "<text x='%g' y='%g' font-size='11'>%g</text>\n", px(x) - 10, h - 35, x);
+    std::fprintf(svg, "<text x='%g' y='%g' font-size='12'>facets (log)</text>\n", ox + 200, h - 15);
+    std::fprintf(svg, "<text x='%g' y='25' font-size='12'>%s</text>\n", ox + 70, y_label);
+    for (int k = 0; k < 2; ++k) {
+      std::fprintf(svg, "<polyline fill='none' stroke='%s' stroke-width='1.5' points='", colours[k]);
+      for (const Point& p : series[k])
+        if (!p.refused) std::fprintf(svg, "%g,%g ", px(p.facets), py(std::max(y_lo, value(p))));
+      std::fprintf(svg, "'/>\n");
+      for (const Point& p : series[k]) {
+        const double x = px(p.facets), y = py(std::max(y_lo, value(p)));
+        if (p.refused)
+          std::fprintf(svg, "<text x='%g' y='%g' font-size='14' fill='%s'>x refused</text>\n", x - 5, y + 5, colours[k]);
+        else
+          std::fprintf(svg, "<circle cx='%g' cy='%g' r='3' fill='%s'/>\n", x, y, colours[k]);
+      }
+    }
+  };
+  panel(0, "seconds, 2 threads (log)", 1, 1000, [](const Point& p) { return p.seconds; });
+  panel(440, "peak RSS, MiB (log)", 10, 10000, [](const Point& p) { return p.mib; });
+  for (int k = 0; k < 2; ++k)
+    std::fprintf(svg, "<text x='%d' y='%d' font-size='12' fill='%s'>%s</text>\n", 80 + 140 * k, 335, colours[k], names[k]);
+  std::fprintf(svg, "</svg>\n");
+  std::fclose(svg);
+  std::printf("wrote %s\n", a.plot.c_str());
+  return 0;
+}
 
 int main(int argc, char** argv) {
   Args a;
@@ -194,6 +289,8 @@ int main(int argc, char** argv) {
       if (which != "monte-carlo" && which != "hierarchical") return usage(argv[i]);
       a.monte_carlo = which == "monte-carlo";
       a.hierarchical = which == "hierarchical";
+    } else if (arg == "--plot" && has_value) {
+      a.plot = argv[++i];
     } else if (arg == "--city-only") {
       a.solve = false;
     } else if (arg == "--threads" && has_value) {
@@ -206,6 +303,7 @@ int main(int argc, char** argv) {
   }
   std::printf("bench_city: radiosity %s, procedural city under a uniform sky of %g W/m^2\n", rad::version(),
               static_cast<double>(bench::kCitySkyIrradiance));
+  if (!a.plot.empty()) return plot(a);
   rad::SolveOptions defaults;
   defaults.threads = a.threads;
   defaults.memory_budget_bytes = a.memory_budget_bytes;

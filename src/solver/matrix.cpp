@@ -37,6 +37,27 @@ void check_row_memory(std::size_t rows, std::size_t unknowns, std::size_t patche
   throw Error(ErrorCode::memory_budget, s.str());
 }
 
+bool end_sweep(const SolverContext& ctx, SolverResult& result, int it, double change, double seconds) {
+  result.iterations = it;
+  result.residual = change / ctx.system.emitted;
+  result.residual_history.push_back(result.residual);
+  result.time_history.push_back(seconds);
+  const bool done = result.residual < ctx.options.tolerance;
+  if (done) result.status = SolveStatus::converged;
+  Progress p;
+  p.phase = Phase::solving;
+  p.iteration = it;
+  p.residual = result.residual;
+  p.fraction = done ? 1.0 : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
+  p.hierarchy = &ctx.hierarchy;
+  p.leaf_radiosity = result.B.data();
+  if (!ctx.progress.report(p, done)) {
+    result.status = SolveStatus::cancelled;
+    return true;
+  }
+  return done;
+}
+
 SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixStore& store,
                           const std::vector<Rgb>& B0) {
   const RadiositySystem& sys = ctx.system;
@@ -168,25 +189,8 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         if (sys.twin[i] != kNone) set(sys.twin[i]);
       }
     }
-    result.iterations = it;
-    result.residual = change / sys.emitted;
-    result.residual_history.push_back(result.residual);
-    result.time_history.push_back(seconds_since(t0));  // form factors included: the first sweep waits for them
-    const bool done = result.residual < ctx.options.tolerance;
-    Progress p;
-    p.phase = Phase::solving;
-    p.iteration = it;
-    p.residual = result.residual;
-    p.fraction = done ? 1.0
-                      : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
-    if (done) result.status = SolveStatus::converged;
-    p.hierarchy = &ctx.hierarchy;
-    p.leaf_radiosity = result.B.data();
-    if (!ctx.progress.report(p, done)) {
-      result.status = SolveStatus::cancelled;
-      break;
-    }
-    if (done) break;
+    // Form factors included in the time: the first sweep waits for them.
+    if (end_sweep(ctx, result, it, change, seconds_since(t0))) break;
   }
 
   // Irradiance for the energy balance: H_e = sum_j F_ej B_j with the final radiosity.

@@ -99,6 +99,12 @@ struct SolverContext {
   ProgressGate& progress;
 };
 
+/// The end of sweep `it` of a sweeping solver (the matrix methods, hierarchical): records the
+/// residual `change` / emitted power and the time, marks convergence, and reports
+/// Phase::solving with the current estimate (result.B, one value per unknown). Returns true
+/// when the sweeps should stop: converged, or cancelled (result.status says which).
+bool end_sweep(const SolverContext& context, SolverResult& result, int it, double change, double seconds);
+
 /// One row F(element -> patches) or column F(elements -> patch) of the form-factor matrix:
 /// dense (`index` empty, one value per patch / element) or sparse (the non-zero entries), as the
 /// estimator produces it (FormFactorEstimator::sparse()).

@@ -819,24 +819,7 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
       change += sys.area[u] * l1(b - result.B[u]);
     }
     result.B.swap(next);
-    result.iterations = it;
-    result.residual = change / sys.emitted;
-    result.residual_history.push_back(result.residual);
-    result.time_history.push_back(seconds_since(t0));
-    const bool done = result.residual < ctx.options.tolerance;
-    if (done) result.status = SolveStatus::converged;
-    Progress p;
-    p.phase = Phase::solving;
-    p.iteration = it;
-    p.residual = result.residual;
-    p.fraction = done ? 1.0 : std::clamp(std::log(result.residual) / std::log(ctx.options.tolerance), 0.0, 1.0);
-    p.hierarchy = &ctx.hierarchy;
-    p.leaf_radiosity = result.B.data();
-    if (!ctx.progress.report(p, done)) {
-      result.status = SolveStatus::cancelled;
-      break;
-    }
-    if (done) break;
+    if (end_sweep(ctx, result, it, change, seconds_since(t0))) break;
   }
   // Irradiance for the energy balance, from the final radiosity.
   m.node_values(ctx.hierarchy, sys, result.B, values);
