@@ -351,7 +351,7 @@ class RADIOSITY_API Problem {
   /// The hierarchy the next solve works on (after adaptive subdivision, the refined one).
   const PatchHierarchy& hierarchy() const;
   /// Bytes of form factors kept between solves (the matrix methods' rows, progressive
-  /// refinement's columns).
+  /// refinement's columns, the hierarchical solver's links and cluster tree).
   std::size_t form_factor_bytes() const;
 
   /// Solves with the emission of the scene's materials. The result is that of

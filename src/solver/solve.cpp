@@ -666,7 +666,9 @@ Problem& Problem::operator=(Problem&&) noexcept = default;
 const Scene& Problem::scene() const { return impl_->scene; }
 const SolveOptions& Problem::options() const { return impl_->options; }
 const PatchHierarchy& Problem::hierarchy() const { return impl_->hierarchy; }
-std::size_t Problem::form_factor_bytes() const { return impl_->store.bytes() + impl_->columns.bytes; }
+std::size_t Problem::form_factor_bytes() const {
+  return impl_->store.bytes() + impl_->columns.bytes + (impl_->links ? impl_->links->bytes() : 0);
+}
 
 Solution Problem::solve() { return impl_->solve(nullptr, false); }
 

@@ -27,8 +27,9 @@
 namespace radiosity::detail {
 namespace {
 
-/// Visibility rays per link: a first pass, and more when it is mixed (a penumbra). A link
-/// whose first pass is all clear or all blocked is taken as fully visible or hidden.
+/// Visibility rays per link: a pilot that decides (mixed: a penumbra, refined when the link
+/// carries enough), then fresh rays that estimate, as many again for a pure pilot and
+/// kPenumbraRays for a mixed one (process(): why the estimate must not reuse the pilot).
 constexpr int kFirstRays = 4;
 constexpr int kPenumbraRays = 12;
 /// Tries per wanted ray to find a pair of points that face each other (cluster surfaces face
@@ -39,7 +40,8 @@ constexpr int kTriesPerRay = 8;
 constexpr std::size_t kBlock = 1024;
 /// Links with a cluster end are taken only when the two nodes' radii add up to at most this
 /// fraction of their distance (unless they carry less than kSeparationFloor x the threshold):
-/// a cluster's transport is taken from its centre, whose error grows with (r / d)^2.
+/// a cluster's transport is taken from its centroid, which is accurate only for nodes small for
+/// their distance (the walls of the benchmark city lose 2.4 % at 0.5, 1.1 % at 0.3).
 constexpr float kSeparation = 0.3f;
 constexpr float kSeparationFloor = 0.1f;
 /// Receiver points per side for the closed form between touching elements (n x n).
