@@ -311,7 +311,8 @@ RADIOSITY_API void validate(const SolveOptions& options);
 
 /// A scene set up for solving, kept across solves: its patch hierarchy (refined in place by
 /// adaptive subdivision), its form-factor estimator (with whatever it builds and caches: BVHs,
-/// visibility) and the form factors the matrix methods have computed. Solving it again, with the
+/// visibility) and the form factors the matrix methods have computed (or the hierarchical
+/// solver's links, re-examined for the new radiosity). Solving it again, with the
 /// materials' emission or with other emission per polygon (relighting, light groups, a lamp
 /// switched off), reuses all of that: a matrix method's second solve costs its sweeps only. The
 /// estimator is made on the first solve that has something to emit. The lights' first shot
@@ -374,8 +375,9 @@ class RADIOSITY_API Problem {
 };
 
 /// Meshes the scene, computes form factors and solves for radiosity. Throws Error for bad
-/// options or when the matrix methods would exceed memory_budget_bytes (the message gives the
-/// size and suggests progressive or a coarser mesh), and Error{invalid_scene} naming two
+/// options or when a matrix method asked for by name would exceed memory_budget_bytes (the
+/// message gives the size and suggests hierarchical, progressive or a coarser mesh; the default
+/// SolverMethod::automatic takes the hierarchical solver instead), and Error{invalid_scene} naming two
 /// polygons for coincident or interpenetrating surfaces (find_overlaps(); checked when the form
 /// factors are set up, so a scene that emits nothing returns B = 0 without the check; a scene with
 /// lights (Scene::lights()) is solved even when no polygon emits: the lights are the first shot,

@@ -597,7 +597,7 @@ struct LinkHierarchy::Impl {
     if (needs_refinement(rc, r, s, false) && refine()) return;
 
     // Link. Element pairs take the closed form (averaged over the receiver when close), the
-    // rest the point-to-point transport of the nodes' centres over distance squared.
+    // rest the point-to-point transport between the nodes' centroids, corrected below.
     const float d = glm::length(centroid(h, r) - centroid(h, s));
     float coefficient = 0.0f;
     if (!is_cluster(r) && !is_cluster(s)) {
@@ -631,7 +631,8 @@ struct LinkHierarchy::Impl {
     out.links.push_back({r, s, partly_hidden ? -coefficient * v : coefficient * v});
   }
 
-  /// Runs refinement rounds from `frontier` until it is empty; new links go to `links`.
+  /// Runs refinement rounds from `frontier` until it is empty; each round's links become a
+  /// chunk of `chunks`. False when `gate` cancels.
   bool run_rounds(PatchHierarchy& hierarchy, Values& values, std::vector<Pair> frontier, float threshold,
                   const SubdivisionLimits& limits, ProgressGate& gate, LinkChunks& chunks,
                   std::vector<std::uint32_t>& split, RefineStats& stats) {
