@@ -1,6 +1,6 @@
 // Hierarchical radiosity's links (docs/HIERARCHICAL.md, issue #15): energy moves along links
-// between nodes of the cluster tree and the element quadtrees, refined by the "BF" oracle
-// from one self-link of the root cluster, then Jacobi sweeps of gather and push-pull over them.
+// between nodes of the cluster tree and the element quadtrees, refined by an error oracle
+// (docs/HIERARCHICAL.md, "Refinement") from one self-link of the root cluster, then Jacobi sweeps of gather and push-pull over them.
 // Private to the library; solve() runs it for SolverMethod::hierarchical.
 // Based on: P. Hanrahan, D. Salzman & L. Aupperle, "A rapid hierarchical radiosity algorithm",
 // SIGGRAPH 1991 (links, BF refinement, gather, push-pull, multigridding); B. Smits, J. Arvo &
@@ -69,8 +69,8 @@ class LinkHierarchy {
 
   /// One refinement pass against the radiosity `B` of `system` (per unknown): the first call
   /// links the root cluster to itself and refines from there; later calls re-examine every link
-  /// with the new radiosity and refine those that now exceed `threshold` (W/m^2: the radiosity
-  /// a link may bring to its receiver). Splits elements of `hierarchy` within `limits`; their
+  /// with the new radiosity and refine those that now fail the oracle against `threshold`
+  /// (W/m^2 of irradiance at the receiver: docs/HIERARCHICAL.md, "Refinement"). Splits elements of `hierarchy` within `limits`; their
   /// ids are appended to `split` (the caller makes their children unknowns). Returns false when
   /// `gate` cancels: the links are then those before the call (elements split so far stay split).
   bool refine(PatchHierarchy& hierarchy, const RadiositySystem& system, const std::vector<Rgb>& B, float threshold,
