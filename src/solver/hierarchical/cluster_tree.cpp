@@ -127,9 +127,7 @@ void add_surface(Moments& P, const glm::vec3& n, const Rgb& power) {
 
 Rgb intensity(const Moments& P, const glm::vec3& w) {
   // I(w) = (1/pi) sum_a |w_a| P[sign(w_a) a] (docs/HIERARCHICAL.md, "Transport through a cluster").
-  Rgb I(0.0f);
-  for (int a = 0; a < 3; ++a) I += std::abs(w[a]) * P[w[a] >= 0.0f ? 2 * a : 2 * a + 1];
-  return kInvPi * I;
+  return kInvPi * directional_sum(P, w);
 }
 
 void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& front,

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -104,6 +105,16 @@ enum MomentAxis : int { kPosX = 0, kNegX = 1, kPosY = 2, kNegY = 3, kPosZ = 4, k
 /// moments: P[+a] += power max(0, n_a) / |n|_1, P[-a] += power max(0, -n_a) / |n|_1, so the six
 /// parts sum to `power`.
 void add_surface(Moments& P, const glm::vec3& n, const Rgb& power);
+
+/// sum_a |w_a| m[sign(w_a) a] over six directional moments `m` (kPosX .. kNegZ) of any
+/// quantity: what they show toward the unit direction `w`. intensity() is this over pi; the
+/// link hierarchy's projected areas are this of the area moments.
+template <typename T>
+T directional_sum(const std::array<T, 6>& m, const glm::vec3& w) {
+  T sum = m[0] * 0.0f;
+  for (int a = 0; a < 3; ++a) sum += std::abs(w[a]) * m[w[a] >= 0.0f ? 2 * a : 2 * a + 1];
+  return sum;
+}
 
 /// Radiant intensity (W/sr) of sending moments toward the unit direction `w`:
 /// I(w) = (1/pi) sum_a |w_a| P[sign(w_a) a]. Its integral over the sphere is the sum of the six

@@ -236,10 +236,7 @@ struct LinkHierarchy::Impl {
   /// A max(0, n . v) (exact for axis-aligned sides of a cluster, as the moments are).
   float projected_area(const PatchHierarchy& h, NodeHandle n, const glm::vec3& v) const {
     if (!is_cluster(n)) return h.element(element_of(n)).area * std::max(0.0f, glm::dot(side_normal(h, n), v));
-    const std::array<float, 6>& m = area_moments[handle_index(n)];
-    float sum = 0.0f;
-    for (int a = 0; a < 3; ++a) sum += v[a] >= 0.0f ? v[a] * m[2 * a] : -v[a] * m[2 * a + 1];
-    return sum;
+    return directional_sum(area_moments[handle_index(n)], v);
   }
 
   /// The unoccluded transport (pi x power, for B = 1 on every side) from `s` to `r` taken
