@@ -113,6 +113,12 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
                 total, r.seconds_meshing, r.seconds_lights, setup, r.seconds_form_factors, r.seconds_solving);
     std::printf("  peak RSS %.1f MiB, form factors %.1f MiB, %zu links\n", peak_rss_mib(),
                 static_cast<double>(r.form_factor_bytes) / (1024.0 * 1024.0), r.link_count);
+    std::printf("  rays: sky %.1f M (%.0f per element)", static_cast<double>(r.light_rays) * 1e-6,
+                static_cast<double>(r.light_rays) / static_cast<double>(std::max<std::size_t>(1, r.element_count)));
+    if (hierarchical)
+      std::printf(", links %.1f M over %.2f M pairs examined", static_cast<double>(r.link_rays) * 1e-6,
+                  static_cast<double>(r.link_pairs_examined) * 1e-6);
+    std::printf("\n");
     std::printf("  group means B (W/m^2):");
     for (const char* group : {"ground", "streets", "walls", "roofs", "under_buildings"}) {
       const rad::Rgb b = sol.group_radiosity(group);

@@ -123,6 +123,8 @@ struct SolveReport {
   int refinement_passes = 0;
   std::size_t form_factor_bytes = 0;     ///< memory held by form factors (or links) at the peak
   std::size_t link_count = 0;            ///< SolverMethod::hierarchical: links at the end (0 otherwise)
+  std::size_t link_pairs_examined = 0;   ///< SolverMethod::hierarchical: node pairs the refinement oracle looked at
+  std::uint64_t link_rays = 0;           ///< SolverMethod::hierarchical: the links' visibility rays
   /// The solver that ran (never automatic), and, when SolveOptions::method was automatic, why
   /// (e.g. "the Gauss-Seidel rows could need 7742 MiB, over the memory budget of 4096 MiB");
   /// empty otherwise.
@@ -152,6 +154,7 @@ struct SolveReport {
   /// The lights' first shot: every element in the first solve of a Problem, the new elements
   /// of adaptive subdivision; 0 when the values were kept from an earlier solve.
   double seconds_lights = 0.0;
+  std::uint64_t light_rays = 0;  ///< the shadow rays of that first shot
   std::vector<std::string> warnings;
 };
 

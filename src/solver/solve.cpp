@@ -344,8 +344,10 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
 
   // The lights' first shot (once per Problem): their direct irradiance on every element.
   const double light_seconds = light_shot.seconds;
+  const std::uint64_t light_rays = light_shot.rays;
   const bool shot = group_light_shot != nullptr || shoot_lights(hierarchy.leaves(), gate);
   report.seconds_lights = light_shot.seconds - light_seconds;
+  report.light_rays = light_shot.rays - light_rays;
   if (!shot) {
     std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
     return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
@@ -422,8 +424,10 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     }
     // The new leaves' share of the lights (their parents' values averaged them).
     const double before = light_shot.seconds;
+    const std::uint64_t rays_before = light_shot.rays;
     const bool lit = shoot_lights(created, gate);
     report.seconds_lights += light_shot.seconds - before;
+    report.light_rays += light_shot.rays - rays_before;
     if (!lit) {
       // Cancelled: the parents' values stand for their children in this solution's balance
       // (a later solve computes them).
@@ -473,6 +477,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       const auto tf = std::chrono::steady_clock::now();
       const bool refined = links->refine(hierarchy, *system, B_now, threshold, limits, gate, split, stats);
       report.seconds_form_factors += seconds_since(tf);
+      report.link_pairs_examined += stats.examined;
+      report.link_rays += stats.rays;
       bool lit = true;
       if (!split.empty()) {
         lit = adopt_children(split).first;

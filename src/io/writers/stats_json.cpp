@@ -83,6 +83,9 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   j["elements"] = r.element_count;
   j["form_factor_bytes"] = r.form_factor_bytes;
   j["link_count"] = r.link_count;
+  j["link_pairs_examined"] = r.link_pairs_examined;
+  j["link_rays"] = r.link_rays;
+  j["light_rays"] = r.light_rays;
   j["method_used"] = method_name(r.method);
   j["method_choice"] = r.method_choice;
   j["mesh"] = Json{{"max_patch_area", number(solution.hierarchy().options().max_patch_area)},

@@ -97,6 +97,15 @@ struct LinkHierarchy::Impl {
 
   /// Per patch: 1 when it has a back side (refresh_patch_data(), at every refine()).
   std::vector<std::uint8_t> has_back;
+  /// Per position of tree.order(): what sampling a point of that patch needs, in one cache
+  /// line, so that a cluster's points (a contiguous range) are drawn without chasing the
+  /// patch, its root element and its vertices through memory (refresh_patch_data()).
+  struct SamplePatch {
+    std::array<glm::vec3, 4> corners;  ///< the root element's, counter-clockwise
+    glm::vec3 normal;
+    std::uint8_t corner_count, has_back;
+  };
+  std::vector<SamplePatch> sample_patches;
   /// Per cluster: its sides' area split by their normals as add_surface() splits power
   /// (refresh_patch_data()): what it shows toward a direction (projected_area()).
   std::vector<std::array<float, 6>> area_moments;
@@ -214,6 +223,17 @@ struct LinkHierarchy::Impl {
   void refresh_patch_data(const PatchHierarchy& hierarchy, const RadiositySystem& sys) {
     has_back.assign(hierarchy.patches().size(), 0);
     for (std::size_t u = sys.fronts(); u < sys.unknowns(); ++u) has_back[hierarchy.element(sys.element(u)).patch] = 1;
+    const std::vector<std::uint32_t>& order = tree.order();
+    sample_patches.resize(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const Patch& patch = hierarchy.patches()[order[k]];
+      const Element& root = hierarchy.element(patch.root);
+      SamplePatch& sp = sample_patches[k];
+      sp.corner_count = static_cast<std::uint8_t>(root.corner_count());
+      for (int c = 0; c < 4; ++c) sp.corners[static_cast<std::size_t>(c)] = hierarchy.vertices()[root.corners[std::min(c, root.corner_count() - 1)]];
+      sp.normal = patch.normal;
+      sp.has_back = has_back[order[k]];
+    }
     const std::uint32_t C = cluster_count();
     area_moments.assign(C, std::array<float, 6>{});
     for (std::uint32_t i = C; i-- > 0;) {
@@ -370,17 +390,20 @@ struct LinkHierarchy::Impl {
   /// barycentric map of a triangle. Not area-uniform on a non-parallelogram quad (the
   /// estimators' CellSampler is, at several times the cost): visibility rays only need points
   /// spread over the element.
-  static glm::vec3 element_point(const PatchHierarchy& h, std::uint32_t element, glm::vec2 uv) {
-    const Element& e = h.element(element);
-    const std::vector<glm::vec3>& v = h.vertices();
-    const glm::vec3 &a = v[e.corners[0]], &b = v[e.corners[1]], &c = v[e.corners[2]];
-    if (e.corner_count() == 3) {
+  static glm::vec3 polygon_point(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
+                                 int count, glm::vec2 uv) {
+    if (count == 3) {
       if (uv.x + uv.y > 1.0f) uv = glm::vec2(1.0f) - uv;
       return a + uv.x * (b - a) + uv.y * (c - a);
     }
-    const glm::vec3& d = v[e.corners[3]];
     const glm::vec3 ab = a + uv.x * (b - a), dc = d + uv.x * (c - d);
     return ab + uv.y * (dc - ab);
+  }
+  static glm::vec3 element_point(const PatchHierarchy& h, std::uint32_t element, glm::vec2 uv) {
+    const Element& e = h.element(element);
+    const std::vector<glm::vec3>& v = h.vertices();
+    const int count = e.corner_count();
+    return polygon_point(v[e.corners[0]], v[e.corners[1]], v[e.corners[2]], v[e.corners[count == 3 ? 2 : 3]], count, uv);
   }
 
   /// A point of node `h`, area-uniform, with the normal of the side it lies on (a cluster's
@@ -401,21 +424,32 @@ struct LinkHierarchy::Impl {
     if (by_power && cumulative_power[c.first + c.count] > cumulative_power[c.first]) cumulative = &cumulative_power;
     const double lo = (*cumulative)[c.first], hi = (*cumulative)[c.first + c.count];
     const double target = lo + static_cast<double>(rng.uniform()) * (hi - lo);
-    auto it = std::upper_bound(cumulative->begin() + c.first + 1, cumulative->begin() + c.first + c.count + 1, target);
-    const auto k = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(
-        it - cumulative->begin() - 1, static_cast<std::ptrdiff_t>(c.first + c.count - 1)));
-    const std::uint32_t p = tree.order()[k];
-    const Patch& patch = hierarchy.patches()[p];
-    point = element_point(hierarchy, patch.root, rng.uniform2());
-    normal = patch.normal;
-    two_sided = has_back[p] != 0;
+    // The last patch k of the cluster with cumulative[k] <= target: a binary search without
+    // branches (the compiler's conditional moves), since the targets are random and a
+    // branching search mispredicts at every step.
+    const double* base = cumulative->data() + c.first;
+    for (std::uint32_t n = c.count; n > 1;) {
+      const std::uint32_t half = n / 2;
+      base = base[half] <= target ? base + half : base;
+      n -= half;
+    }
+    const SamplePatch& sp = sample_patches[static_cast<std::size_t>(base - cumulative->data())];
+    point = polygon_point(sp.corners[0], sp.corners[1], sp.corners[2], sp.corners[3], sp.corner_count, rng.uniform2());
+    normal = sp.normal;
+    two_sided = sp.has_back != 0;
   }
 
   /// Shadow rays between facing points of two nodes, drawn from the link's own stream.
   class ShadowSampler {
    public:
     ShadowSampler(const Impl& m, const PatchHierarchy& h, NodeHandle r, NodeHandle s)
-        : m_(m), h_(h), r_(r), s_(s), rng_(m.seed, (std::uint64_t{r} << 32) | s, stream_key(Stream::hierarchical_link)) {}
+        : m_(m),
+          h_(h),
+          r_(r),
+          s_(s),
+          rng_(m.seed, (std::uint64_t{r} << 32) | s, stream_key(Stream::hierarchical_link)),
+          receiver_centre_(m.centre(h, r)),
+          receiver_radius_(m.radius(h, r)) {}
     /// Casts up to `wanted` rays (as many facing pairs as `wanted` x kTriesPerRay tries find);
     /// returns {clear, cast}.
     std::pair<int, int> draw(int wanted, std::uint64_t& rays) {
@@ -427,6 +461,9 @@ struct LinkHierarchy::Impl {
         glm::vec3 x, nx, y, ny;
         bool two_x, two_y;
         m_.sample(h_, s_, true, rng_, x, nx, two_x);
+        // A one-sided source point facing away from the receiver's whole bounding sphere has
+        // no partner there: the try ends before the receiver point is drawn.
+        if (!two_x && !(glm::dot(nx, receiver_centre_ - x) + receiver_radius_ > 0.0f)) continue;
         m_.sample(h_, r_, false, rng_, y, ny, two_y);
         const glm::vec3 d = y - x;
         if (two_x && glm::dot(nx, d) < 0.0f) nx = -nx;
@@ -450,6 +487,8 @@ struct LinkHierarchy::Impl {
     const PatchHierarchy& h_;
     NodeHandle r_, s_;
     Rng rng_;
+    glm::vec3 receiver_centre_;
+    float receiver_radius_;
   };
 
   /// Element-to-element factor: the point-to-polygon closed form from receiver points to the
@@ -920,7 +959,7 @@ std::size_t LinkHierarchy::bytes() const {
   const std::size_t clusters = m.tree.nodes().size();
   return m.sources.capacity() * sizeof(NodeHandle) + m.coefficients.capacity() * sizeof(float) +
          m.offsets.capacity() * sizeof(std::uint64_t) + clusters * (sizeof(ClusterNode) + 2 * sizeof(Moments)) +
-         m.cumulative_area.capacity() * sizeof(double);
+         m.cumulative_area.capacity() * sizeof(double) + m.sample_patches.capacity() * sizeof(Impl::SamplePatch);
 }
 
 const ClusterTree& LinkHierarchy::tree() const { return impl_->tree; }
