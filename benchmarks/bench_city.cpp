@@ -9,11 +9,15 @@
 // Each configuration runs in its own child process, so its peak RSS is its own.
 //
 // Usage: bench_city [PRESET] [--blocks N] [--facet S] [--seed K] [--threads T] [--memory-budget MIB]
-//                   [--epsilon E] [--only monte-carlo|hierarchical] [--city-only]
+//                   [--epsilon E] [--only monte-carlo|hierarchical] [--city-only] [--sky-rays N]
+//                   [--make-reference FILE | --reference FILE] [--plot FILE.svg]
 //   PRESET: 22k (3 blocks, 2.25 m facets: 23.5k facets), 246k (10 blocks: 250k), 1M (20 blocks:
 //   991k); the options after a preset change it. Default: 22k. --memory-budget sets
 //   SolveOptions::memory_budget_bytes (default: the library's 4 GiB). --city-only builds the city
-//   and prints its facets without solving.
+//   and prints its facets without solving. --sky-rays sets SolveOptions::sky_rays.
+//   --make-reference FILE solves the city with 16 times the rays of the issue's configuration
+//   (form factors and sky; Gauss-Seidel to a tolerance of 1e-5) and writes its element radiosity;
+//   --reference FILE then prints every solve's element RMS relative difference to it.
 // Prints the city (facets per group, buildings, time to build it), then per configuration the
 // elements, the time of each phase (meshing, the sky's first shot, the estimator's set-up,
 // form factors, solving; from SolveReport, the set-up is the rest of the wall time), sweeps,
@@ -26,6 +30,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -52,7 +57,87 @@ struct Args {
   bool hierarchical = true;             ///< run SolverMethod::hierarchical
   float epsilon = rad::HierarchicalOptions{}.epsilon;
   std::string plot;                     ///< --plot FILE: the SVG of time and memory against facets
+  std::uint32_t sky_rays = rad::SolveOptions{}.sky_rays;  ///< SolveOptions::sky_rays of every solve
+  std::string make_reference;           ///< --make-reference FILE: solve the reference, write its radiosity
+  std::string reference;                ///< --reference FILE: compare every solve with that reference
 };
+
+/// The reference's rays: 16 times the issue's configuration, for form factors and the sky.
+constexpr std::uint32_t kReferenceFactor = 16;
+
+/// Element radiosity (the mean channel per element) as --make-reference writes it: a count,
+/// then the values, native float.
+bool write_values(const std::string& path, const std::vector<float>& v) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) return false;
+  const std::uint64_t n = v.size();
+  const bool ok = std::fwrite(&n, sizeof n, 1, f) == 1 && std::fwrite(v.data(), sizeof(float), v.size(), f) == v.size();
+  return std::fclose(f) == 0 && ok;
+}
+std::vector<float> read_values(const std::string& path) {
+  std::vector<float> v;
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return v;
+  std::uint64_t n = 0;
+  if (std::fread(&n, sizeof n, 1, f) == 1 && n < (std::uint64_t{1} << 32)) {
+    v.resize(n);
+    if (std::fread(v.data(), sizeof(float), v.size(), f) != v.size()) v.clear();
+  }
+  std::fclose(f);
+  return v;
+}
+std::vector<float> mean_channel(const std::vector<rad::Rgb>& B) {
+  std::vector<float> v(B.size());
+  for (std::size_t i = 0; i < B.size(); ++i) v[i] = (B[i].x + B[i].y + B[i].z) / 3.0f;
+  return v;
+}
+
+/// Prints how far `got` (mean channel per element) lies from `ref`: the RMS relative difference
+/// over the elements whose reference exceeds a tenth of the mean (the dark ground under the
+/// buildings would make relative figures meaningless), and the relative difference of the
+/// area-uniform mean (every facet of a city has nearly the same area).
+void compare(const std::vector<float>& got, const std::vector<float>& ref, const std::vector<std::uint32_t>& group,
+             const std::vector<std::string>& group_names) {
+  if (got.size() != ref.size()) {
+    std::printf("  reference: %zu elements there, %zu here: not compared\n", ref.size(), got.size());
+    return;
+  }
+  double mean_ref = 0.0, mean_got = 0.0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    mean_ref += ref[i];
+    mean_got += got[i];
+  }
+  double sq = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    if (!(ref[i] > 0.1 * mean_ref / static_cast<double>(ref.size()))) continue;
+    const double d = got[i] / ref[i] - 1.0;
+    sq += d * d;
+    ++n;
+  }
+  std::printf("  against the reference: element RMS relative difference %.2f %% (%zu elements above a tenth of "
+              "the mean), mean %+.2f %%\n",
+              n ? 100.0 * std::sqrt(sq / static_cast<double>(n)) : 0.0, n, 100.0 * (mean_got / mean_ref - 1.0));
+  // The same per group: where the differences are.
+  std::printf("    per group (RMS, mean):");
+  for (std::uint32_t g = 0; g < group_names.size(); ++g) {
+    double gs = 0.0, gr = 0.0, gsq = 0.0;
+    std::size_t gn = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      if (group[i] != g) continue;
+      gs += got[i];
+      gr += ref[i];
+      if (!(ref[i] > 0.1 * mean_ref / static_cast<double>(ref.size()))) continue;
+      const double d = got[i] / ref[i] - 1.0;
+      gsq += d * d;
+      ++gn;
+    }
+    if (gr > 0.0)
+      std::printf("  %s %.2f %% %+.2f %%", group_names[g].c_str(), gn ? 100.0 * std::sqrt(gsq / static_cast<double>(gn)) : 0.0,
+                  100.0 * (gs / gr - 1.0));
+  }
+  std::printf("\n");
+}
 
 /// With --plot: each child appends "SERIES FACETS SECONDS PEAK_RSS_MIB REFUSED" here.
 std::string g_record_path;
@@ -63,6 +148,7 @@ rad::SolveOptions issue_options(const Args& a) {
   rad::SolveOptions opt;
   opt.threads = a.threads;
   opt.memory_budget_bytes = a.memory_budget_bytes;
+  opt.sky_rays = a.sky_rays;
   opt.method = rad::SolverMethod::gauss_seidel;
   opt.form_factors.method = rad::FormFactorMethod::monte_carlo;
   opt.form_factors.hemisphere_rays = 1024;
@@ -128,6 +214,23 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
     std::printf("\n  power: the sky puts %.4g W onto the surfaces; absorbed %.1f %%, escaped %.1f %%\n", emitted / 3.0,
                 100.0 * channel_sum(r.absorbed_power) / emitted, 100.0 * channel_sum(r.escaped_power) / emitted);
     for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
+    if (!a.make_reference.empty()) {
+      if (!write_values(a.make_reference, mean_channel(sol.radiosity()))) {
+        std::printf("  could not write %s\n", a.make_reference.c_str());
+        return kFailed;
+      }
+      std::printf("  wrote the reference to %s\n", a.make_reference.c_str());
+    } else if (!a.reference.empty()) {
+      const std::vector<float> ref = read_values(a.reference);
+      if (ref.empty()) {
+        std::printf("  could not read the reference %s\n", a.reference.c_str());
+        return kFailed;
+      }
+      std::vector<std::uint32_t> group(sol.radiosity().size(), 0);
+      for (std::size_t e = 0; e < group.size(); ++e)
+        group[e] = sol.hierarchy().patches()[sol.hierarchy().element(static_cast<std::uint32_t>(e)).patch].group;
+      compare(mean_channel(sol.radiosity()), ref, group, city.scene.groups());
+    }
     std::fflush(stdout);
     if (!g_record_path.empty())
       if (FILE* f = std::fopen(g_record_path.c_str(), "a")) {
@@ -176,7 +279,7 @@ int usage(const char* bad) {
   std::fprintf(stderr,
                "usage: bench_city [22k|246k|1M] [--blocks N] [--facet METRES] [--seed K] [--threads T]\n"
                "                  [--memory-budget MIB] [--epsilon E] [--only monte-carlo|hierarchical] [--city-only]\n"
-               "                  [--plot FILE.svg]\n"
+               "                  [--sky-rays N] [--make-reference FILE | --reference FILE] [--plot FILE.svg]\n"
                "  presets: 22k = --blocks 3 --facet 2.25 (23.5k facets), 246k = --blocks 10 --facet 2.25 (250k),\n"
                "           1M = --blocks 20 --facet 2.25 (991k)\n");
   return bad ? 2 : 0;
@@ -295,6 +398,14 @@ int main(int argc, char** argv) {
       if (which != "monte-carlo" && which != "hierarchical") return usage(argv[i]);
       a.monte_carlo = which == "monte-carlo";
       a.hierarchical = which == "hierarchical";
+    } else if (arg == "--sky-rays" && has_value) {
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || v < 5 || v > (1L << 24)) return usage(argv[i]);
+      a.sky_rays = static_cast<std::uint32_t>(v);
+    } else if (arg == "--make-reference" && has_value) {
+      a.make_reference = argv[++i];
+    } else if (arg == "--reference" && has_value) {
+      a.reference = argv[++i];
     } else if (arg == "--plot" && has_value) {
       a.plot = argv[++i];
     } else if (arg == "--city-only") {
@@ -310,9 +421,21 @@ int main(int argc, char** argv) {
   std::printf("bench_city: radiosity %s, procedural city under a uniform sky of %g W/m^2\n", rad::version(),
               static_cast<double>(bench::kCitySkyIrradiance));
   if (!a.plot.empty()) return plot(a);
+  if (!a.make_reference.empty()) {
+    // Gauss-Seidel over Monte Carlo rows with kReferenceFactor times the rays, and as many
+    // more sky rays: the converged reference the accuracy targets are stated against.
+    rad::SolveOptions ref = issue_options(a);
+    ref.form_factors.hemisphere_rays *= kReferenceFactor;
+    ref.sky_rays *= kReferenceFactor;
+    ref.tolerance = 1e-5;
+    const std::string label = "reference (gauss-seidel, monte-carlo " + std::to_string(ref.form_factors.hemisphere_rays) +
+                              " rays, " + std::to_string(ref.sky_rays) + " sky rays, tolerance 1e-5)";
+    return in_child(a, ref, label.c_str(), true) == kFailed ? 1 : 0;
+  }
   rad::SolveOptions defaults;
   defaults.threads = a.threads;
   defaults.memory_budget_bytes = a.memory_budget_bytes;
+  defaults.sky_rays = a.sky_rays;
   int first = 0;
   if (a.monte_carlo) {
     first = in_child(a, defaults, "default solve (automatic method and form factors, tolerance 1e-3)", true);

@@ -124,10 +124,12 @@ Rgb unoccluded_cell_irradiance(const PreparedLight& light, const glm::vec3* corn
   return light.power * static_cast<float>(omega / static_cast<double>(area));
 }
 
-LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads)
+LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
+                           std::uint32_t sky_rays)
     : hierarchy_(hierarchy),
       lights_(scene.lights()),
       occluders_(RayScene::from_polygons(scene)),
+      sky_budget_(sky_ray_budget(sky_rays)),
       seed_(seed),
       threads_(threads) {
   // The estimators' ray offset: far above float rounding at the scene's scale, far below any feature.
@@ -157,7 +159,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
     Rng rng(seed_, e, stream_key(back_side ? Stream::light_back : Stream::light_front, light.id));
     const bool sky = light.type == LightType::sky;
     const bool to_point = light.type == LightType::point || light.type == LightType::spot;
-    const LightRayBudget budget = sky ? kSkyRays : kDeltaLightRays;
+    const LightRayBudget budget = sky ? sky_budget_ : kDeltaLightRays;
     // Generates and traces one pass of `points` rays; returns how many were traced and how many
     // of those were clear, adding their weights to the sums.
     double weight_sum = 0.0, visible_sum = 0.0;

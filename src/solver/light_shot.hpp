@@ -3,6 +3,7 @@
 // carries the lights' interreflection unchanged. See docs/LIGHTS.md.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -25,7 +26,11 @@ struct LightRayBudget {
   std::uint32_t penumbra = 256;
 };
 inline constexpr LightRayBudget kDeltaLightRays{16, 256};
-inline constexpr LightRayBudget kSkyRays{256, 1024};
+/// A sky's budget from SolveOptions::sky_rays (at least 5): a fifth first, the rest second.
+inline LightRayBudget sky_ray_budget(std::uint32_t sky_rays) {
+  const std::uint32_t first = std::max<std::uint32_t>(1, sky_rays / 5);
+  return {first, std::max<std::uint32_t>(1, sky_rays - first)};
+}
 
 /// The lights' direct irradiance per element id, kept by a Problem across solves (the lights
 /// and the geometry do not change); elements made by adaptive subdivision are added as they
@@ -51,9 +56,10 @@ struct LightShot {
 /// Thread safety: shoot() may be called concurrently on different LightShots.
 class LightShooter {
  public:
-  /// `seed` keys the random streams (Stream::light_front/light_back); `threads` as
-  /// SolveOptions::threads. Builds a BVH over the scene's polygons (Embree).
-  LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads);
+  /// `seed` keys the random streams (Stream::light_front/light_back); `threads` and `sky_rays`
+  /// as SolveOptions'. Builds a BVH over the scene's polygons (Embree).
+  LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
+               std::uint32_t sky_rays = 1280);
 
   bool empty() const { return lights_.empty(); }
 
@@ -80,6 +86,7 @@ class LightShooter {
   SceneLights lights_;
   RayScene occluders_;
   float epsilon_ = 0.0f;
+  LightRayBudget sky_budget_;
   std::uint64_t seed_ = 0;
   unsigned threads_ = 0;
   std::vector<std::uint8_t> patch_has_back_;

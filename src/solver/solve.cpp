@@ -106,6 +106,8 @@ void validate(const SolveOptions& o) {
       throw Error(ErrorCode::invalid_argument,
                   "adaptive.max_depth must be >= 1, got " + std::to_string(o.adaptive.max_depth));
   }
+  if (o.sky_rays < 5)
+    throw Error(ErrorCode::invalid_argument, "sky_rays must be >= 5, got " + std::to_string(o.sky_rays));
   if (o.method == SolverMethod::hierarchical) {
     if (!(o.hierarchical.epsilon > 0.0f && o.hierarchical.epsilon <= 1.0f))
       throw Error(ErrorCode::invalid_argument,
@@ -193,7 +195,8 @@ void Problem::Impl::choose_method() {
 bool Problem::Impl::shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate) {
   if (scene.lights().empty()) return true;
   if (!light_shooter)
-    light_shooter = std::make_unique<detail::LightShooter>(scene, hierarchy, options.seed, options.threads);
+    light_shooter =
+        std::make_unique<detail::LightShooter>(scene, hierarchy, options.seed, options.threads, options.sky_rays);
   return light_shooter->shoot(elements, light_shot, gate);
 }
 

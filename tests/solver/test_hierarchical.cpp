@@ -209,6 +209,8 @@ TEST_SUITE("solver") {
       const rad::Solution hr = rad::solve(scene, h);
       REQUIRE(hr.status() == rad::SolveStatus::converged);
       CHECK(hr.report().link_count > 0);
+      CHECK(hr.report().link_pairs_examined >= hr.report().link_count);  // every link was a pair looked at
+      CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
       for (const std::string& g : scene.groups()) {
         CAPTURE(g);
         const rad::Rgb a = gs.group_radiosity(g), b = hr.group_radiosity(g);

@@ -180,7 +180,8 @@ TEST_SUITE("solver") {
     }
   }
 
-  TEST_CASE("lights: under a parallel square roof the floor receives E (1 - F(x to roof)) of a uniform sky") {
+  TEST_CASE("lights: under a parallel square roof the floor receives E (1 - F(x to roof)) of a uniform sky, "
+            "its error shrinking as sky_rays grows") {
     // A floor of side 4 under a roof of side 1 at height 0.5, both centred: the floor's
     // elements see the sky except the roof's solid angle, weighted by the cosine: the point
     // factor F of Lambert's contour integral.
@@ -194,29 +195,51 @@ TEST_SUITE("solver") {
     sky.type = rad::LightType::sky;
     sky.intensity = 1.0f;
     scene.add_light(sky);
-    rad::SolveOptions o;
-    o.mesh.max_patch_area = 0.25f;
-    o.mesh.max_element_area = 1.0f / 16.0f;
-    const rad::Solution sol = rad::solve(scene, o);
-    const rad::PatchHierarchy& h = sol.hierarchy();
-    double worst = 0.0, sum_error = 0.0;
-    int count = 0;
-    for (std::uint32_t e : h.leaves()) {
-      if (h.patches()[h.element(e).patch].group != 0) continue;
-      const double exact = element_mean(h, e, [&](const glm::vec3& x) {
-        return 1.0 - rad::point_to_polygon_factor(x, glm::vec3(0, 1, 0), roof, 4);
-      }, 16);
-      const double H = sol.direct_irradiance()[e].x;
-      worst = std::max(worst, std::fabs(H - exact));
-      sum_error += H - exact;
-      ++count;
-      // 1280 rays (256, and 1024 more where they disagree) per element: the visible fraction of
-      // a half-covered sky has a standard error of about 1 %.
-      CHECK(std::fabs(H - exact) < 0.03);
+    std::uint64_t rays_at_default = 0;
+    // SolveOptions::sky_rays per element where the sky is partly covered (a fifth first, the
+    // rest where those disagree): the visible fraction's standard error is about
+    // 0.5 / sqrt(sky_rays) where half the sky is covered, so each element's bound is about 3 of
+    // those. The mean's bound is the first fifth's bias: far from the roof it covers little of the
+    // sky (about 1 % at the floor's corners), which 64 first rays miss half the time (V = 1).
+    struct Budget {
+      unsigned sky_rays;
+      double element, mean;
+    };
+    for (const auto& [sky_rays, bound, mean_bound] : {Budget{320u, 0.06, 6e-3}, Budget{1280u, 0.03, 2e-3},
+                                                      Budget{5120u, 0.015, 1e-3}}) {
+      CAPTURE(sky_rays);
+      rad::SolveOptions o;
+      o.mesh.max_patch_area = 0.25f;
+      o.mesh.max_element_area = 1.0f / 16.0f;
+      o.sky_rays = sky_rays;
+      const rad::Solution sol = rad::solve(scene, o);
+      const rad::PatchHierarchy& h = sol.hierarchy();
+      double worst = 0.0, sum_error = 0.0;
+      int count = 0;
+      for (std::uint32_t e : h.leaves()) {
+        if (h.patches()[h.element(e).patch].group != 0) continue;
+        const double exact = element_mean(h, e, [&](const glm::vec3& x) {
+          return 1.0 - rad::point_to_polygon_factor(x, glm::vec3(0, 1, 0), roof, 4);
+        }, 16);
+        const double H = sol.direct_irradiance()[e].x;
+        worst = std::max(worst, std::fabs(H - exact));
+        sum_error += H - exact;
+        ++count;
+        CHECK(std::fabs(H - exact) < bound);
+      }
+      MESSAGE("sky under a roof, " << sky_rays << " sky rays: worst element error " << worst << " E, mean "
+                                   << sum_error / count << " E over " << count << " elements");
+      CHECK(std::fabs(sum_error / count) < mean_bound);
+      if (sky_rays == 1280u) rays_at_default = sol.report().light_rays;
+      // The floor's elements all see the roof in part: each casts every ray of the budget (or
+      // the first fifth for one that sees only sky); the roof's back faces the ground, no sky.
+      CHECK(sol.report().light_rays <= static_cast<std::uint64_t>(count) * sky_rays);
+      CHECK(sol.report().light_rays >= static_cast<std::uint64_t>(count) * sky_rays / 5);
     }
-    MESSAGE("sky under a roof: worst element error " << worst << " E, mean " << sum_error / count << " E over " << count
-                                                     << " elements");
-    CHECK(std::fabs(sum_error / count) < 2e-3);
+    CHECK(rays_at_default > 0);
+    rad::SolveOptions bad;
+    bad.sky_rays = 4;
+    CHECK_THROWS_AS(rad::solve(scene, bad), rad::Error);
   }
 
   TEST_CASE("lights: in a closed box lit by a point light every solver and estimator gives B = rho H and absorbs 4 pi I") {
