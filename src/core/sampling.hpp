@@ -11,7 +11,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
@@ -125,6 +127,13 @@ class CellSampler {
   float A_ = 0.0f, B_ = 0.0f, C_ = 0.0f;
   bool parallelogram_ = false;
 };
+
+/// Shuffles v[0 .. count) uniformly (Fisher-Yates): pairs one set of strata with another at
+/// random (a Latin-hypercube-like padding of two stratified 2D sets into a 4D one).
+template <typename T>
+inline void shuffle(T* v, std::size_t count, Rng& rng) {
+  for (std::size_t i = count; i > 1; --i) std::swap(v[i - 1], v[rng.below(static_cast<std::uint32_t>(i))]);
+}
 
 /// Stratified points on [0,1]^2: a g x g grid (jittered, or cell centres) when count is a square
 /// g^2, otherwise `count` strata along u with random (or centred) v.

@@ -534,7 +534,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     stratified(count, rng, true, scratch.directions.data());
     // Pair point strata with direction strata at random, so the 4D samples are stratified in
     // each 2D projection (a Latin-hypercube-like padding).
-    for (std::uint32_t i = count; i > 1; --i) std::swap(scratch.directions[i - 1], scratch.directions[rng.next() % i]);
+    shuffle(scratch.directions.data(), count, rng);
     const glm::vec3 n = back ? -source.normal : source.normal;
     glm::vec3 t, b;
     tangent_frame(n, t, b);

@@ -108,7 +108,7 @@ VisibleFraction visible_fraction(const From& from, const glm::vec3& from_normal,
     stratified(S, rng, true, b.source_uv.data());
     if (budget.pairing == ShadowPairing::shuffled) {
       stratified(S, rng, true, b.target_uv.data());
-      for (std::uint32_t i = S; i > 1; --i) std::swap(b.target_uv[i - 1], b.target_uv[rng.next() % i]);
+      shuffle(b.target_uv.data(), S, rng);
     }
     for (std::uint32_t k = 0; k < S; ++k) {
       const glm::vec3 x = from(b.source_uv[k]);

@@ -77,7 +77,7 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads, co
       tangent_frame(polygon.normal, t, b);
       Rng rng(kSeed, out[k].polygon);
       std::iota(order.begin(), order.end(), 0u);
-      for (std::size_t i = rays - 1; i > 0; --i) std::swap(order[i], order[rng.next() % (i + 1)]);
+      shuffle(order.data(), rays, rng);
       const float cell = 1.0f / static_cast<float>(side);
       auto stratum = [&](std::size_t s) {
         const glm::vec2 u = rng.uniform2();

@@ -58,12 +58,6 @@ float PreparedLight::falloff(const glm::vec3& w) const {
   return t * t;
 }
 
-Rgb PreparedLight::sky_radiance(const glm::vec3& from) const {
-  const float c = glm::dot(from, direction);
-  if (!(c > 0.0f)) return Rgb(0.0f);
-  return sky == SkyModel::uniform ? zenith_radiance : zenith_radiance * ((1.0f + 2.0f * c) / 3.0f);
-}
-
 Rgb PreparedLight::sky_irradiance(const glm::vec3& n) const {
   // b: angle between the plane's normal and the zenith. Over the lune where both hemispheres
   // overlap, integral of (w.n) = pi (1 + cos b) / 2 and integral of (w.z)(w.n) =

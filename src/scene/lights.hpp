@@ -20,6 +20,7 @@
 #include <limits>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -48,7 +49,12 @@ struct PreparedLight {
   /// Spot falloff in [0, 1] for light leaving along the unit direction w (1 for a point light).
   float falloff(const glm::vec3& w) const;
   /// A sky's radiance arriving from the unit direction `from` (towards the sky), 0 below the horizon.
-  Rgb sky_radiance(const glm::vec3& from) const;
+  Rgb sky_radiance(const glm::vec3& from) const {
+    // Inline: the first shot asks it for each of hundreds of millions of sky rays.
+    const float c = glm::dot(from, direction);
+    if (!(c > 0.0f)) return Rgb(0.0f);
+    return sky == SkyModel::uniform ? zenith_radiance : zenith_radiance * ((1.0f + 2.0f * c) / 3.0f);
+  }
   /// A sky's irradiance on an unoccluded plane facing the unit normal n (closed forms: the
   /// uniform sky E (1 + cos b) / 2, the overcast sky with Arvo's lune moments, b the angle
   /// between n and the zenith). E itself for n = zenith.

@@ -174,7 +174,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
       if (sky) {
         r.direction_uv.resize(points);
         stratified(points, rng, true, r.direction_uv.data());
-        for (std::uint32_t i = points; i > 1; --i) std::swap(r.direction_uv[i - 1], r.direction_uv[rng.next() % i]);
+        shuffle(r.direction_uv.data(), points, rng);
       }
       traced = 0;
       for (std::uint32_t k = 0; k < points; ++k) {
@@ -188,7 +188,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
           w = incidence(light, x, in) ? std::max(0.0f, glm::dot(n, in.wi)) * channel_mean(in.irradiance) : 0.0f;
         } else if (sky) {
           const glm::vec3 l = cosine_hemisphere(r.direction_uv[k]);
-          dir = glm::normalize(l.x * t + l.y * b + l.z * n);
+          dir = l.x * t + l.y * b + l.z * n;  // unit: the frame is orthonormal
           w = channel_mean(light.sky_radiance(dir));
           if (!(w > 0.0f)) continue;  // below the horizon: no sky there to hide
         } else {

@@ -144,7 +144,7 @@ class TwoPassRenderer {
             detail::Rng sky_rng(options_.seed, e, detail::stream_key(detail::Stream::two_pass_sky));
             sky_u.resize(static_cast<std::size_t>(n) * n);
             detail::stratified(static_cast<std::uint32_t>(n * n), sky_rng, true, sky_u.data());
-            for (std::size_t k = sky_u.size(); k > 1; --k) std::swap(sky_u[k - 1], sky_u[sky_rng.next() % k]);
+            detail::shuffle(sky_u.data(), sky_u.size(), sky_rng);
           }
           for (int a = 0; a < n; ++a)
             for (int b = 0; b < n; ++b) {
