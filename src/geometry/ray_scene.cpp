@@ -149,6 +149,41 @@ bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tne
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
 
+void RayScene::occluded_incoherent(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear,
+                                   float tfar, std::uint8_t* blocked) const {
+  // Embree's stream mode (rtcOccluded1M, incoherent) sorts a batch of rays into packets that
+  // travel the BVH together; below a few dozen rays its set-up costs more than it saves.
+  // Measured on the 22k city: the sky's first shot (batches of 256 and 1024 rays) 1.25 s -> 0.93 s;
+  // the hierarchical links (4 to 64 rays) slower in stream mode at 16 rays, unchanged at 64.
+  constexpr std::size_t kStreamMinimum = 64;
+  if (count < kStreamMinimum) {
+    for (std::size_t i = 0; i < count; ++i) blocked[i] = occluded(origin[i], dir[i], tnear, tfar) ? 1 : 0;
+    return;
+  }
+  thread_local std::vector<RTCRay> rays;
+  rays.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    RTCRay& ray = rays[i];
+    ray.org_x = origin[i].x;
+    ray.org_y = origin[i].y;
+    ray.org_z = origin[i].z;
+    ray.dir_x = dir[i].x;
+    ray.dir_y = dir[i].y;
+    ray.dir_z = dir[i].z;
+    ray.tnear = tnear;
+    ray.tfar = tfar;
+    ray.time = 0.0f;
+    ray.mask = 0xffffffffu;
+    ray.id = static_cast<unsigned>(i);
+    ray.flags = 0;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  rtcOccluded1M(as_scene(scene_), &context, rays.data(), static_cast<unsigned>(count), sizeof(RTCRay));
+  for (std::size_t i = 0; i < count; ++i) blocked[i] = rays[i].tfar < 0.0f ? 1 : 0;
+}
+
 namespace {
 
 /// Lane k of a packet of rays (RTCRay4/8/16): the ray origin + t dir, t in (tnear, tfar).

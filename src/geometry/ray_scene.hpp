@@ -54,13 +54,12 @@ class RayScene {
   /// between two nearby surfaces this is 2-3x faster than one ray at a time.
   void occluded(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
                 std::uint8_t* blocked) const;
-  /// The same answers as occluded() for `count` segments, one ray at a time: faster than
-  /// packets for rays that go their own ways (sky directions from one element, about 1.3x
-  /// on the benchmark city) or for a handful of rays.
+  /// The same answers as occluded() for `count` segments that go their own ways (sky
+  /// directions from one element: packets were 1.3x slower on the benchmark city): Embree's
+  /// stream mode for batches of 64 rays or more (1.3x faster than one at a time there), one ray
+  /// at a time for fewer.
   void occluded_incoherent(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
-                           std::uint8_t* blocked) const {
-    for (std::size_t i = 0; i < count; ++i) blocked[i] = occluded(origin[i], dir[i], tnear, tfar) ? 1 : 0;
-  }
+                           std::uint8_t* blocked) const;
   /// The nearest hit on the ray within (tnear, tfar).
   std::optional<Hit> intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
   /// intersect() for `count` rays as packets of Embree's widest native size: found[i] = 1 and
