@@ -224,8 +224,24 @@ RADIOSITY_API const char* to_string(FormFactorMethod method);
 RADIOSITY_API std::unique_ptr<FormFactorEstimator> make_form_factor_estimator(
     const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options);
 
+/// Where view_factors() takes its factors from.
+enum class ViewFactorMethod {
+  /// Element rows of the estimator that ViewFactorOptions::form_factors names: time and memory
+  /// grow as elements x patches.
+  estimator,
+  /// Hierarchical radiosity's links (SolverMethod::hierarchical, docs/HIERARCHICAL.md), refined
+  /// for unit radiosity on every surface against ViewFactorOptions::epsilon: cost close to
+  /// linear in the scene; the group factors are made reciprocal (A_i F_ij = A_j F_ji exactly)
+  /// by averaging each pair's two transports.
+  hierarchical,
+};
+
 /// Options of view_factors(). Every field has a default. Thread safety: a plain value.
 struct ViewFactorOptions {
+  ViewFactorMethod method = ViewFactorMethod::estimator;
+  /// ViewFactorMethod::hierarchical: a link is refined while its transport may vary over its
+  /// two ends by more than this (in units of view factor, for unit radiosity), in (0, 1].
+  float epsilon = 0.02f;
   /// How finely to mesh; 0 = derive from the scene as solve() does. Finer elements make the
   /// hemicube more accurate (it treats each element as a few points) and cost time for all
   /// methods; ray_cast and analytic integrate each element adaptively and need no fine mesh.
@@ -254,6 +270,7 @@ struct GroupViewFactors {
   std::vector<double> factors;
   std::size_t patch_count = 0;    ///< patches of the whole scene (the receivers)
   std::size_t element_count = 0;  ///< source elements of the listed groups
+  std::size_t link_count = 0;     ///< ViewFactorMethod::hierarchical: the links (0 otherwise)
   double seconds = 0.0;           ///< wall time of meshing and form factors
   /// The progress callback asked to stop: only some source elements were summed, so the rows
   /// are incomplete.

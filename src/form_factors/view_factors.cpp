@@ -13,6 +13,7 @@
 #include "form_factors/estimators.hpp"
 #include "radiosity/form_factors.hpp"
 #include "core/progress.hpp"
+#include "solver/hierarchical/link_view_factors.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -33,6 +34,9 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   // Thermal users read small factors: the automatic choice is the accurate one here.
   if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factors: the scene has no polygons");
+  const bool links = options.method == ViewFactorMethod::hierarchical;
+  if (links && !(options.epsilon > 0.0f && options.epsilon <= 1.0f))
+    throw Error(ErrorCode::invalid_argument, "view_factors: epsilon must be in (0, 1], got " + std::to_string(options.epsilon));
 
   // Rows and columns: the requested groups, or all of them.
   GroupViewFactors result;
@@ -54,8 +58,7 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   const std::size_t G = result.groups.size();
 
   const auto t0 = std::chrono::steady_clock::now();
-  const PatchHierarchy hierarchy(scene, options.mesh);
-  const auto estimator = make_form_factor_estimator(scene, hierarchy, ff);
+  PatchHierarchy hierarchy(scene, options.mesh);
   const std::vector<Patch>& patches = hierarchy.patches();
   const std::size_t n = patches.size();
   std::vector<std::size_t> column(n);
@@ -75,9 +78,6 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   // A_e F(e -> j) summed per (source group, receiver group) in element order, so the sums do not
   // depend on the thread count; chunks bound the memory to chunk x n floats.
   std::vector<double> sum(G * G, 0.0);
-  const std::size_t chunk = chunk_rows(sources.size(), n);
-  std::vector<float> rows;
-  std::vector<std::uint32_t> batch;
   // Progress: at the start, at the end, and in between at most every 100 ms; a false return
   // stops after the current chunk.
   detail::ProgressGate gate(options.on_progress);
@@ -88,7 +88,21 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
     return gate.report(p, force);
   };
   result.cancelled = !report(0.0, true);
-  for (std::size_t begin = 0; begin < sources.size() && !result.cancelled; begin += chunk) {
+  if (links && !result.cancelled) {
+    detail::LinkGroupTransport t =
+        detail::link_group_transport(scene, hierarchy, slot, G, options.epsilon, ff.seed, ff.threads, gate);
+    result.cancelled = t.cancelled;
+    // Reciprocal by construction: each pair's transport A_i F_ij is the mean of the links' two
+    // directions' estimates (each direction was refined and sampled on its own).
+    for (std::size_t i = 0; i < G; ++i)
+      for (std::size_t k = 0; k < G; ++k) sum[i * G + k] = 0.5 * (t.transport[i * G + k] + t.transport[k * G + i]);
+    result.link_count = t.link_count;
+  }
+  const std::unique_ptr<FormFactorEstimator> estimator = links ? nullptr : make_form_factor_estimator(scene, hierarchy, ff);
+  const std::size_t chunk = chunk_rows(sources.size(), n);
+  std::vector<float> rows;
+  std::vector<std::uint32_t> batch;
+  for (std::size_t begin = 0; begin < sources.size() && !result.cancelled && !links; begin += chunk) {
     const std::size_t end = std::min(sources.size(), begin + chunk);
     batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(begin),
                  sources.begin() + static_cast<std::ptrdiff_t>(end));

@@ -73,6 +73,39 @@ TEST_SUITE("form_factors") {
     }
   }
 
+  TEST_CASE("view_factors from hierarchical links: the occluded room against ray_cast - bit-identical at 1 and 2 "
+            "threads - a bad epsilon is an error") {
+    const rad::Scene s = room_with_block();
+    rad::ViewFactorOptions o;
+    o.mesh.max_patch_area = 0.25f;
+    o.mesh.max_element_area = 1.0f / 64.0f;
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    const rad::GroupViewFactors reference = rad::view_factors(s, o);
+    o.method = rad::ViewFactorMethod::hierarchical;
+    o.form_factors.threads = 1;
+    const rad::GroupViewFactors one = rad::view_factors(s, o);
+    o.form_factors.threads = 2;
+    const rad::GroupViewFactors two = rad::view_factors(s, o);
+    CHECK(one.factors == two.factors);  // exact equality
+    CHECK(one.link_count > 0);
+    CHECK(reference.link_count == 0);
+    REQUIRE(one.groups == reference.groups);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < one.groups.size(); ++i)
+      for (std::size_t k = 0; k < one.groups.size(); ++k) {
+        const double a = one.at(i, k), b = reference.at(i, k);
+        INFO("F(", one.groups[i], " -> ", one.groups[k], ") = ", a, " links, ", b, " ray_cast");
+        CHECK(std::fabs(a - b) < 0.01);  // absolute, in units of view factor
+        worst = std::max(worst, std::fabs(a - b));
+      }
+    // Measured: worst |difference| 0.0044 (epsilon 0.02, the default).
+    MESSAGE("links against ray_cast in the room with a block: worst |difference| " << worst);
+    o.epsilon = 0.0f;
+    CHECK_THROWS_AS(rad::view_factors(s, o), rad::Error);
+    o.epsilon = 1.5f;
+    CHECK_THROWS_AS(rad::view_factors(s, o), rad::Error);
+  }
+
   TEST_CASE("patch_column agrees with element_rows for every estimator - in an occluded scene") {
     const rad::Scene s = room_with_block();
     const rad::PatchHierarchy h(s, coarse());

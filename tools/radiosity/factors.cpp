@@ -28,6 +28,7 @@ struct FactorsArgs {
   float max_patch_area = 0.0f, max_element_area = 0.0f;
   bool strict = false;
   bool photometric = false;
+  float epsilon = rad::ViewFactorOptions{}.epsilon;
 };
 
 std::vector<std::string> split_list(const std::string& s) {
@@ -44,7 +45,12 @@ int run_factors(const FactorsArgs& a) {
     rad::Scene scene = load(a.scene, a.strict, a.photometric);
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
-    o.form_factors.method = form_factor_method(a.method);
+    if (a.method == "hierarchical") {
+      o.method = rad::ViewFactorMethod::hierarchical;
+      o.epsilon = a.epsilon;
+    } else {
+      o.form_factors.method = form_factor_method(a.method);
+    }
     o.form_factors.hemisphere_rays = a.hemisphere_rays;
     o.form_factors.source_samples = a.samples;
     o.form_factors.visibility_rays = a.rays;
@@ -69,9 +75,10 @@ int run_factors(const FactorsArgs& a) {
       if (!out) throw rad::Error(rad::ErrorCode::io_error, "cannot write '" + a.output + "'");
     }
     // The summary goes to stderr, so that stdout stays a clean CSV/JSON stream.
-    std::fprintf(stderr, "factors: %zu groups, %zu patches, %zu source elements, %s, %.3f s%s%s\n", v.groups.size(),
-                 v.patch_count, v.element_count, a.method.c_str(), v.seconds, a.output.empty() ? "" : ", wrote ",
-                 a.output.c_str());
+    const std::string links = v.link_count > 0 ? " (" + std::to_string(v.link_count) + " links)" : "";
+    std::fprintf(stderr, "factors: %zu groups, %zu patches, %zu source elements, %s%s, %.3f s%s%s\n", v.groups.size(),
+                 v.patch_count, v.element_count, a.method.c_str(), links.c_str(), v.seconds,
+                 a.output.empty() ? "" : ", wrote ", a.output.c_str());
     return 0;
   });
 }
@@ -84,8 +91,17 @@ Command add_factors_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "factors", "Group-to-group view factors F(gi -> gk), area-weighted over each source group, as CSV or JSON");
   cmd->add_option("scene", a.scene, kSceneHelp);
-  cmd->add_option("--method", a.method, "Form-factor estimator")
-      ->check(CLI::IsMember(form_factor_names()))
+  std::vector<std::string> methods = form_factor_names();
+  methods.push_back("hierarchical");
+  cmd->add_option("--method", a.method,
+                  "Form-factor estimator, or hierarchical: hierarchical radiosity's links (reciprocal factors, "
+                  "cost close to linear in the scene)")
+      ->check(CLI::IsMember(methods))
+      ->capture_default_str();
+  cmd->add_option("--epsilon", a.epsilon,
+                  "Hierarchical: refine a link while its view factor may vary over its ends by more than this, "
+                  "(0, 1]")
+      ->check(in_range<float>(1e-6f, 1.0f))
       ->capture_default_str();
   cmd->add_option("--format", a.format, "Output format")->check(CLI::IsMember({"csv", "json"}))->capture_default_str();
   cmd->add_flag("--sparse", a.sparse, "Only the non-zero factors (CSV: from,to,factor rows)");

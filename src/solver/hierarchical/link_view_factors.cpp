@@ -1,0 +1,58 @@
+// View factors from hierarchical radiosity's links (ViewFactorMethod::hierarchical): the links
+// refined for unit radiosity on every surface, then one gather per group.
+// Based on: P. Hanrahan, D. Salzman & L. Aupperle, "A rapid hierarchical radiosity algorithm",
+// SIGGRAPH 1991 (the links as a hierarchical representation of the form-factor matrix: any
+// block of it is one gather away); J. Howell, M. Menguc & R. Siegel, "Thermal Radiation Heat
+// Transfer", 6th ed., 2016, ch. 4 (view-factor algebra: F(i -> j u k) = F(i -> j) + F(i -> k)).
+#include "solver/hierarchical/link_view_factors.hpp"
+
+#include "core/assert.hpp"
+#include "solver/hierarchical/link_hierarchy.hpp"
+#include "solver/system.hpp"
+
+namespace radiosity::detail {
+
+LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hierarchy,
+                                        const std::vector<std::size_t>& slot, std::size_t groups, float epsilon,
+                                        std::uint64_t seed, unsigned threads, ProgressGate& gate) {
+  LinkGroupTransport out;
+  out.transport.assign(groups * groups, 0.0);
+  const RadiositySystem system(scene, hierarchy, false);
+  LinkHierarchy links(scene, hierarchy, seed, threads);
+  // Unit radiosity everywhere: the oracle judges the geometry alone, and its threshold (the
+  // irradiance a link may get wrong) is then a view factor.
+  const std::vector<Rgb> one(system.unknowns(), Rgb(1.0f));
+  std::vector<std::uint32_t> split;
+  RefineStats stats;
+  if (!links.refine(hierarchy, system, one, epsilon, SubdivisionLimits{}, gate, split, stats)) {
+    out.cancelled = true;
+    return out;
+  }
+  RADIOSITY_ASSERT(split.empty());  // no subdivision limits: the meshed elements stay
+  out.link_count = links.link_count();
+  out.link_rays = stats.rays;
+
+  // Column k: the irradiance every front receives from unit radiosity on the fronts of group k
+  // alone is its view factor to that group; summed over each group's fronts, times their area.
+  std::vector<std::size_t> unknown_slot(system.fronts());
+  for (std::size_t u = 0; u < system.fronts(); ++u)
+    unknown_slot[u] = slot[hierarchy.patches()[hierarchy.element(system.element(u)).patch].group];
+  std::vector<Rgb> B(system.unknowns());
+  for (std::size_t k = 0; k < groups; ++k) {
+    for (std::size_t u = 0; u < B.size(); ++u) B[u] = Rgb(u < system.fronts() && unknown_slot[u] == k ? 1.0f : 0.0f);
+    const std::vector<Rgb> H = links.irradiance(hierarchy, system, B);
+    for (std::size_t u = 0; u < system.fronts(); ++u)
+      if (unknown_slot[u] != kNone)
+        out.transport[unknown_slot[u] * groups + k] += static_cast<double>(system.area[u]) * static_cast<double>(H[u].x);
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = static_cast<double>(k + 1) / static_cast<double>(groups);
+    if (!gate.report(p, k + 1 == groups)) {
+      out.cancelled = true;
+      return out;
+    }
+  }
+  return out;
+}
+
+}  // namespace radiosity::detail

@@ -1,0 +1,33 @@
+// View factors from hierarchical radiosity's links (ViewFactorMethod::hierarchical).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+
+namespace radiosity::detail {
+
+/// What link_group_transport() found.
+struct LinkGroupTransport {
+  /// groups x groups, row-major: sum over the fronts e of row group i of A_e F(e -> group k),
+  /// scene units squared (not yet made reciprocal).
+  std::vector<double> transport;
+  std::size_t link_count = 0;
+  std::uint64_t link_rays = 0;
+  bool cancelled = false;  ///< `gate` said stop: transport is incomplete
+};
+
+/// Refines the links of `hierarchy`'s scene for unit radiosity on every surface against
+/// `epsilon` (a view factor), then gathers once per group: the transport between the groups
+/// that `slot` gives each scene GroupId (row and column, or kNone for a group not reported),
+/// `groups` of them. Progress goes through `gate` (Phase::form_factors). Deterministic for a
+/// seed at any thread count, as the links are.
+LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hierarchy,
+                                        const std::vector<std::size_t>& slot, std::size_t groups, float epsilon,
+                                        std::uint64_t seed, unsigned threads, ProgressGate& gate);
+
+}  // namespace radiosity::detail
