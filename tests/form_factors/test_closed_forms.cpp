@@ -163,6 +163,23 @@ std::vector<Poly> box(double sx, double sy, double sz) {
 
 }  // namespace
 
+namespace {
+
+/// Face pairs of the closed 1 x 2 x 3 box (box(1, 2, 3)) with closed forms: x0 -> x1 is C-11
+/// (2 x 3 at distance 1); x0 -> y0 is C-14 (shared edge 3, source width 2, receiver height 1);
+/// z0 -> y1 is C-14 (edge 1, width 2, height 3).
+struct ClosedFormPair {
+  std::size_t from, to;
+  double exact;
+};
+std::vector<ClosedFormPair> box123_closed_forms() {
+  return {{0, 1, test::parallel_rectangles(2, 3, 1)},
+          {0, 2, test::perpendicular_rectangles(3, 2, 1)},
+          {4, 3, test::perpendicular_rectangles(1, 2, 3)}};
+}
+
+}  // namespace
+
 TEST_SUITE("form_factors") {
   TEST_CASE(
       "parallel rectangles (Howell C-11) at several sizes and distances - rotated: ray_cast and analytic within 0.5% - "
@@ -326,14 +343,7 @@ TEST_SUITE("form_factors") {
   TEST_CASE(
       "closed 1 x 2 x 3 box - rotated: faces match C-11 and C-14 - reciprocity A_i F_ij = A_j F_ji and row sums of 1") {
     const std::vector<Poly> faces = box(1, 2, 3);
-    // Pairs with closed forms: x0 -> x1 is C-11 (2 x 3 at distance 1); x0 -> y0 is C-14 (shared
-    // edge 3, source width 2, receiver height 1); z0 -> y1 is C-14 (edge 1, width 2, height 3).
-    const struct {
-      std::size_t from, to;
-      double exact;
-    } pairs[] = {{0, 1, test::parallel_rectangles(2, 3, 1)},
-                 {0, 2, test::perpendicular_rectangles(3, 2, 1)},
-                 {4, 3, test::perpendicular_rectangles(1, 2, 3)}};
+    const std::vector<ClosedFormPair> pairs = box123_closed_forms();
     Random rng(41);
     const glm::dmat3 r = random_rotation(rng);
     const rad::Scene s = scene_of(moved(faces, {r, glm::dvec3(1, -2, 0.5)}));
@@ -368,12 +378,7 @@ TEST_SUITE("form_factors") {
     // unit each, are the finest ends: below about 0.01 what remains is their quadrature and their
     // links' visibility rays, not the refinement).
     const std::vector<Poly> faces = box(1, 2, 3);
-    const struct {
-      std::size_t from, to;
-      double exact;
-    } pairs[] = {{0, 1, test::parallel_rectangles(2, 3, 1)},
-                 {0, 2, test::perpendicular_rectangles(3, 2, 1)},
-                 {4, 3, test::perpendicular_rectangles(1, 2, 3)}};
+    const std::vector<ClosedFormPair> pairs = box123_closed_forms();
     const rad::Scene s = scene_of(faces);
     for (const float eps : {0.05f, 0.01f, 0.002f}) {
       CAPTURE(eps);
