@@ -374,13 +374,13 @@ TEST_SUITE("form_factors") {
   TEST_CASE("hierarchical links: the 1 x 2 x 3 box's C-11 and C-14 factors - exactly reciprocal - rows of 1") {
     // ViewFactorMethod::hierarchical: the links refined for unit radiosity, one gather per face.
     // Measured, worst relative error over the three closed forms / worst row sum: 0.22 % / 0.31 %
-    // at epsilon 0.05, 0.16 % / 0.18 % at 0.01, 0.17 % / 0.20 % at 0.002 (the elements, 1/32 of a
-    // unit each, are the finest ends: below about 0.01 what remains is their quadrature and their
-    // links' visibility rays, not the refinement).
+    // at epsilon 0.05, 0.16 % / 0.18 % at 0.01 (and 0.17 % / 0.20 % at 0.002: the elements, 1/32
+    // of a unit each, are the finest ends; below about 0.01 what remains is their quadrature and
+    // their links' visibility rays, not the refinement).
     const std::vector<Poly> faces = box(1, 2, 3);
     const std::vector<ClosedFormPair> pairs = box123_closed_forms();
     const rad::Scene s = scene_of(faces);
-    for (const float eps : {0.05f, 0.01f, 0.002f}) {
+    for (const float eps : {0.05f, 0.01f}) {
       CAPTURE(eps);
       rad::ViewFactorOptions o;
       o.method = rad::ViewFactorMethod::hierarchical;
