@@ -21,6 +21,24 @@ namespace {
 RTCDevice as_device(void* p) { return static_cast<RTCDevice>(p); }
 RTCScene as_scene(void* p) { return static_cast<RTCScene>(p); }
 
+/// One ray origin + t dir, t in (tnear, tfar), for the single-ray and stream calls.
+RTCRay single_ray(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar, unsigned id) {
+  RTCRay ray;
+  ray.org_x = origin.x;
+  ray.org_y = origin.y;
+  ray.org_z = origin.z;
+  ray.dir_x = dir.x;
+  ray.dir_y = dir.y;
+  ray.dir_z = dir.z;
+  ray.tnear = tnear;
+  ray.tfar = tfar;
+  ray.time = 0.0f;
+  ray.mask = 0xffffffffu;
+  ray.id = id;
+  ray.flags = 0;
+  return ray;
+}
+
 }  // namespace
 
 RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& triangles,
@@ -132,19 +150,7 @@ RayScene RayScene::from_leaves(const PatchHierarchy& hierarchy) {
 bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay ray;
-  ray.org_x = origin.x;
-  ray.org_y = origin.y;
-  ray.org_z = origin.z;
-  ray.dir_x = dir.x;
-  ray.dir_y = dir.y;
-  ray.dir_z = dir.z;
-  ray.tnear = tnear;
-  ray.tfar = tfar;
-  ray.time = 0.0f;
-  ray.mask = 0xffffffffu;
-  ray.id = 0;
-  ray.flags = 0;
+  RTCRay ray = single_ray(origin, dir, tnear, tfar, 0);
   rtcOccluded1(as_scene(scene_), &context, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
 }
@@ -162,21 +168,7 @@ void RayScene::occluded_incoherent(std::size_t count, const glm::vec3* origin, c
   }
   thread_local std::vector<RTCRay> rays;
   rays.resize(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    RTCRay& ray = rays[i];
-    ray.org_x = origin[i].x;
-    ray.org_y = origin[i].y;
-    ray.org_z = origin[i].z;
-    ray.dir_x = dir[i].x;
-    ray.dir_y = dir[i].y;
-    ray.dir_z = dir[i].z;
-    ray.tnear = tnear;
-    ray.tfar = tfar;
-    ray.time = 0.0f;
-    ray.mask = 0xffffffffu;
-    ray.id = static_cast<unsigned>(i);
-    ray.flags = 0;
-  }
+  for (std::size_t i = 0; i < count; ++i) rays[i] = single_ray(origin[i], dir[i], tnear, tfar, static_cast<unsigned>(i));
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
@@ -301,18 +293,7 @@ std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const 
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  rh.ray.org_x = origin.x;
-  rh.ray.org_y = origin.y;
-  rh.ray.org_z = origin.z;
-  rh.ray.dir_x = dir.x;
-  rh.ray.dir_y = dir.y;
-  rh.ray.dir_z = dir.z;
-  rh.ray.tnear = tnear;
-  rh.ray.tfar = tfar;
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
+  rh.ray = single_ray(origin, dir, tnear, tfar, 0);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;

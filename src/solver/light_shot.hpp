@@ -59,7 +59,7 @@ class LightShooter {
   /// `seed` keys the random streams (Stream::light_front/light_back); `threads` and `sky_rays`
   /// as SolveOptions'. Builds a BVH over the scene's polygons (Embree).
   LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
-               std::uint32_t sky_rays = 1280);
+               std::uint32_t sky_rays);
 
   bool empty() const { return lights_.empty(); }
 

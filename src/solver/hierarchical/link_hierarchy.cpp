@@ -484,8 +484,8 @@ struct LinkHierarchy::Impl {
       const float floor = kWeightFloor * (receiver_radius_ + m.radius(h, s));
       weight_floor2_ = floor * floor;
     }
-    /// Casts up to `wanted` rays (as many facing pairs as `wanted` x kTriesPerRay tries find);
-    /// returns {clear, cast}.
+    /// Casts up to `wanted` rays (as many facing pairs as `wanted` x kTriesPerRay tries find):
+    /// how many were cast and clear, and their kernel weights.
     struct Result {
       int clear = 0, cast = 0;
       double weight_clear = 0.0, weight = 0.0;  ///< the rays' kernel weights: all, and the clear ones'
@@ -616,8 +616,9 @@ struct LinkHierarchy::Impl {
   /// and its nodes are large for their distance (a cluster's transport is taken from its
   /// centre, accurate only when the nodes are small for their distance, as in Barnes & Hut's
   /// multipole acceptance), unless it carries little; or when it is partly hidden (a shadow
-  /// boundary somewhere in its nodes) and may bring more than the threshold. A fully visible or
-  /// fully hidden link is never refined for visibility.
+  /// boundary somewhere in its nodes) and may bring more than the threshold (kHiddenClusterFloor
+  /// x the threshold into a cluster). A fully visible or fully hidden link is never refined for
+  /// visibility.
   bool needs_refinement(const RoundContext& rc, NodeHandle r, NodeHandle s, bool partly_hidden) const {
     return needs_refinement(rc, r, s, link_error(rc, r, s), partly_hidden);
   }
