@@ -126,6 +126,10 @@ struct Polygon {
   GroupId group = 0;
   MeshId mesh = kNone;                ///< the mesh it came from (Scene::add_mesh()), or kNone
   std::uint32_t mesh_triangle = kNone;  ///< its triangle's index in that mesh, or kNone
+  /// Blocks light but is no surface of the view-factor matrix (View3D's obstruction-only
+  /// surfaces): view_factor_matrix() and view_factors() give it no row or column, while it
+  /// still hides what lies behind it. solve() treats it as any polygon of its material.
+  bool obstruction_only = false;
 };
 
 /// How forgiving the scene readers are (load_scene(), parse_scene_json()) and
@@ -344,6 +348,9 @@ class RADIOSITY_API Scene {
   const std::vector<Material>& materials() const { return materials_; }
   const Material& material(MaterialId id) const { return materials_.at(id); }
   const std::vector<Polygon>& polygons() const { return polygons_; }
+  /// Marks polygon `id` obstruction-only (Polygon::obstruction_only) or not. Throws
+  /// Error{invalid_argument} for an unknown id. Thread safety: mutates the scene.
+  void set_obstruction_only(PolygonId id, bool obstruction_only = true);
   /// Group names, indexed by GroupId, in order of first use.
   const std::vector<std::string>& groups() const { return groups_; }
   std::optional<GroupId> find_group(std::string_view name) const;

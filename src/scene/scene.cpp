@@ -70,6 +70,13 @@ MaterialId Scene::add_material(const Material& material) {
   return static_cast<MaterialId>(materials_.size() - 1);
 }
 
+void Scene::set_obstruction_only(PolygonId id, bool obstruction_only) {
+  if (id >= polygons_.size())
+    throw Error(ErrorCode::invalid_argument, "set_obstruction_only: no polygon " + std::to_string(id) + " (the scene has " +
+                                                 std::to_string(polygons_.size()) + ")");
+  polygons_[id].obstruction_only = obstruction_only;
+}
+
 void Scene::make_two_sided() {
   for (Material& m : materials_) m.two_sided = true;
 }
