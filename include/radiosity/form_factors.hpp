@@ -236,9 +236,36 @@ enum class ViewFactorMethod {
   hierarchical,
 };
 
-/// Options of view_factors(). Every field has a default. Thread safety: a plain value.
+/// The surfaces that view_factor_matrix() gives a row and a column each.
+enum class ViewFactorLevel {
+  group,    ///< the scene's groups (view_factors()'s matrix, as CSR)
+  polygon,  ///< every polygon, in Scene::polygons() order (a facet mesh's facets; View3D's surfaces)
+  element,  ///< every leaf element of the mesh ViewFactorOptions::mesh makes, in PatchHierarchy::leaves() order
+};
+
+/// How view_factor_matrix() corrects the estimated factors (docs/VIEW_FACTORS.md, "Correction").
+enum class ViewFactorCorrection {
+  /// The estimates as they are: reciprocity and row sums hold within the estimator's accuracy.
+  none,
+  /// A_i F_ij = A_j F_ji exactly: each pair's transport becomes the mean of its two directions'
+  /// estimates (the pattern is the union of both). For open scenes; the sky view factor is the
+  /// remainder 1 - sum_j F_ij.
+  reciprocity,
+  /// Reciprocity and rows that sum to 1, for closed enclosures: the smallest weighted
+  /// least-squares change of the reciprocal transports that closes every row (van Leersum
+  /// 1989), which keeps the sparsity (only non-zero factors change, each in proportion to
+  /// itself).
+  enclosure,
+};
+
+/// Options of view_factors() and view_factor_matrix(). Every field has a default. Thread
+/// safety: a plain value.
 struct ViewFactorOptions {
   ViewFactorMethod method = ViewFactorMethod::estimator;
+  /// view_factor_matrix(): rows and columns per group, polygon or element.
+  ViewFactorLevel level = ViewFactorLevel::polygon;
+  /// view_factor_matrix(): the correction applied to the estimates.
+  ViewFactorCorrection correction = ViewFactorCorrection::none;
   /// ViewFactorMethod::hierarchical: a link is refined while its transport may vary over its
   /// two ends by more than this (in units of view factor, for unit radiosity), in (0, 1].
   float epsilon = 0.02f;
@@ -289,6 +316,76 @@ struct GroupViewFactors {
 /// that the scene does not have.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& options = {});
+
+/// What ViewFactorOptions::correction changed, and how far the estimates were from the two
+/// laws before it (after it they hold to rounding). Thread safety: a plain value.
+struct ViewFactorCorrectionReport {
+  /// Before: the largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) over pairs with a
+  /// non-zero factor in either direction (1 where only one direction has one).
+  double reciprocity_before = 0.0;
+  /// Before: the largest and the area-weighted RMS of |1 - sum_j F_ij| over the rows.
+  double row_sum_error_before = 0.0, row_sum_rms_before = 0.0;
+  /// The largest |F'_ij - F_ij| the correction made, and its RMS over the stored factors.
+  double largest_change = 0.0, rms_change = 0.0;
+  /// Enclosure: rows that see nothing (their sum stays 0: a polygon facing away from every
+  /// other), and factors the correction would have made negative (set to 0, and solved
+  /// again without them).
+  std::size_t empty_rows = 0, clamped = 0;
+  int iterations = 0;  ///< enclosure: conjugate-gradient iterations
+};
+
+/// A view-factor matrix in compressed sparse rows: row i holds F(i -> columns[k]) = values[k]
+/// for k in [row_offsets[i], row_offsets[i + 1]), columns increasing; rows and columns number
+/// the same surfaces (ViewFactorLevel), so the matrix is square. Memory: 8 bytes per stored
+/// factor plus 8 per row. Thread safety: a plain value.
+struct ViewFactorMatrix {
+  ViewFactorLevel level = ViewFactorLevel::polygon;
+  /// What each row (and column) is: a PolygonId (polygon level), an element id of the mesh
+  /// (element level) or a GroupId (group level).
+  std::vector<std::uint32_t> ids;
+  std::vector<std::string> names;      ///< group level: the group names; else empty
+  std::vector<double> area;            ///< per row, scene units squared
+  std::vector<std::uint64_t> row_offsets;  ///< rows + 1 entries, row_offsets[0] = 0
+  std::vector<std::uint32_t> columns;
+  std::vector<float> values;           ///< the factors, > 0
+  /// Per row: 1 - sum_j F_ij after the correction, the part of the hemisphere that sees no
+  /// surface of the matrix (the sky of an open scene, light that escapes; 0 in a closed
+  /// enclosure after ViewFactorCorrection::enclosure). Negative where noise made a row sum
+  /// exceed 1.
+  std::vector<double> sky;
+  /// Per row: the estimated standard error of the row's sum from the estimator alone (Monte
+  /// Carlo: binomial, sqrt(S (1 - S) / rays) over the row's rays); empty for estimators that
+  /// state none (ray_cast, analytic, hemicube, hierarchical).
+  std::vector<double> row_standard_error;
+  ViewFactorCorrectionReport correction;
+  std::string method;              ///< the estimator's name as the command line spells it
+  std::size_t element_count = 0;   ///< source elements the rows were summed from
+  double seconds = 0.0;            ///< wall time of meshing, form factors and correction
+  bool cancelled = false;          ///< the progress callback stopped it: rows are incomplete
+
+  std::size_t rows() const { return area.size(); }
+  std::size_t non_zeros() const { return values.size(); }
+  /// F(row -> column), 0 where not stored (a binary search of the row).
+  double at(std::size_t row, std::uint32_t column) const;
+};
+
+/// The sparse view-factor matrix between the scene's polygons, elements or groups
+/// (options.level), with the correction options.correction asks for. Rows and columns skip
+/// obstruction-only polygons (they still hide) and, when options.groups is set, keep the
+/// polygons of those groups only. The estimator options.form_factors.method names computes
+/// every row (automatic means ray_cast: exact unoccluded factors, occlusion by rays, cost
+/// rows x polygons; monte_carlo: hemisphere rays per element, cost and memory rows x rays,
+/// the method for large scenes); ViewFactorMethod::hierarchical is group level only. Memory
+/// is bounded by the result plus a few thousand element rows; the same scene, options and
+/// seed give bit-identical results at any thread count. Throws as view_factors() does, and
+/// Error{invalid_argument} for ViewFactorMethod::hierarchical below group level.
+/// Thread safety: concurrent calls are safe.
+RADIOSITY_API ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions& options = {});
+
+/// The name of a level or correction as the command line spells it ("group", "polygon",
+/// "element"; "none", "reciprocity", "enclosure").
+RADIOSITY_API const char* to_string(ViewFactorLevel level);
+RADIOSITY_API const char* to_string(ViewFactorCorrection correction);
 
 /// Unoccluded form factor from a differential area at `point` with unit normal `normal` to a
 /// planar convex polygon of `vertex_count` corners (counter-clockwise seen from its front;
