@@ -62,13 +62,15 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   const std::vector<Patch>& patches = hierarchy.patches();
   const std::size_t n = patches.size();
   std::vector<std::size_t> column(n);
-  for (std::size_t j = 0; j < n; ++j) column[j] = slot[patches[j].group];
+  // Obstruction-only polygons hide but neither send nor receive here.
+  auto obstruction = [&](std::size_t patch) { return scene.polygons()[patches[patch].polygon].obstruction_only; };
+  for (std::size_t j = 0; j < n; ++j) column[j] = obstruction(j) ? kNone : slot[patches[j].group];
 
   std::vector<std::uint32_t> sources;
   result.area.assign(G, 0.0);
   for (const std::uint32_t e : hierarchy.leaves()) {
     const std::size_t g = slot[patches[hierarchy.element(e).patch].group];
-    if (g == kNone) continue;
+    if (g == kNone || obstruction(hierarchy.element(e).patch)) continue;
     sources.push_back(e);
     result.area[g] += hierarchy.element(e).area;
   }

@@ -35,8 +35,11 @@ LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hier
   // Column k: the irradiance every front receives from unit radiosity on the fronts of group k
   // alone is its view factor to that group; summed over each group's fronts, times their area.
   std::vector<std::size_t> unknown_slot(system.fronts());
-  for (std::size_t u = 0; u < system.fronts(); ++u)
-    unknown_slot[u] = slot[hierarchy.patches()[hierarchy.element(system.element(u)).patch].group];
+  for (std::size_t u = 0; u < system.fronts(); ++u) {
+    // Obstruction-only polygons hide but neither send nor receive here.
+    const Patch& patch = hierarchy.patches()[hierarchy.element(system.element(u)).patch];
+    unknown_slot[u] = scene.polygons()[patch.polygon].obstruction_only ? kNone : slot[patch.group];
+  }
   std::vector<Rgb> B(system.unknowns());
   for (std::size_t k = 0; k < groups; ++k) {
     for (std::size_t u = 0; u < B.size(); ++u) B[u] = Rgb(u < system.fronts() && unknown_slot[u] == k ? 1.0f : 0.0f);

@@ -1,0 +1,289 @@
+// The sparse view-factor matrix between polygons, elements or groups (form_factors.hpp,
+// docs/VIEW_FACTORS.md), for thermal and urban-climate users.
+// Based on:
+//   M. Cohen, D. Greenberg, D. Immel & P. Brock, "An efficient radiosity approach for realistic
+//     image synthesis", IEEE CG&A 6(3), 1986 (substructuring: a surface's factor is the
+//     area-weighted sum over its elements: F(p -> j) = sum_e A_e F(e -> j) / A_p).
+//   J. R. Howell, M. P. Menguc & R. Siegel, "Thermal Radiation Heat Transfer", 6th ed., 2016,
+//     ch. 4 (view-factor algebra; the reciprocity and closure that view_factor_correction.cpp
+//     enforces).
+//
+// Rows are made a chunk of whole polygons at a time from the estimator's sparse element rows,
+// so memory is the result plus one chunk; the element level is the polygon level of a scene
+// whose polygons are the mesh's leaf elements.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/progress.hpp"
+#include "form_factors/estimators.hpp"
+#include "form_factors/view_factor_correction.hpp"
+#include "radiosity/form_factors.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+/// Source elements per chunk of rows (whole polygons are kept together, so a chunk may hold
+/// more): enough for the estimators' parallel loops, few enough for ~100 progress reports on
+/// large scenes.
+constexpr std::size_t kChunkElements = 4096;
+
+/// Which polygons get a row: not obstruction-only, and in `groups` when it is not empty.
+/// Throws for an unknown or repeated group name.
+std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vector<std::string>& groups,
+                                             const char* caller) {
+  std::vector<char> keep_group(scene.groups().size(), groups.empty() ? 1 : 0);
+  for (const std::string& name : groups) {
+    const std::optional<GroupId> id = scene.find_group(name);
+    if (!id) throw Error(ErrorCode::invalid_argument, std::string(caller) + ": groups: the scene has no group '" + name + "'");
+    if (keep_group[*id]) throw Error(ErrorCode::invalid_argument, std::string(caller) + ": groups: '" + name + "' is listed twice");
+    keep_group[*id] = 1;
+  }
+  std::vector<std::uint32_t> row_of(scene.polygons().size(), kNone);
+  std::uint32_t rows = 0;
+  for (std::size_t p = 0; p < scene.polygons().size(); ++p) {
+    const Polygon& polygon = scene.polygons()[p];
+    if (!polygon.obstruction_only && keep_group[polygon.group]) row_of[p] = rows++;
+  }
+  return row_of;
+}
+
+/// The rows of every selected polygon (row_of[p] != kNone) from the estimator `ff` names, on
+/// `scene` meshed with `mesh`. Fills ids, area, the CSR, row_standard_error (Monte Carlo),
+/// element_count and cancelled of `out`.
+void polygon_rows(const Scene& scene, const std::vector<std::uint32_t>& row_of, const FormFactorOptions& ff,
+                  const MeshOptions& mesh, detail::ProgressGate& gate, ViewFactorMatrix& out) {
+  const std::size_t polygons = scene.polygons().size();
+  std::size_t rows = 0;
+  out.ids.clear();
+  for (std::size_t p = 0; p < polygons; ++p)
+    if (row_of[p] != kNone) {
+      out.ids.push_back(static_cast<std::uint32_t>(p));
+      ++rows;
+    }
+  out.area.assign(rows, 0.0);
+  out.row_offsets.assign(rows + 1, 0);
+  out.columns.clear();
+  out.values.clear();
+
+  const PatchHierarchy hierarchy(scene, mesh);
+  const std::vector<Patch>& patches = hierarchy.patches();
+  std::vector<std::uint32_t> column_of_patch(patches.size());
+  for (std::size_t j = 0; j < patches.size(); ++j) column_of_patch[j] = row_of[patches[j].polygon];
+
+  // Source elements grouped by row (in element order within a row).
+  std::vector<std::uint32_t> sources;
+  std::vector<std::uint64_t> first(rows + 1, 0);
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
+    if (r == kNone) continue;
+    ++first[r + 1];
+    out.area[r] += hierarchy.element(e).area;
+  }
+  for (std::size_t r = 0; r < rows; ++r) first[r + 1] += first[r];
+  sources.resize(first[rows]);
+  {
+    std::vector<std::uint64_t> at(first.begin(), first.end() - 1);
+    for (const std::uint32_t e : hierarchy.leaves()) {
+      const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
+      if (r != kNone) sources[at[r]++] = e;
+    }
+  }
+  out.element_count = sources.size();
+  const bool monte_carlo = ff.method == FormFactorMethod::monte_carlo;
+  if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
+
+  const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(scene, hierarchy, ff);
+  std::vector<double> sum(rows, 0.0);       // the accumulator of one row, by column
+  std::vector<std::uint32_t> touched;
+  std::vector<std::uint32_t> batch;
+  std::vector<SparseFactors> element_rows;
+  std::size_t row = 0;
+  while (row < rows) {
+    // The chunk: whole rows until it holds kChunkElements elements.
+    std::size_t end = row;
+    while (end < rows && (end == row || first[end] - first[row] < kChunkElements)) ++end;
+    batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
+                 sources.begin() + static_cast<std::ptrdiff_t>(first[end]));
+    estimator->sparse_element_rows(batch, element_rows);
+    for (std::size_t r = row; r < end; ++r) {
+      touched.clear();
+      for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
+        const std::uint32_t e = sources[k];
+        const double a = hierarchy.element(e).area;
+        const SparseFactors& f = element_rows[k - first[row]];
+        for (std::size_t m = 0; m < f.index.size(); ++m) {
+          // Backs of two-sided patches (indices past the patches) are not surfaces here.
+          if (f.index[m] >= patches.size()) continue;
+          const std::uint32_t c = column_of_patch[f.index[m]];
+          if (c == kNone) continue;
+          if (sum[c] == 0.0) touched.push_back(c);
+          sum[c] += a * static_cast<double>(f.value[m]);
+        }
+      }
+      std::sort(touched.begin(), touched.end());
+      const double inverse_area = out.area[r] > 0.0 ? 1.0 / out.area[r] : 0.0;
+      double row_sum = 0.0;
+      for (const std::uint32_t c : touched) {
+        const float v = static_cast<float>(sum[c] * inverse_area);
+        sum[c] = 0.0;
+        if (!(v > 0.0f)) continue;
+        out.columns.push_back(c);
+        out.values.push_back(v);
+        row_sum += static_cast<double>(v);
+      }
+      out.row_offsets[r + 1] = out.columns.size();
+      if (monte_carlo) {
+        // Binomial: the row's rays each reach a surface of the matrix or not.
+        const double s = std::clamp(row_sum, 0.0, 1.0);
+        const double n = static_cast<double>(ff.hemisphere_rays) * static_cast<double>(first[r + 1] - first[r]);
+        out.row_standard_error[r] = std::sqrt(s * (1.0 - s) / n);
+      }
+    }
+    row = end;
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = static_cast<double>(row) / static_cast<double>(rows);
+    if (!gate.report(p, row == rows)) {
+      out.cancelled = true;
+      for (std::size_t r = row; r < rows; ++r) out.row_offsets[r + 1] = out.columns.size();
+      break;
+    }
+  }
+}
+
+/// A scene whose polygons are the leaf elements of `hierarchy` (in leaves() order), with their
+/// polygons' materials, groups and obstruction flags.
+Scene element_scene(const Scene& scene, const PatchHierarchy& hierarchy) {
+  Scene out;
+  for (const Material& m : scene.materials()) out.add_material(m);
+  std::vector<glm::vec3> corners;
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const Element& el = hierarchy.element(e);
+    const Polygon& polygon = scene.polygons()[hierarchy.patches()[el.patch].polygon];
+    corners.clear();
+    for (int k = 0; k < el.corner_count(); ++k) corners.push_back(hierarchy.vertices()[el.corners[k]]);
+    const PolygonRange range = out.add_polygon(corners, polygon.material, scene.groups()[polygon.group]);
+    if (range.count != 1)
+      throw Error(ErrorCode::internal, "view_factor_matrix: element " + std::to_string(e) + " is not one polygon");
+    if (polygon.obstruction_only) out.set_obstruction_only(range.first);
+  }
+  return out;
+}
+
+}  // namespace
+
+double ViewFactorMatrix::at(std::size_t row, std::uint32_t column) const {
+  const auto first = columns.begin() + static_cast<std::ptrdiff_t>(row_offsets[row]);
+  const auto last = columns.begin() + static_cast<std::ptrdiff_t>(row_offsets[row + 1]);
+  const auto it = std::lower_bound(first, last, column);
+  return it != last && *it == column ? static_cast<double>(values[static_cast<std::size_t>(it - columns.begin())]) : 0.0;
+}
+
+const char* to_string(ViewFactorLevel level) {
+  switch (level) {
+    case ViewFactorLevel::group: return "group";
+    case ViewFactorLevel::polygon: return "polygon";
+    case ViewFactorLevel::element: return "element";
+  }
+  return "unknown";
+}
+
+const char* to_string(ViewFactorCorrection correction) {
+  switch (correction) {
+    case ViewFactorCorrection::none: return "none";
+    case ViewFactorCorrection::reciprocity: return "reciprocity";
+    case ViewFactorCorrection::enclosure: return "enclosure";
+  }
+  return "unknown";
+}
+
+ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factor_matrix: the scene has no polygons");
+  FormFactorOptions ff = detail::resolve(options.form_factors);
+  if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
+  // The view factors of surfaces that send and receive on their fronts (as View3D's).
+  ff.diffuse_transmission = false;
+  ff.specular_depth = 0;
+  const bool links = options.method == ViewFactorMethod::hierarchical;
+  if (links && options.level != ViewFactorLevel::group)
+    throw Error(ErrorCode::invalid_argument,
+                std::string("view_factor_matrix: the hierarchical method gives group-level factors only (level '") +
+                    to_string(options.level) + "'); use the estimator method (monte_carlo for large scenes)");
+
+  ViewFactorMatrix out;
+  out.level = options.level;
+  out.row_offsets.assign(1, 0);
+  if (options.level == ViewFactorLevel::group) {
+    const GroupViewFactors g = view_factors(scene, options);
+    const std::size_t n = g.groups.size();
+    out.names = g.groups;
+    out.area = g.area;
+    for (const std::string& name : g.groups) out.ids.push_back(*scene.find_group(name));
+    out.row_offsets.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t k = 0; k < n; ++k) {
+        const float v = static_cast<float>(g.at(i, k));
+        if (!(v > 0.0f)) continue;
+        out.columns.push_back(static_cast<std::uint32_t>(k));
+        out.values.push_back(v);
+      }
+      out.row_offsets[i + 1] = out.columns.size();
+    }
+    out.method = links ? "hierarchical" : to_string(ff.method);
+    out.element_count = g.element_count;
+    out.cancelled = g.cancelled;
+  } else {
+    detail::ProgressGate gate(options.on_progress);
+    Progress start;
+    start.phase = Phase::form_factors;
+    out.cancelled = !gate.report(start, true);
+    out.method = to_string(ff.method);
+    if (!out.cancelled) {
+      const std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
+      if (options.level == ViewFactorLevel::polygon) {
+        polygon_rows(scene, row_of, ff, options.mesh, gate, out);
+      } else {
+        // Elements: the polygon level of a scene made of the leaf elements, meshed as they are.
+        const PatchHierarchy hierarchy(scene, options.mesh);
+        const Scene elements = element_scene(scene, hierarchy);
+        std::vector<std::uint32_t> element_row_of(elements.polygons().size(), kNone);
+        for (std::size_t k = 0; k < hierarchy.leaves().size(); ++k)
+          element_row_of[k] = row_of[hierarchy.patches()[hierarchy.element(hierarchy.leaves()[k]).patch].polygon];
+        // Rows renumbered densely in leaf order.
+        std::uint32_t rows = 0;
+        for (std::uint32_t& r : element_row_of)
+          if (r != kNone) r = rows++;
+        MeshOptions whole;
+        whole.max_patch_area = whole.max_element_area = std::numeric_limits<float>::max();
+        polygon_rows(elements, element_row_of, ff, whole, gate, out);
+        for (std::uint32_t& id : out.ids) id = hierarchy.leaves()[id];  // leaf position -> element id
+      }
+    }
+  }
+  if (!out.cancelled) {
+    detail::SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
+    out.correction = detail::correct_view_factors(options.correction, out.area, F, ff.threads);
+    out.row_offsets = std::move(F.offsets);
+    out.columns = std::move(F.columns);
+    out.values = std::move(F.values);
+  }
+  out.sky.assign(out.rows(), 0.0);
+  for (std::size_t i = 0; i < out.rows(); ++i) {
+    double s = 0.0;
+    for (std::uint64_t k = out.row_offsets[i]; k < out.row_offsets[i + 1]; ++k) s += static_cast<double>(out.values[k]);
+    out.sky[i] = 1.0 - s;
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace v1
+}  // namespace radiosity

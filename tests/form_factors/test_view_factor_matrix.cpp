@@ -1,0 +1,295 @@
+// view_factor_matrix(): per-facet and per-element sparse view factors against Howell's closed
+// forms, the reciprocity and enclosure corrections, obstruction-only polygons, determinism,
+// and its errors.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "support/scenes.hpp"
+
+namespace {
+
+namespace rad = radiosity;
+
+/// The box [0,X]x[0,Y]x[0,Z] with each face cut into square facets of side `facet` (each a
+/// polygon of its own, facing inward), grouped by face "x0", "x1", "y0", "y1", "z0", "z1".
+rad::Scene faceted_box(float X, float Y, float Z, float facet) {
+  rad::Scene scene;
+  const rad::MaterialId m = scene.add_material(rad::Material{});
+  const glm::vec3 size(X, Y, Z), centre = 0.5f * size;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      const int nu = static_cast<int>(std::lround(size[u] / facet)), nv = static_cast<int>(std::lround(size[v] / facet));
+      const std::string group = std::string(1, "xyz"[axis]) + (side ? "1" : "0");
+      for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+          std::vector<glm::vec3> q(4, glm::vec3(0.0f));
+          const float u0 = size[u] * static_cast<float>(i) / static_cast<float>(nu),
+                      u1 = size[u] * static_cast<float>(i + 1) / static_cast<float>(nu),
+                      v0 = size[v] * static_cast<float>(j) / static_cast<float>(nv),
+                      v1 = size[v] * static_cast<float>(j + 1) / static_cast<float>(nv);
+          const float at = side ? size[axis] : 0.0f;
+          const float us[4] = {u0, u1, u1, u0}, vs[4] = {v0, v0, v1, v1};
+          for (int k = 0; k < 4; ++k) {
+            q[static_cast<std::size_t>(k)][axis] = at;
+            q[static_cast<std::size_t>(k)][u] = us[k];
+            q[static_cast<std::size_t>(k)][v] = vs[k];
+          }
+          const glm::vec3 n = glm::cross(q[1] - q[0], q[2] - q[0]);
+          if (glm::dot(n, centre - q[0]) < 0.0f) std::reverse(q.begin(), q.end());
+          scene.add_polygon(q, m, group);
+        }
+    }
+  return scene;
+}
+
+/// The polygon of `scene` in `group` whose centroid is nearest `point`.
+std::uint32_t polygon_at(const rad::Scene& scene, const std::string& group, const glm::vec3& point) {
+  const rad::GroupId g = *scene.find_group(group);
+  std::uint32_t best = rad::kNone;
+  float best_d = 1e30f;
+  for (std::size_t p = 0; p < scene.polygons().size(); ++p) {
+    const rad::Polygon& polygon = scene.polygons()[p];
+    if (polygon.group != g) continue;
+    glm::vec3 c(0.0f);
+    for (const glm::vec3& x : polygon.vertices) c += x;
+    c /= static_cast<float>(polygon.vertices.size());
+    const float d = glm::length(c - point);
+    if (d < best_d) {
+      best_d = d;
+      best = static_cast<std::uint32_t>(p);
+    }
+  }
+  return best;
+}
+
+/// The face-to-face factor from the polygon rows: sum over the source face's facets of
+/// A_i sum over the receiver face's facets of F_ij, over the source face's area.
+double face_factor(const rad::Scene& scene, const rad::ViewFactorMatrix& m, const std::string& from,
+                   const std::string& to) {
+  const rad::GroupId gf = *scene.find_group(from), gt = *scene.find_group(to);
+  double transport = 0.0, area = 0.0;
+  for (std::size_t i = 0; i < m.rows(); ++i) {
+    if (scene.polygons()[m.ids[i]].group != gf) continue;
+    area += m.area[i];
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k)
+      if (scene.polygons()[m.ids[m.columns[k]]].group == gt) transport += m.area[i] * static_cast<double>(m.values[k]);
+  }
+  return transport / area;
+}
+
+double row_sum(const rad::ViewFactorMatrix& m, std::size_t i) {
+  double s = 0.0;
+  for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) s += static_cast<double>(m.values[k]);
+  return s;
+}
+
+/// The largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) over the stored factors.
+double reciprocity_error(const rad::ViewFactorMatrix& m) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < m.rows(); ++i)
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) {
+      const std::uint32_t j = m.columns[k];
+      const double a = m.area[i] * static_cast<double>(m.values[k]), b = m.area[j] * m.at(j, static_cast<std::uint32_t>(i));
+      worst = std::max(worst, std::fabs(a - b) / std::max(a, b));
+    }
+  return worst;
+}
+
+}  // namespace
+
+TEST_SUITE("form_factors") {
+  TEST_CASE("view_factor_matrix per facet: the faceted 1x2x3 box against Howell C-11 and C-14, facet to facet and "
+            "face to face - ray_cast within 0.5 % - monte_carlo within its stated standard error") {
+    const rad::Scene s = faceted_box(1, 2, 3, 0.5f);  // 2x4 + 2x6 + 4x6 facets per face pair: 88 polygons
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    const rad::ViewFactorMatrix m = rad::view_factor_matrix(s, o);
+    REQUIRE(m.rows() == s.polygons().size());
+    CHECK(m.method == "ray-cast");
+    CHECK(m.row_standard_error.empty());
+    for (std::size_t i = 0; i < m.rows(); ++i) {
+      CHECK(m.ids[i] == i);
+      CHECK(m.area[i] == doctest::Approx(0.25).epsilon(1e-5));
+      CHECK(std::fabs(row_sum(m, i) - 1.0) < 0.005);  // closed: every row sums to 1
+      CHECK(std::fabs(m.sky[i]) < 0.005);
+    }
+    // Facet to facet: directly opposed 0.5 squares at distance 1 (C-11), and two facets at a
+    // corner sharing a 0.5 edge (C-14).
+    const std::uint32_t a = polygon_at(s, "x0", {0, 0.75f, 1.25f}), b = polygon_at(s, "x1", {1, 0.75f, 1.25f});
+    const double c11 = test::parallel_rectangles(0.5, 0.5, 1.0);
+    CHECK(m.at(a, b) == doctest::Approx(c11).epsilon(0.005));
+    const std::uint32_t c = polygon_at(s, "y0", {0.25f, 0, 1.25f});
+    const double c14 = test::perpendicular_rectangles(0.5, 0.5, 0.5);
+    const std::uint32_t corner = polygon_at(s, "x0", {0, 0.25f, 1.25f});
+    CHECK(m.at(corner, c) == doctest::Approx(c14).epsilon(0.005));
+    // Face to face, summed from the facets.
+    CHECK(face_factor(s, m, "x0", "x1") == doctest::Approx(test::parallel_rectangles(2, 3, 1)).epsilon(0.005));
+    CHECK(face_factor(s, m, "x0", "y0") == doctest::Approx(test::perpendicular_rectangles(3, 2, 1)).epsilon(0.005));
+    CHECK(face_factor(s, m, "z0", "y1") == doctest::Approx(test::perpendicular_rectangles(1, 2, 3)).epsilon(0.005));
+
+    // Monte Carlo: each row's sum is 1 within a few standard errors of its own estimate; a
+    // row's error is stated per row.
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.hemisphere_rays = 4096;
+    const rad::ViewFactorMatrix mc = rad::view_factor_matrix(s, o);
+    CHECK(mc.method == "monte-carlo");
+    REQUIRE(mc.row_standard_error.size() == mc.rows());
+    const double x0x1 = face_factor(s, mc, "x0", "x1"), exact = test::parallel_rectangles(2, 3, 1);
+    // 8 facets x 4096 rays: the face factor's binomial standard error is about 0.0022.
+    CHECK(std::fabs(x0x1 - exact) < 4.0 * std::sqrt(exact * (1 - exact) / (8 * 4096.0)));
+    for (std::size_t i = 0; i < mc.rows(); ++i) CHECK(std::fabs(row_sum(mc, i) - 1.0) < 1e-4);  // no ray escapes
+  }
+
+  TEST_CASE("view_factor_matrix corrections: reciprocity to 1e-6 - enclosure rows to 1e-6 - the changes stated and "
+            "small - the closed forms within 0.01 after it") {
+    const rad::Scene s = faceted_box(1, 2, 3, 0.5f);
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.hemisphere_rays = 512;
+    const rad::ViewFactorMatrix raw = rad::view_factor_matrix(s, o);
+    CHECK(raw.correction.reciprocity_before > 0.05);  // 512 rays per facet: noisy pairs
+    CHECK(reciprocity_error(raw) > 0.05);
+
+    o.correction = rad::ViewFactorCorrection::reciprocity;
+    const rad::ViewFactorMatrix rec = rad::view_factor_matrix(s, o);
+    CHECK(reciprocity_error(rec) < 1e-6);
+    CHECK(rec.correction.reciprocity_before == doctest::Approx(raw.correction.reciprocity_before));
+    CHECK(rec.correction.largest_change > 0.0);
+    CHECK(rec.non_zeros() >= raw.non_zeros());  // the union of both directions' patterns
+
+    o.correction = rad::ViewFactorCorrection::enclosure;
+    const rad::ViewFactorMatrix enc = rad::view_factor_matrix(s, o);
+    CHECK(reciprocity_error(enc) < 1e-6);
+    double worst_row = 0.0;
+    for (std::size_t i = 0; i < enc.rows(); ++i) worst_row = std::max(worst_row, std::fabs(row_sum(enc, i) - 1.0));
+    CHECK(worst_row < 1e-6);
+    CHECK(enc.correction.clamped == 0);
+    CHECK(enc.correction.empty_rows == 0);
+    CHECK(enc.correction.iterations > 0);
+    CHECK(enc.correction.rms_change < 0.01);
+    CHECK(enc.non_zeros() == rec.non_zeros());  // the sparsity is kept
+    MESSAGE("512 rays per facet: reciprocity before " << raw.correction.reciprocity_before << ", row sums before "
+                                                      << raw.correction.row_sum_error_before << ", enclosure change largest "
+                                                      << enc.correction.largest_change << " rms " << enc.correction.rms_change
+                                                      << " in " << enc.correction.iterations << " iterations");
+    // Against the closed forms, face to face: the corrections do not make them worse.
+    for (const auto& [from, to, exact] : {std::make_tuple("x0", "x1", test::parallel_rectangles(2, 3, 1)),
+                                          std::make_tuple("x0", "y0", test::perpendicular_rectangles(3, 2, 1)),
+                                          std::make_tuple("z0", "y1", test::perpendicular_rectangles(1, 2, 3))}) {
+      INFO(from, " -> ", to, ": exact ", exact, ", raw ", face_factor(s, raw, from, to), ", enclosure ",
+           face_factor(s, enc, from, to));
+      CHECK(std::fabs(face_factor(s, enc, from, to) - exact) < 0.01);
+    }
+  }
+
+  TEST_CASE("view_factor_matrix: an open scene's sky is the remainder - obstruction-only polygons hide but have no "
+            "row - groups select rows") {
+    // Two unit squares at distance 1, facing each other, and between them a square marked
+    // obstruction-only that covers half of the view.
+    rad::Scene s;
+    const rad::MaterialId m = s.add_material(rad::Material{});
+    s.add_polygon({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, m, "bottom");
+    s.add_polygon({{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}}, m, "top");
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.correction = rad::ViewFactorCorrection::reciprocity;
+    const rad::ViewFactorMatrix open = rad::view_factor_matrix(s, o);
+    const double c11 = test::parallel_rectangles(1, 1, 1);
+    REQUIRE(open.rows() == 2);
+    CHECK(open.at(0, 1) == doctest::Approx(c11).epsilon(0.005));
+    CHECK(open.sky[0] == doctest::Approx(1.0 - c11).epsilon(0.002));
+    CHECK(open.correction.row_sum_error_before == doctest::Approx(1.0 - c11).epsilon(0.005));
+
+    const rad::PolygonRange blocker = s.add_polygon({{-1, -1, 0.5f}, {0.5f, -1, 0.5f}, {0.5f, 2, 0.5f}, {-1, 2, 0.5f}}, m, "blocker");
+    s.set_obstruction_only(blocker.first);
+    const rad::ViewFactorMatrix hidden = rad::view_factor_matrix(s, o);
+    REQUIRE(hidden.rows() == 2);
+    CHECK(hidden.ids == std::vector<std::uint32_t>{0, 1});
+    CHECK(hidden.at(0, 1) < 0.7 * c11);
+    CHECK(hidden.at(0, 1) > 0.3 * c11);
+    CHECK(hidden.sky[0] == doctest::Approx(1.0 - hidden.at(0, 1)).epsilon(1e-6));
+    // The group level leaves it out too.
+    o.level = rad::ViewFactorLevel::group;
+    const rad::ViewFactorMatrix groups = rad::view_factor_matrix(s, o);
+    REQUIRE(groups.rows() == 3);
+    CHECK(groups.names == std::vector<std::string>{"bottom", "top", "blocker"});
+    CHECK(groups.area[2] == 0.0);
+    CHECK(groups.at(0, 1) == doctest::Approx(hidden.at(0, 1)).epsilon(0.01));
+    CHECK(groups.at(0, 2) == 0.0);
+    CHECK_THROWS_AS(s.set_obstruction_only(99), rad::Error);
+    // Groups select the rows: only the top.
+    o.level = rad::ViewFactorLevel::polygon;
+    o.groups = {"top"};
+    const rad::ViewFactorMatrix top = rad::view_factor_matrix(s, o);
+    REQUIRE(top.rows() == 1);
+    CHECK(top.ids == std::vector<std::uint32_t>{1});
+    CHECK(top.non_zeros() == 0);  // it sees no other selected polygon
+    o.groups = {"nothing"};
+    CHECK_THROWS_AS(rad::view_factor_matrix(s, o), rad::Error);
+  }
+
+  TEST_CASE("view_factor_matrix per element agrees with the polygon level summed - is bit-identical at 1 and 2 "
+            "threads - the hierarchical method is group level only - cancel stops it") {
+    const rad::Scene s = test::closed_box(rad::Material{});
+    rad::ViewFactorOptions o;
+    o.mesh.max_patch_area = 0.25f;
+    o.mesh.max_element_area = 0.25f;
+    o.level = rad::ViewFactorLevel::element;
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    o.form_factors.threads = 1;
+    const rad::ViewFactorMatrix one = rad::view_factor_matrix(s, o);
+    REQUIRE(one.rows() == 24);  // 6 faces x 4 elements
+    o.form_factors.threads = 2;
+    const rad::ViewFactorMatrix two = rad::view_factor_matrix(s, o);
+    CHECK(one.values == two.values);  // exact equality
+    CHECK(one.columns == two.columns);
+    const rad::PatchHierarchy h(s, o.mesh);
+    // Summed to faces (the scene's polygons), element rows give the polygon level's factors.
+    o.level = rad::ViewFactorLevel::polygon;
+    const rad::ViewFactorMatrix faces = rad::view_factor_matrix(s, o);
+    REQUIRE(faces.rows() == 6);
+    for (std::size_t p = 0; p < 6; ++p)
+      for (std::size_t q = 0; q < 6; ++q) {
+        double transport = 0.0, area = 0.0;
+        for (std::size_t i = 0; i < one.rows(); ++i) {
+          if (h.patches()[h.element(one.ids[i]).patch].polygon != p) continue;
+          area += one.area[i];
+          for (std::uint64_t k = one.row_offsets[i]; k < one.row_offsets[i + 1]; ++k)
+            if (h.patches()[h.element(one.ids[one.columns[k]]).patch].polygon == q)
+              transport += one.area[i] * static_cast<double>(one.values[k]);
+        }
+        CHECK(transport / area == doctest::Approx(faces.at(p, static_cast<std::uint32_t>(q))).epsilon(0.005));
+      }
+    // Monte Carlo with the enclosure correction, bit-identical too.
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.correction = rad::ViewFactorCorrection::enclosure;
+    o.form_factors.threads = 1;
+    const rad::ViewFactorMatrix mc1 = rad::view_factor_matrix(s, o);
+    o.form_factors.threads = 2;
+    const rad::ViewFactorMatrix mc2 = rad::view_factor_matrix(s, o);
+    CHECK(mc1.values == mc2.values);
+    CHECK(mc1.row_standard_error == mc2.row_standard_error);
+
+    o.method = rad::ViewFactorMethod::hierarchical;
+    CHECK_THROWS_AS(rad::view_factor_matrix(s, o), rad::Error);
+    o.level = rad::ViewFactorLevel::group;
+    const rad::ViewFactorMatrix links = rad::view_factor_matrix(s, o);
+    CHECK(links.method == "hierarchical");
+    CHECK(links.rows() == 6);
+
+    o.method = rad::ViewFactorMethod::estimator;
+    o.level = rad::ViewFactorLevel::polygon;
+    int calls = 0;
+    o.on_progress = [&calls](const rad::Progress&) { return ++calls < 1; };
+    const rad::ViewFactorMatrix stopped = rad::view_factor_matrix(s, o);
+    CHECK(stopped.cancelled);
+    CHECK(stopped.row_offsets.size() == stopped.rows() + 1);
+  }
+}
