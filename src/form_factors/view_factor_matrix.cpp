@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -33,6 +34,8 @@ namespace {
 /// more): enough for the estimators' parallel loops, few enough for ~100 progress reports on
 /// large scenes.
 constexpr std::size_t kChunkElements = 4096;
+/// The enclosure correction refuses a scene with a row farther than this from 1 (check_enclosure()).
+constexpr double kMaxClosureGap = 0.25;
 
 /// Which polygons get a row: not obstruction-only, and in `groups` when it is not empty.
 /// Throws for an unknown or repeated group name.
@@ -177,6 +180,40 @@ Scene element_scene(const Scene& scene, const PatchHierarchy& hierarchy) {
   return out;
 }
 
+/// The enclosure correction closes rows that noise and small gaps leave a little off 1; rows
+/// far from 1 mean the scene is no enclosure as seen from the polygons' fronts, and closing
+/// them would invent factors. Throws Error{invalid_argument} naming the worst row.
+void check_enclosure(const ViewFactorMatrix& m, const Scene& scene) {
+  std::size_t off = 0, worst = 0, empty = 0;
+  double worst_gap = 0.0;
+  for (std::size_t i = 0; i < m.rows(); ++i) {
+    double s = 0.0;
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) s += static_cast<double>(m.values[k]);
+    const double gap = std::fabs(1.0 - s);
+    if (gap > kMaxClosureGap) ++off;
+    if (s == 0.0) ++empty;
+    if (gap > worst_gap) {
+      worst_gap = gap;
+      worst = i;
+    }
+  }
+  if (off == 0) return;
+  std::string what = m.level == ViewFactorLevel::group     ? "group '" + m.names[worst] + "'"
+                     : m.level == ViewFactorLevel::polygon ? "polygon " + std::to_string(m.ids[worst])
+                                                           : "element " + std::to_string(m.ids[worst]);
+  if (m.level == ViewFactorLevel::polygon) what += " (group '" + scene.groups()[scene.polygons()[m.ids[worst]].group] + "')";
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers, " rows sum to less than %g or more than %g (%zu see nothing at all; the worst, ",
+                1.0 - kMaxClosureGap, 1.0 + kMaxClosureGap, empty);
+  char gap[48];
+  std::snprintf(gap, sizeof gap, ", is off by %.3g)", worst_gap);
+  throw Error(ErrorCode::invalid_argument,
+              "view_factor_matrix: enclosure correction: the scene is no closed enclosure seen from the fronts of its "
+              "polygons: " + std::to_string(off) + " of " + std::to_string(m.rows()) + numbers + what + gap +
+                  ". An open scene takes the reciprocity correction; polygons that face outward (an exporter's "
+                  "winding) see nothing in front of them");
+}
+
 }  // namespace
 
 double ViewFactorMatrix::at(std::size_t row, std::uint32_t column) const {
@@ -268,6 +305,7 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
       }
     }
   }
+  if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
   if (!out.cancelled) {
     detail::SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
     out.correction = detail::correct_view_factors(options.correction, out.area, F, ff.threads);

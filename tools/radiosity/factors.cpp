@@ -1,4 +1,5 @@
-// `radiosity factors`: the group-to-group view-factor matrix of a scene, as CSV or JSON.
+// `radiosity factors`: the view-factor matrix of a scene between its groups (CSV or JSON), its
+// polygons or its elements (sparse: CSV triplets, JSON CSR, Matrix Market).
 #include "factors.hpp"
 
 #include <cstdio>
@@ -16,6 +17,9 @@ struct FactorsArgs {
   std::string scene;
   std::string method = "ray-cast";
   std::string format = "csv";
+  std::string level = "group";
+  std::string correction = "none";
+  std::string row_sums;
   bool sparse = false;
   std::string output;
   std::string groups;
@@ -40,6 +44,18 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
+/// Writes `text` to `path`, or to stdout for "" or "-".
+void write_text(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return;
+  }
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw rad::Error(rad::ErrorCode::io_error, "cannot write '" + path + "'");
+}
+
 int run_factors(const FactorsArgs& a) {
   return run_guarded([&] {
     rad::Scene scene = load(a.scene, a.strict, a.photometric);
@@ -60,25 +76,70 @@ int run_factors(const FactorsArgs& a) {
     o.mesh.max_patch_area = a.max_patch_area;
     o.mesh.max_element_area = a.max_element_area;
     o.groups = split_list(a.groups);
+    o.level = a.level == "polygon" ? rad::ViewFactorLevel::polygon
+              : a.level == "element" ? rad::ViewFactorLevel::element
+                                     : rad::ViewFactorLevel::group;
+    o.correction = a.correction == "reciprocity" ? rad::ViewFactorCorrection::reciprocity
+                   : a.correction == "enclosure" ? rad::ViewFactorCorrection::enclosure
+                                                 : rad::ViewFactorCorrection::none;
+    if (o.level != rad::ViewFactorLevel::group && a.format != "json" && a.format != "mtx" && a.format != "csv")
+      throw rad::Error(rad::ErrorCode::invalid_argument, "--format " + a.format + " is for --level group");
+    if (o.level == rad::ViewFactorLevel::group && a.format == "mtx")
+      throw rad::Error(rad::ErrorCode::invalid_argument, "--format mtx is for --level polygon or element");
     ProgressBar bar;
     o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
-    const rad::GroupViewFactors v = rad::view_factors(scene, o);
+    // The group level without a correction is view_factors() itself, as before the levels.
+    const bool matrix = o.level != rad::ViewFactorLevel::group || o.correction != rad::ViewFactorCorrection::none;
+    rad::ViewFactorMatrix m;
+    rad::GroupViewFactors v;
+    if (matrix)
+      m = rad::view_factor_matrix(scene, o);
+    else
+      v = rad::view_factors(scene, o);
     bar.finish();
+    if (matrix && o.level == rad::ViewFactorLevel::group) v = group_factors(m, 0);
 
-    const std::string text = a.format == "json" ? factors_json(v, a.sparse, a.method) : factors_csv(v, a.sparse);
-    if (a.output.empty() || a.output == "-") {
-      std::fwrite(text.data(), 1, text.size(), stdout);
-    } else {
-      std::ofstream out(a.output, std::ios::binary);
-      out << text;
-      out.close();
-      if (!out) throw rad::Error(rad::ErrorCode::io_error, "cannot write '" + a.output + "'");
+    std::string text;
+    if (o.level == rad::ViewFactorLevel::group)
+      text = a.format == "json" ? factors_json(v, a.sparse, a.method) : factors_csv(v, a.sparse);
+    else
+      text = a.format == "json" ? matrix_json(m, o.correction) : a.format == "mtx" ? matrix_market(m) : matrix_csv(m);
+    write_text(a.output, text);
+    if (!a.row_sums.empty()) {
+      if (!matrix) m = rad::view_factor_matrix(scene, o);  // the group rows as a matrix
+      write_text(a.row_sums, row_sums_csv(m));
     }
     // The summary goes to stderr, so that stdout stays a clean CSV/JSON stream.
     const std::string links = v.link_count > 0 ? " (" + std::to_string(v.link_count) + " links)" : "";
-    std::fprintf(stderr, "factors: %zu groups, %zu patches, %zu source elements, %s%s, %.3f s%s%s\n", v.groups.size(),
-                 v.patch_count, v.element_count, a.method.c_str(), links.c_str(), v.seconds,
-                 a.output.empty() ? "" : ", wrote ", a.output.c_str());
+    if (o.level == rad::ViewFactorLevel::group && !matrix) {
+      std::fprintf(stderr, "factors: %zu groups, %zu patches, %zu source elements, %s%s, %.3f s%s%s\n",
+                   v.groups.size(), v.patch_count, v.element_count, a.method.c_str(), links.c_str(), v.seconds,
+                   a.output.empty() ? "" : ", wrote ", a.output.c_str());
+    } else {
+      std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s, %.3f s%s%s\n", m.rows(),
+                   a.level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), m.seconds,
+                   a.output.empty() ? "" : ", wrote ", a.output.c_str());
+      // Rows that see nothing: one-sided polygons whose fronts face away from everything.
+      std::size_t blind = 0;
+      for (std::size_t i = 0; i < m.rows(); ++i) blind += m.row_offsets[i + 1] == m.row_offsets[i] ? 1 : 0;
+      if (blind > 0)
+        std::fprintf(stderr,
+                     "warning: factors: %zu of %zu rows see no surface in front of them (polygons send and receive "
+                     "on their fronts only: if the scene is closed, its polygons may face outward)\n",
+                     blind, m.rows());
+      const rad::ViewFactorCorrectionReport& c = m.correction;
+      std::fprintf(stderr,
+                   "factors: before correction: reciprocity error up to %.3g, row sums off by up to %.3g (rms %.3g)\n",
+                   c.reciprocity_before, c.row_sum_error_before, c.row_sum_rms_before);
+      if (o.correction != rad::ViewFactorCorrection::none)
+        std::fprintf(stderr, "factors: %s correction changed factors by up to %.3g (rms %.3g)%s\n",
+                     a.correction.c_str(), c.largest_change, c.rms_change,
+                     o.correction == rad::ViewFactorCorrection::enclosure
+                         ? (", " + std::to_string(c.iterations) + " iterations, " + std::to_string(c.clamped) +
+                            " factors clamped to 0, " + std::to_string(c.empty_rows) + " rows see nothing")
+                               .c_str()
+                         : "");
+    }
     return 0;
   });
 }
@@ -89,7 +150,9 @@ Command add_factors_command(CLI::App& app) {
   auto args = std::make_shared<FactorsArgs>();
   FactorsArgs& a = *args;
   CLI::App* cmd = app.add_subcommand(
-      "factors", "Group-to-group view factors F(gi -> gk), area-weighted over each source group, as CSV or JSON");
+      "factors",
+      "View factors F(i -> k) between the scene's groups (area-weighted over each source group), polygons or "
+      "elements, as CSV, JSON or Matrix Market");
   cmd->add_option("scene", a.scene, kSceneHelp);
   std::vector<std::string> methods = form_factor_names();
   methods.push_back("hierarchical");
@@ -103,7 +166,22 @@ Command add_factors_command(CLI::App& app) {
                   "(0, 1]")
       ->check(in_range<float>(1e-6f, 1.0f))
       ->capture_default_str();
-  cmd->add_option("--format", a.format, "Output format")->check(CLI::IsMember({"csv", "json"}))->capture_default_str();
+  cmd->add_option("--level", a.level,
+                  "Rows and columns: group, polygon (every polygon, in scene order; sparse) or element (every "
+                  "element of the mesh; sparse)")
+      ->check(CLI::IsMember({"group", "polygon", "element"}))
+      ->capture_default_str();
+  cmd->add_option("--correction", a.correction,
+                  "reciprocity: A_i F_ij = A_j F_ji exactly; enclosure: also rows that sum to 1 (closed scenes), by "
+                  "a least-squares change that keeps the sparsity")
+      ->check(CLI::IsMember({"none", "reciprocity", "enclosure"}))
+      ->capture_default_str();
+  cmd->add_option("--format", a.format,
+                  "Output format: csv, json; mtx (Matrix Market, 1-based) for --level polygon or element")
+      ->check(CLI::IsMember({"csv", "json", "mtx"}))
+      ->capture_default_str();
+  cmd->add_option("--row-sums", a.row_sums,
+                  "Also write each row's area, sum, sky view factor (1 - sum) and standard error as CSV here");
   cmd->add_flag("--sparse", a.sparse, "Only the non-zero factors (CSV: from,to,factor rows)");
   cmd->add_option("-o,--output", a.output, "Write here instead of stdout");
   cmd->add_option("--groups", a.groups, "Comma-separated groups to report, in this order (default: all)");

@@ -1,4 +1,5 @@
-// Output formats of `radiosity factors`: the group-to-group view-factor matrix as CSV or JSON.
+// Output formats of `radiosity factors`: the group-to-group view-factor matrix as CSV or JSON,
+// and the sparse polygon or element matrices as CSV triplets, JSON CSR or Matrix Market.
 // Header-only and free of CLI11, so the test suite can check the formats. The formats are a
 // contract that scripts parse: see docs/FORM_FACTORS.md.
 #pragma once
@@ -79,6 +80,91 @@ inline std::string factors_json(const radiosity::GroupViewFactors& v, bool spars
   }
   j["factors"] = std::move(factors);
   return j.dump(2) + "\n";
+}
+
+/// The dense group matrix of a group-level ViewFactorMatrix, for the group formats above.
+inline radiosity::GroupViewFactors group_factors(const radiosity::ViewFactorMatrix& m, std::size_t patches) {
+  radiosity::GroupViewFactors g;
+  g.groups = m.names;
+  g.area = m.area;
+  const std::size_t n = m.rows();
+  g.factors.assign(n * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k)
+      g.factors[i * n + m.columns[k]] = static_cast<double>(m.values[k]);
+  g.patch_count = patches;
+  g.element_count = m.element_count;
+  g.seconds = m.seconds;
+  g.cancelled = m.cancelled;
+  return g;
+}
+
+/// What a row or column of a polygon or element matrix names: the PolygonId or element id.
+/// CSV: a header `from,to,factor` and one row per stored factor, row-major, `from` and `to`
+/// being those ids (0-based).
+inline std::string matrix_csv(const radiosity::ViewFactorMatrix& m) {
+  std::string out = "from,to,factor\n";
+  for (std::size_t i = 0; i < m.rows(); ++i)
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k)
+      out += std::to_string(m.ids[i]) + "," + std::to_string(m.ids[m.columns[k]]) + "," +
+             csv_number(static_cast<double>(m.values[k])) + "\n";
+  return out;
+}
+
+/// Matrix Market coordinate format (NIST), 1-based: row and column k are the matrix's k-th
+/// surface (ids[k - 1]; the `%ids` comment lists them when they are not 0, 1, 2, ... in order).
+inline std::string matrix_market(const radiosity::ViewFactorMatrix& m) {
+  std::string out = "%%MatrixMarket matrix coordinate real general\n";
+  out += std::string("% radiosity view factors F(row -> column): level ") + radiosity::to_string(m.level) + ", method " +
+         m.method + "\n";
+  bool identity = true;
+  for (std::size_t i = 0; i < m.ids.size(); ++i) identity = identity && m.ids[i] == i;
+  if (!identity) {
+    out += "%ids";
+    for (const std::uint32_t id : m.ids) out += " " + std::to_string(id);
+    out += "\n";
+  }
+  out += std::to_string(m.rows()) + " " + std::to_string(m.rows()) + " " + std::to_string(m.non_zeros()) + "\n";
+  for (std::size_t i = 0; i < m.rows(); ++i)
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k)
+      out += std::to_string(i + 1) + " " + std::to_string(m.columns[k] + 1) + " " +
+             csv_number(static_cast<double>(m.values[k])) + "\n";
+  return out;
+}
+
+/// JSON: {"level", "method", "correction", "rows", "non_zeros", "seconds", "ids", "area",
+/// "row_offsets", "columns", "values", "sky", and "row_standard_error" when the estimator states
+/// one}: the CSR arrays as they are (0-based, columns index rows).
+inline std::string matrix_json(const radiosity::ViewFactorMatrix& m, radiosity::ViewFactorCorrection correction) {
+  nlohmann::ordered_json j;
+  j["level"] = radiosity::to_string(m.level);
+  j["method"] = m.method;
+  j["correction"] = radiosity::to_string(correction);
+  j["rows"] = m.rows();
+  j["non_zeros"] = m.non_zeros();
+  j["seconds"] = m.seconds;
+  j["ids"] = m.ids;
+  j["area"] = m.area;
+  j["row_offsets"] = m.row_offsets;
+  j["columns"] = m.columns;
+  nlohmann::ordered_json values = nlohmann::ordered_json::array();
+  for (const float v : m.values) values.push_back(static_cast<double>(v));
+  j["values"] = std::move(values);
+  j["sky"] = m.sky;
+  if (!m.row_standard_error.empty()) j["row_standard_error"] = m.row_standard_error;
+  return j.dump() + "\n";
+}
+
+/// Per row: `row,id,area,row_sum,sky,standard_error` (standard_error empty where the estimator
+/// states none; the group level names the group in `id`).
+inline std::string row_sums_csv(const radiosity::ViewFactorMatrix& m) {
+  std::string out = "row,id,area,row_sum,sky,standard_error\n";
+  for (std::size_t i = 0; i < m.rows(); ++i) {
+    const std::string id = m.names.empty() ? std::to_string(m.ids[i]) : csv_field(m.names[i]);
+    out += std::to_string(i) + "," + id + "," + csv_number(m.area[i]) + "," + csv_number(1.0 - m.sky[i]) + "," +
+           csv_number(m.sky[i]) + "," + (m.row_standard_error.empty() ? "" : csv_number(m.row_standard_error[i])) + "\n";
+  }
+  return out;
 }
 
 }  // namespace cli
