@@ -320,17 +320,21 @@ RADIOSITY_API GroupViewFactors view_factors(const Scene& scene, const ViewFactor
 /// What ViewFactorOptions::correction changed, and how far the estimates were from the two
 /// laws before it (after it they hold to rounding). Thread safety: a plain value.
 struct ViewFactorCorrectionReport {
-  /// Before: the largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) over pairs with a
-  /// non-zero factor in either direction (1 where only one direction has one).
+  /// Before: the largest |F_ij - A_j F_ji / A_i|, the change of a factor that reciprocity asks
+  /// for, in units of view factor.
   double reciprocity_before = 0.0;
-  /// Before: the largest and the area-weighted RMS of |1 - sum_j F_ij| over the rows.
+  /// Before: the largest and the area-weighted RMS of |1 - sum_j F_ij| over the rows that see
+  /// something.
   double row_sum_error_before = 0.0, row_sum_rms_before = 0.0;
   /// The largest |F'_ij - F_ij| the correction made, and its RMS over the stored factors.
   double largest_change = 0.0, rms_change = 0.0;
-  /// Enclosure: rows that see nothing (their sum stays 0: a polygon facing away from every
-  /// other), and factors the correction would have made negative (set to 0, and solved
-  /// again without them).
-  std::size_t empty_rows = 0, clamped = 0;
+  /// Rows that see nothing (a floor facet covered by a block that stands on it, a polygon
+  /// facing away from every other): left out of the figures above, and left open by the
+  /// enclosure correction.
+  std::size_t empty_rows = 0;
+  /// Enclosure: factors the correction would have made negative (set to 0, and the rows
+  /// solved again without them).
+  std::size_t clamped = 0;
   int iterations = 0;  ///< enclosure: conjugate-gradient iterations
 };
 

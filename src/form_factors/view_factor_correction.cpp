@@ -87,8 +87,8 @@ SparseRowsF symmetric_transport(const SparseRowsF& F, const std::vector<double>&
           const std::uint32_t j = F.columns[k];
           const double tij = area[i] * static_cast<double>(F.values[k]);
           const double tji = area[j] * static_cast<double>(find(F, j, static_cast<std::uint32_t>(i)));
-          const double larger = std::max(tij, tji);
-          if (larger > 0.0) worst[b] = std::max(worst[b], std::fabs(tij - tji) / larger);
+          // The change of F_ij that reciprocity asks for, in units of view factor.
+          worst[b] = std::max(worst[b], std::fabs(tij - tji) / area[i]);
           if (tji == 0.0) missing[b].push_back({j, static_cast<std::uint32_t>(i), static_cast<float>(0.5 * tij)});
         }
       }
@@ -156,10 +156,12 @@ void closure_product(const SparseRowsF& G, const std::vector<double>& g, const s
   });
 }
 
-/// Solves (D + G) l = A - g by Jacobi-preconditioned conjugate gradients; returns the
-/// iterations. Rows with g_i = 0 keep l_i = 0.
-int closure_multipliers(const SparseRowsF& G, const std::vector<double>& area, unsigned threads,
-                        std::vector<double>& l) {
+/// Solves (D + G) l = A - g by Jacobi-preconditioned conjugate gradients over the rows flagged
+/// in `closed`; returns the iterations. The other rows keep l_i = 0: their sums are not
+/// constrained (a row that saw nothing before the reciprocity step, which may have given it
+/// tiny entries from grazing pairs, would otherwise need a huge multiplier).
+int closure_multipliers(const SparseRowsF& G, const std::vector<double>& area, const std::vector<char>& closed,
+                        unsigned threads, std::vector<double>& l) {
   const std::size_t n = G.rows();
   std::vector<double> g(n, 0.0), diagonal(n, 0.0);
   parallel_for(threads, n, kRowBlock, [&](std::size_t begin, std::size_t end) {
@@ -173,17 +175,19 @@ int closure_multipliers(const SparseRowsF& G, const std::vector<double>& area, u
       diagonal[i] = s + self;
     }
   });
+  std::vector<char> active(n, 0);
+  for (std::size_t i = 0; i < n; ++i) active[i] = closed[i] && g[i] > 0.0;
   l.assign(n, 0.0);
-  std::vector<double> r(n), z(n), p(n), q(n);
-  for (std::size_t i = 0; i < n; ++i) r[i] = g[i] > 0.0 ? area[i] - g[i] : 0.0;
+  std::vector<double> r(n, 0.0), z(n, 0.0), p(n, 0.0), q(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) r[i] = active[i] ? area[i] - g[i] : 0.0;
   auto converged = [&] {
     double worst = 0.0;
     for (std::size_t i = 0; i < n; ++i)
-      if (g[i] > 0.0) worst = std::max(worst, std::fabs(r[i]) / area[i]);
+      if (active[i]) worst = std::max(worst, std::fabs(r[i]) / area[i]);
     return worst <= kClosureTolerance;
   };
   auto precondition = [&] {
-    for (std::size_t i = 0; i < n; ++i) z[i] = diagonal[i] > 0.0 ? r[i] / diagonal[i] : 0.0;
+    for (std::size_t i = 0; i < n; ++i) z[i] = active[i] ? r[i] / diagonal[i] : 0.0;
   };
   if (converged()) return 0;
   precondition();
@@ -193,6 +197,8 @@ int closure_multipliers(const SparseRowsF& G, const std::vector<double>& area, u
   while (it < kMaxIterations) {
     ++it;
     closure_product(G, g, p, q, threads);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!active[i]) q[i] = 0.0;  // the equations of the unconstrained rows are not part of the system
     const double pq = block_sum(threads, n, [&](std::size_t i) { return p[i] * q[i]; });
     if (!(pq > 0.0)) break;  // singular direction: rows that cannot be closed (say, two plates alone)
     const double alpha = rz / pq;
@@ -256,10 +262,17 @@ ViewFactorCorrectionReport correct_view_factors(ViewFactorCorrection correction,
   const std::size_t n = F.rows();
   RADIOSITY_ASSERT(area.size() == n);
   ViewFactorCorrectionReport report;
-  // Closure before: |1 - row sum|, the largest and the area-weighted RMS.
+  // Closure before: |1 - row sum|, the largest and the area-weighted RMS, over the rows that
+  // see something (the others are counted apart; the enclosure correction leaves them open).
+  std::vector<char> closed(n, 0);
   {
     double total_area = 0.0, squares = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
+      if (F.offsets[i + 1] == F.offsets[i]) {
+        ++report.empty_rows;
+        continue;
+      }
+      closed[i] = 1;
       double s = 0.0;
       for (std::uint64_t k = F.offsets[i]; k < F.offsets[i + 1]; ++k) s += static_cast<double>(F.values[k]);
       const double e = std::fabs(1.0 - s);
@@ -275,7 +288,7 @@ ViewFactorCorrectionReport correct_view_factors(ViewFactorCorrection correction,
   if (correction == ViewFactorCorrection::enclosure) {
     std::vector<double> l;
     for (int pass = 1;; ++pass) {
-      report.iterations += closure_multipliers(G, area, threads, l);
+      report.iterations += closure_multipliers(G, area, closed, threads, l);
       if (pass == kMaxClampPasses) break;  // any factor still negative is clamped to 0 below
       const std::size_t negative = zero_negative(G, l);
       report.clamped += negative;
@@ -283,8 +296,6 @@ ViewFactorCorrectionReport correct_view_factors(ViewFactorCorrection correction,
     }
     scale_by_multipliers(G, l);
     drop_zeros(G);
-    for (std::size_t i = 0; i < n; ++i)
-      if (G.offsets[i + 1] == G.offsets[i]) ++report.empty_rows;
   }
 
   // Back to factors, and what changed against the estimate.
