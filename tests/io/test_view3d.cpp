@@ -197,7 +197,7 @@ TEST_CASE("view3d combine: pieces combined with a surface join its group - subsu
   CHECK(contains(e.what(), p.string() + ":11: surface 2 ('window') is a subsurface"));
 }
 
-TEST_CASE("view3d forgiving: emissivities clamped into (0 1] - unnamed surfaces - unknown lines - low recursions - each one warning") {
+TEST_CASE("view3d forgiving: emissivities outside 0 to 1 clamped - unnamed surfaces - unknown lines - low recursions - each one warning") {
   const std::string text =
       "T forgiven\nC maxU=2 minO=-1\nV 1 0 0 0\nV 2 1 0 0\nV 3 0 1 0\nV 4 1 1 0\nQ what is this\n"
       "S 1 1 2 3 0 0 0 0 black-hole\nS 2 2 4 3 0 0 0 1.5 too-much\nS 3 1 2 3 0 0 0 -2\nS 4 2 4 3 0 0 0 0.5\nE\n";
