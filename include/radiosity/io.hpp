@@ -3,7 +3,9 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "radiosity/common.hpp"
@@ -15,7 +17,7 @@ namespace radiosity {
 inline namespace v1 {
 
 /// Loads a scene, choosing the reader by extension: .obj with its .mtl files, .json, .gltf and
-/// .glb, and the formats of Assimp.
+/// .glb, .vs3 (NIST View3D), and the formats of Assimp.
 /// OBJ: `o`/`g` names become groups, `Kd` the diffuse reflectance, `Ke` emitted radiance (so
 /// E = pi * Ke); without materials everything is grey 0.5. MTL `illum` modes map as the format
 /// means them (docs/SCENE_OBJ.md has the table): 0/1 diffuse; 2 (or none, with Ks) Phong from
@@ -42,6 +44,7 @@ inline namespace v1 {
 /// required extension (Draco, meshopt); Error{file_not_found} for a missing external buffer.
 /// Every other extension Assimp reads (FBX, COLLADA, 3DS, PLY, STL, ...): its scene graph and
 /// materials read the same way, where the format carries them.
+/// NIST View3D (.vs3): load_view3d()'s scene (its control line and title are dropped).
 /// Throws Error{invalid_argument} for an unsupported extension, and only radiosity::Error (or
 /// std::bad_alloc) whatever the file holds.
 /// Thread safety: may be called concurrently.
@@ -62,6 +65,95 @@ RADIOSITY_API Scene load_scene(const std::filesystem::path& path, const LoadOpti
 /// Thread safety: may be called concurrently.
 RADIOSITY_API Scene parse_scene_json(std::string_view text, const std::filesystem::path& base_dir = {},
                                      std::string_view source_name = "<string>", const LoadOptions& options = {});
+
+/// The control line (`C name=value ...`) of a NIST View3D vertex/surface file: View3D's run
+/// settings, under View3D's names in the comments. The library computes nothing from them;
+/// load_view3d() reads them so that save_view3d() writes them back and the View3D output
+/// writer (tools/radiosity/view3d_format.hpp) fills its header. A field the line does not set
+/// keeps View3D 3.2's default, given here. docs/SCENE_VS3.md has the format.
+/// Thread safety: a plain value.
+struct View3DControl {
+  /// encl: the surfaces form a closed enclosure (View3D then adjusts each row to sum to 1).
+  bool enclosure = false;
+  /// emit: View3D's output holds Hottel's script-F (exchange factors of grey surfaces of the
+  /// files' emissivities) instead of black-body view factors.
+  bool script_f = false;
+  /// out: the output file's format: 0 text, 1 binary (32-bit floats), 2 the sparse format of
+  /// uDALES' View3D fork. In [0, 2].
+  int output_format = 0;
+  /// eps: convergence criterion of View3D's adaptive integration (View3D warns outside
+  /// [1e-6, 1e-2]). Finite and > 0.
+  float epsilon = 1e-4f;
+  int max_unobstructed_recursions = 12;  ///< maxU: recursion limit of unobstructed factors, >= 4
+  int max_obstructed_recursions = 8;     ///< maxO: recursion limit of obstructed factors, >= 4
+  int min_obstructed_recursions = 0;     ///< minO: recursions always made for obstructed factors, >= 0
+  /// row: compute only this row (a 1-based surface number; 0 = every row). At most the
+  /// radiating surfaces.
+  int row = 0;
+  /// col: with `row`, compute only this factor (1-based; 0 = the whole row). Needs row > 0.
+  int column = 0;
+  int list = 0;                      ///< list: detail of View3D's log file, 0 (least) to 3
+  bool reverse_projections = false;  ///< prjD: View3D's projection test in reverse (written only when true)
+  /// Words View3D 3.2 does not know (later versions' and forks' maxV, maxD, ...), as written,
+  /// name and value, in order of first appearance (a repeated name keeps its last value);
+  /// written back after the others. Neither may be empty or hold a blank, ',', '=' or '!'.
+  std::vector<std::pair<std::string, std::string>> other;
+};
+
+/// What load_view3d() reads from a View3D file. Thread safety: a plain value.
+struct View3DFile {
+  /// One polygon per surface, in the file's surface order, so PolygonId = surface number - 1
+  /// (radiating surfaces first, then obstruction-only ones, as View3D numbers them).
+  Scene scene;
+  View3DControl control;  ///< the control line(s)
+  std::string title;      ///< the last `T` line's text, blanks trimmed ("" when there is none)
+};
+
+/// Reads a NIST View3D 3-D vertex/surface file (.vs3, "F 3" geometry; G. Walton, NISTIR 6925,
+/// 2002; docs/SCENE_VS3.md). Each surface becomes one polygon, in surface order
+/// (PolygonId = surface number - 1), counter-clockwise seen from its radiating side as in the
+/// file, coordinates in the file's units (areas in those units squared). Its group is its
+/// name ("s<N>" for surface N without one, with a warning), or, for a surface combined with
+/// another (cmbn > 0), that surface's name, so that group-level view factors are View3D's
+/// combined rows. Its material is grey and diffuse, reflectance 1 - emissivity, one material
+/// (named "emissivity <e>") per distinct emissivity; obstruction-only surfaces (`O`) get
+/// Scene::set_obstruction_only() and emissivity 1 unless their line gives one in the `S` layout.
+/// Errors name file and line (Error{parse_error} for syntax, Error{invalid_scene} for geometry):
+/// a number that is not one, a vertex or surface numbered out of sequence, a radiating surface
+/// after an obstruction surface, a vertex index out of range, a bad base or combine number, a
+/// surface that is not one convex planar polygon (degenerate, non-planar or non-convex: split
+/// it into triangles), mask (`M`) and null (`N`) surfaces, 2-D ("F 2") and BLAST ("F 3a")
+/// geometry, a bad control value (out outside [0, 2], col without row, row beyond the
+/// surfaces), no surface at all; Error{file_not_found} for a missing file. Forgiven with one
+/// warning per kind (an Error under options.strict): an emissivity outside (0, 1] (clamped to
+/// 0.01 or 1), a surface without a name, a subsurface (base > 0: View3D subtracts it from its
+/// base, here both are whole polygons), maxU/maxO below 4, minO, row or col below 0 (clamped as
+/// View3D does), an unknown line. Notes (warnings even under strict): an unknown control word
+/// (kept in View3DControl::other), an `X` transformation line (ignored, as View3D 3.2 does), no
+/// end-of-data line (`E` or `*`). Throws only radiosity::Error (or std::bad_alloc).
+/// Thread safety: may be called concurrently.
+RADIOSITY_API View3DFile load_view3d(const std::filesystem::path& path, const LoadOptions& options = {});
+
+/// Writes `scene` as a View3D 3-D vertex/surface file that View3D and load_view3d() read:
+/// `T title` (line breaks in it become blanks), the control line with every field of
+/// `control`, "F 3", the corners of all polygons as vertices (bit-identical positions shared,
+/// each written with the fewest digits that read back to the same float), then one surface per
+/// polygon in polygon order, radiating polygons first and obstruction-only ones (`O`) after, so
+/// surface number = PolygonId + 1 whenever the obstruction-only polygons come last (always so
+/// for a scene load_view3d() read). A polygon of more than 4 corners is split into a fan of
+/// convex quadrilaterals (and a triangle) from its first corner, the later pieces combined
+/// with the first (cmbn), which View3D reports as one surface; load_view3d() reads them back
+/// as that many polygons of one group. Emissivity = 1 - the mean of the material's diffuse
+/// reflectance (emission, colour and specular parts are not written); the name is the group's,
+/// with blanks, ',' and '!' made '_' (View3D names are one word). Base and cmbn are otherwise 0.
+/// load -> save -> load gives the same polygons, order, groups, obstruction flags, emissivities
+/// (to float rounding), title and control.
+/// Throws Error{invalid_argument} for a scene without radiating polygons or a control value
+/// that load_view3d() would not read back as written (see View3DControl's ranges; row and
+/// col at most the radiating surfaces written), Error{io_error} naming the path when the file
+/// cannot be written. Thread safety: may be called concurrently for different paths.
+RADIOSITY_API void save_view3d(const Scene& scene, const View3DControl& control, const std::string& title,
+                               const std::filesystem::path& path);
 
 /// Writes linear float RGB (channels R, G, B) and each layer as LAYER.R/.G/.B. Throws
 /// Error{io_error} naming the path when the file cannot be written, Error{invalid_argument}

@@ -388,7 +388,7 @@ TEST_CASE("Assimp broken COLLADA: a stray character in an index list - an array 
 TEST_CASE("an unsupported extension lists the formats load_scene reads") {
   const Error e = load_error(write("scene.abc", "nothing"));
   CHECK(e.code() == ErrorCode::invalid_argument);
-  CHECK(contains(e.what(), "unsupported extension '.abc' (supported: .obj, .json, .gltf, .glb, and through Assimp "));
+  CHECK(contains(e.what(), "unsupported extension '.abc' (supported: .obj, .json, .gltf, .glb, .vs3, and through Assimp "));
   CHECK(contains(e.what(), " .fbx "));
   CHECK(contains(e.what(), " .ply "));
 }

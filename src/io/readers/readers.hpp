@@ -19,6 +19,9 @@ Scene load_scene_json(const std::filesystem::path& path, const LoadOptions& opti
 /// glTF 2.0, .gltf (embedded or external buffers) or .glb (docs/SCENE_GLTF.md).
 Scene load_gltf(const std::filesystem::path& path, const LoadOptions& options);
 
+/// NIST View3D vertex/surface files (.vs3): load_view3d()'s scene (docs/SCENE_VS3.md).
+Scene load_view3d(const std::filesystem::path& path, const LoadOptions& options);
+
 /// Every other format Assimp reads (FBX, COLLADA, 3DS, PLY, STL, ...; docs/SCENE_GLTF.md).
 Scene load_assimp(const std::filesystem::path& path, const LoadOptions& options);
 
