@@ -2,12 +2,15 @@
 // polygons or its elements (sparse: CSV triplets, JSON CSR, Matrix Market).
 #include "factors.hpp"
 
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
 
 #include "factors_format.hpp"
+#include "view3d_format.hpp"
 
 namespace cli {
 
@@ -21,6 +24,7 @@ struct FactorsArgs {
   std::string correction = "none";
   std::string row_sums;
   bool sparse = false;
+  bool level_given = false, correction_given = false;  // set from the options' counts
   std::string output;
   std::string groups;
   // The library's defaults; an explicit 0 is passed on and rejected with the field named.
@@ -58,7 +62,24 @@ void write_text(const std::string& path, const std::string& text) {
 
 int run_factors(const FactorsArgs& a) {
   return run_guarded([&] {
-    rad::Scene scene = load(a.scene, a.strict, a.photometric);
+    // A View3D file brings its control line: encl=1 asks for the enclosure correction, and its
+    // factors are per surface (a polygon each).
+    std::string extension = std::filesystem::path(a.scene).extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool vs3 = extension == ".vs3";
+    rad::View3DControl control;
+    std::string title;
+    rad::Scene scene;
+    if (vs3) {
+      rad::LoadOptions load_options;
+      load_options.strict = a.strict;
+      rad::View3DFile file = rad::load_view3d(a.scene, load_options);
+      scene = std::move(file.scene);
+      control = file.control;
+      title = file.title;
+    } else {
+      scene = load(a.scene, a.strict, a.photometric);
+    }
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
     if (a.method == "hierarchical") {
@@ -76,20 +97,32 @@ int run_factors(const FactorsArgs& a) {
     o.mesh.max_patch_area = a.max_patch_area;
     o.mesh.max_element_area = a.max_element_area;
     o.groups = split_list(a.groups);
-    o.level = a.level == "polygon" ? rad::ViewFactorLevel::polygon
-              : a.level == "element" ? rad::ViewFactorLevel::element
+    std::string level = a.level, correction = a.correction;
+    std::string chosen;  // what the defaults chose, and why
+    if (!a.level_given && (vs3 || a.format == "view3d")) {
+      level = "polygon";
+      chosen += vs3 ? "level polygon (a View3D file's surfaces)" : "level polygon (--format view3d)";
+    }
+    if (!a.correction_given && vs3 && control.enclosure) {
+      correction = "enclosure";
+      chosen += std::string(chosen.empty() ? "" : ", ") + "correction enclosure (the file's control line says encl=1)";
+    }
+    if (!chosen.empty()) std::fprintf(stderr, "factors: %s\n", chosen.c_str());
+    o.level = level == "polygon" ? rad::ViewFactorLevel::polygon
+              : level == "element" ? rad::ViewFactorLevel::element
                                      : rad::ViewFactorLevel::group;
-    o.correction = a.correction == "reciprocity" ? rad::ViewFactorCorrection::reciprocity
-                   : a.correction == "enclosure" ? rad::ViewFactorCorrection::enclosure
+    o.correction = correction == "reciprocity" ? rad::ViewFactorCorrection::reciprocity
+                   : correction == "enclosure" ? rad::ViewFactorCorrection::enclosure
                                                  : rad::ViewFactorCorrection::none;
-    if (o.level != rad::ViewFactorLevel::group && a.format != "json" && a.format != "mtx" && a.format != "csv")
-      throw rad::Error(rad::ErrorCode::invalid_argument, "--format " + a.format + " is for --level group");
+    if (a.format == "view3d" && o.level == rad::ViewFactorLevel::element)
+      throw rad::Error(rad::ErrorCode::invalid_argument, "--format view3d is for --level polygon or group");
     if (o.level == rad::ViewFactorLevel::group && a.format == "mtx")
       throw rad::Error(rad::ErrorCode::invalid_argument, "--format mtx is for --level polygon or element");
     ProgressBar bar;
     o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
     // The group level without a correction is view_factors() itself, as before the levels.
-    const bool matrix = o.level != rad::ViewFactorLevel::group || o.correction != rad::ViewFactorCorrection::none;
+    const bool matrix = o.level != rad::ViewFactorLevel::group || o.correction != rad::ViewFactorCorrection::none ||
+                        a.format == "view3d";
     rad::ViewFactorMatrix m;
     rad::GroupViewFactors v;
     if (matrix)
@@ -100,10 +133,25 @@ int run_factors(const FactorsArgs& a) {
     if (matrix && o.level == rad::ViewFactorLevel::group) v = group_factors(m, 0);
 
     std::string text;
-    if (o.level == rad::ViewFactorLevel::group)
+    if (a.format == "view3d") {
+      // View3D's output is dense: n^2 numbers of about 9 characters each.
+      constexpr std::size_t kMaxDenseRows = 10000;
+      if (m.rows() > kMaxDenseRows)
+        throw rad::Error(rad::ErrorCode::invalid_argument,
+                         "--format view3d writes every factor, zeros included: " + std::to_string(m.rows()) +
+                             " rows would make " + std::to_string(m.rows() * m.rows() / 100000000 + 1) +
+                             "00 million numbers; above " + std::to_string(kMaxDenseRows) +
+                             " rows use the sparse --format mtx or json");
+      // View3D's output file: its header records encl as the run had it.
+      control.enclosure = o.correction == rad::ViewFactorCorrection::enclosure;
+      text = view3d_output(m, view3d_emissivities(scene, m), control);
+    } else if (o.level == rad::ViewFactorLevel::group)
       text = a.format == "json" ? factors_json(v, a.sparse, a.method) : factors_csv(v, a.sparse);
     else
       text = a.format == "json" ? matrix_json(m, o.correction) : a.format == "mtx" ? matrix_market(m) : matrix_csv(m);
+    if (a.format == "view3d" && control.output_format == 1 && (a.output.empty() || a.output == "-"))
+      throw rad::Error(rad::ErrorCode::invalid_argument,
+                       "the control line asks for View3D's binary output (out=1): give a file with -o");
     write_text(a.output, text);
     if (!a.row_sums.empty()) {
       if (!matrix) m = rad::view_factor_matrix(scene, o);  // the group rows as a matrix
@@ -117,7 +165,7 @@ int run_factors(const FactorsArgs& a) {
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
     } else {
       std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s, %.3f s%s%s\n", m.rows(),
-                   a.level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), m.seconds,
+                   level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), m.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
       // Rows that see nothing: one-sided polygons whose fronts face away from everything.
       std::size_t blind = 0;
@@ -133,7 +181,7 @@ int run_factors(const FactorsArgs& a) {
                    c.reciprocity_before, c.row_sum_error_before, c.row_sum_rms_before);
       if (o.correction != rad::ViewFactorCorrection::none)
         std::fprintf(stderr, "factors: %s correction changed factors by up to %.3g (rms %.3g)%s\n",
-                     a.correction.c_str(), c.largest_change, c.rms_change,
+                     correction.c_str(), c.largest_change, c.rms_change,
                      o.correction == rad::ViewFactorCorrection::enclosure
                          ? (", " + std::to_string(c.iterations) + " iterations, " + std::to_string(c.clamped) +
                             " factors clamped to 0, " + std::to_string(c.empty_rows) + " rows see nothing")
@@ -177,8 +225,9 @@ Command add_factors_command(CLI::App& app) {
       ->check(CLI::IsMember({"none", "reciprocity", "enclosure"}))
       ->capture_default_str();
   cmd->add_option("--format", a.format,
-                  "Output format: csv, json; mtx (Matrix Market, 1-based) for --level polygon or element")
-      ->check(CLI::IsMember({"csv", "json", "mtx"}))
+                  "Output format: csv, json; mtx (Matrix Market, 1-based) for --level polygon or element; view3d "
+                  "(View3D's output file: areas, dense rows, emissivities; implies --level polygon)")
+      ->check(CLI::IsMember({"csv", "json", "mtx", "view3d"}))
       ->capture_default_str();
   cmd->add_option("--row-sums", a.row_sums,
                   "Also write each row's area, sum, sky view factor (1 - sum) and standard error as CSV here");
@@ -208,7 +257,13 @@ Command add_factors_command(CLI::App& app) {
       ->check(non_negative<float>());
   add_strict_flag(*cmd, a.strict);
   add_photometric_flag(*cmd, a.photometric);
-  return Command{cmd, [args] { return run_factors(*args); }};
+  CLI::Option* level = cmd->get_option("--level");
+  CLI::Option* correction = cmd->get_option("--correction");
+  return Command{cmd, [args, level, correction] {
+                   args->level_given = level->count() > 0;
+                   args->correction_given = correction->count() > 0;
+                   return run_factors(*args);
+                 }};
 }
 
 }  // namespace cli
