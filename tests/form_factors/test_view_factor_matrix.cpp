@@ -8,6 +8,11 @@
 #include <string>
 #include <vector>
 
+#include <zip.h>
+
+#include <cstring>
+
+#include "../../tools/radiosity/npz_format.hpp"
 #include "support/scenes.hpp"
 
 namespace {
@@ -98,6 +103,25 @@ double reciprocity_error(const rad::ViewFactorMatrix& m) {
       worst = std::max(worst, std::fabs(a - b) / std::max(a, b));
     }
   return worst;
+}
+
+/// A member of a zip archive, read whole; empty when it is missing.
+std::string zip_member(zip_t* archive, const char* name) {
+  zip_stat_t st;
+  if (zip_stat(archive, name, 0, &st) != 0) return {};
+  zip_file_t* f = zip_fopen(archive, name, 0);
+  std::string bytes(static_cast<std::size_t>(st.size), '\0');
+  const zip_int64_t got = zip_fread(f, bytes.data(), st.size);
+  zip_fclose(f);
+  return got == static_cast<zip_int64_t>(st.size) ? bytes : std::string();
+}
+
+/// The header dict and the data of a .npy file (version 1.0), or empty strings.
+std::pair<std::string, std::string> parse_npy(const std::string& npy) {
+  if (npy.size() < 10 || npy.compare(0, 8, std::string("\x93NUMPY\x01\x00", 8)) != 0) return {};
+  const std::size_t length = static_cast<unsigned char>(npy[8]) | (static_cast<std::size_t>(static_cast<unsigned char>(npy[9])) << 8);
+  if ((10 + length) % 64 != 0 || npy.size() < 10 + length) return {};
+  return {npy.substr(10, length), npy.substr(10 + length)};
 }
 
 }  // namespace
@@ -291,5 +315,45 @@ TEST_SUITE("form_factors") {
     const rad::ViewFactorMatrix stopped = rad::view_factor_matrix(s, o);
     CHECK(stopped.cancelled);
     CHECK(stopped.row_offsets.size() == stopped.rows() + 1);
+  }
+
+  TEST_CASE("radiosity factors --format npz: scipy.sparse's CSR archive - members - headers aligned to 64 bytes - the "
+            "arrays as they are") {
+    const rad::Scene s = test::closed_box(rad::Material{});
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.form_factors.hemisphere_rays = 64;
+    const rad::ViewFactorMatrix m = rad::view_factor_matrix(s, o);
+    const std::string path = std::string(RADIOSITY_TEST_TMP) + "/box.npz";
+    cli::write_npz(m, path);
+    int error = 0;
+    zip_t* archive = zip_open(path.c_str(), ZIP_RDONLY, &error);
+    REQUIRE(archive != nullptr);
+    const auto [data_header, data] = parse_npy(zip_member(archive, "data.npy"));
+    CHECK(data_header.find("'descr': '<f4'") != std::string::npos);
+    CHECK(data_header.find("'shape': (" + std::to_string(m.non_zeros()) + ",)") != std::string::npos);
+    REQUIRE(data.size() == m.values.size() * 4);
+    CHECK(std::memcmp(data.data(), m.values.data(), data.size()) == 0);
+    const auto [indptr_header, indptr] = parse_npy(zip_member(archive, "indptr.npy"));
+    CHECK(indptr_header.find("'descr': '<i8'") != std::string::npos);
+    REQUIRE(indptr.size() == (m.rows() + 1) * 8);
+    std::int64_t last = 0;
+    std::memcpy(&last, indptr.data() + m.rows() * 8, 8);
+    CHECK(last == static_cast<std::int64_t>(m.non_zeros()));
+    const auto [format_header, format] = parse_npy(zip_member(archive, "format.npy"));
+    CHECK(format_header.find("'descr': '|S3'") != std::string::npos);
+    CHECK(format_header.find("'shape': ()") != std::string::npos);
+    CHECK(format == "csr");
+    const auto [shape_header, shape] = parse_npy(zip_member(archive, "shape.npy"));
+    std::int64_t dims[2] = {0, 0};
+    REQUIRE(shape.size() == 16);
+    std::memcpy(dims, shape.data(), 16);
+    CHECK(dims[0] == 6);
+    CHECK(dims[1] == 6);
+    for (const char* name : {"indices.npy", "ids.npy", "area.npy", "sky.npy", "row_standard_error.npy"})
+      CHECK_MESSAGE(!parse_npy(zip_member(archive, name)).first.empty(), name);
+    zip_close(archive);
+    CHECK_THROWS_AS(cli::write_npz(m, std::string(RADIOSITY_TEST_TMP) + "/no/such/dir/box.npz"), rad::Error);
   }
 }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "factors_format.hpp"
+#include "npz_format.hpp"
 #include "view3d_format.hpp"
 
 namespace cli {
@@ -122,7 +123,7 @@ int run_factors(const FactorsArgs& a) {
     o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
     // The group level without a correction is view_factors() itself, as before the levels.
     const bool matrix = o.level != rad::ViewFactorLevel::group || o.correction != rad::ViewFactorCorrection::none ||
-                        a.format == "view3d";
+                        a.format == "view3d" || a.format == "npz";
     rad::ViewFactorMatrix m;
     rad::GroupViewFactors v;
     if (matrix)
@@ -133,7 +134,11 @@ int run_factors(const FactorsArgs& a) {
     if (matrix && o.level == rad::ViewFactorLevel::group) v = group_factors(m, 0);
 
     std::string text;
-    if (a.format == "view3d") {
+    if (a.format == "npz") {
+      if (a.output.empty() || a.output == "-")
+        throw rad::Error(rad::ErrorCode::invalid_argument, "--format npz writes a zip archive: give a file with -o");
+      write_npz(m, a.output);
+    } else if (a.format == "view3d") {
       // View3D's output is dense: n^2 numbers of about 9 characters each.
       constexpr std::size_t kMaxDenseRows = 10000;
       if (m.rows() > kMaxDenseRows)
@@ -152,7 +157,7 @@ int run_factors(const FactorsArgs& a) {
     if (a.format == "view3d" && control.output_format == 1 && (a.output.empty() || a.output == "-"))
       throw rad::Error(rad::ErrorCode::invalid_argument,
                        "the control line asks for View3D's binary output (out=1): give a file with -o");
-    write_text(a.output, text);
+    if (a.format != "npz") write_text(a.output, text);
     if (!a.row_sums.empty()) {
       if (!matrix) m = rad::view_factor_matrix(scene, o);  // the group rows as a matrix
       write_text(a.row_sums, row_sums_csv(m));
@@ -226,8 +231,9 @@ Command add_factors_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--format", a.format,
                   "Output format: csv, json; mtx (Matrix Market, 1-based) for --level polygon or element; view3d "
-                  "(View3D's output file: areas, dense rows, emissivities; implies --level polygon)")
-      ->check(CLI::IsMember({"csv", "json", "mtx", "view3d"}))
+                  "(View3D's output file: areas, dense rows, emissivities; implies --level polygon); npz (scipy.sparse's "
+                  "CSR archive with ids, area and sky per row; needs -o)")
+      ->check(CLI::IsMember({"csv", "json", "mtx", "view3d", "npz"}))
       ->capture_default_str();
   cmd->add_option("--row-sums", a.row_sums,
                   "Also write each row's area, sum, sky view factor (1 - sum) and standard error as CSV here");
