@@ -144,9 +144,13 @@ void city_part(const Args& a) {
       }
     if (area > 0.0) std::printf(" %s %.3f", city.scene.groups()[g].c_str(), sky / area);
   }
-  std::size_t negative = 0;
-  for (const double s : m.sky) negative += s < 0.0 ? 1 : 0;
-  std::printf("\n    rows whose sum exceeds 1 (noise): %zu\n", negative);
+  std::size_t over = 0;
+  for (std::size_t i = 0; i < m.rows(); ++i) {
+    double sum = m.sky[i];
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) sum += static_cast<double>(m.values[k]);
+    over += sum > 1.0 + 3.0 * m.sky_standard_error[i] + 1e-6 ? 1 : 0;
+  }
+  std::printf("\n    rows whose factors and sky add up to more than 1 (beyond 3 standard errors): %zu\n", over);
 }
 
 void enclosure_part(const Args& a) {

@@ -352,11 +352,16 @@ struct ViewFactorMatrix {
   std::vector<std::uint64_t> row_offsets;  ///< rows + 1 entries, row_offsets[0] = 0
   std::vector<std::uint32_t> columns;
   std::vector<float> values;           ///< the factors, > 0
-  /// Per row: 1 - sum_j F_ij after the correction, the part of the hemisphere that sees no
-  /// surface of the matrix (the sky of an open scene, light that escapes; 0 in a closed
-  /// enclosure after ViewFactorCorrection::enclosure). Negative where noise made a row sum
-  /// exceed 1.
+  /// Per row: the sky view factor, the part of the hemisphere above the row's surface (cosine-
+  /// weighted) in which no polygon lies at all, estimated by ViewFactorOptions::form_factors.
+  /// hemisphere_rays rays per element (every method): what urban-climate codes call the sky
+  /// view factor, 0 in a closed enclosure. It is not 1 - sum_j F_ij: the rest of that
+  /// remainder sees back faces, obstruction-only polygons, polygons left out by `groups`, or
+  /// nothing where a surface is covered (the ground under a building sees the building's
+  /// inside: remainder 1, sky 0).
   std::vector<double> sky;
+  /// Per row: the binomial standard error of `sky`, sqrt(sky (1 - sky) / rays).
+  std::vector<double> sky_standard_error;
   /// Per row: the estimated standard error of the row's sum from the estimator alone (Monte
   /// Carlo: binomial, sqrt(S (1 - S) / rays) over the row's rays); empty for estimators that
   /// state none (ray_cast, analytic, hemicube, hierarchical).

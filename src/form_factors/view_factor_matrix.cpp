@@ -20,8 +20,14 @@
 #include <optional>
 #include <string>
 
+#include "core/frame.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
+#include "core/rng.hpp"
+#include "core/sampling.hpp"
+#include "core/streams.hpp"
 #include "form_factors/estimators.hpp"
+#include "geometry/ray_scene.hpp"
 #include "form_factors/view_factor_correction.hpp"
 #include "radiosity/form_factors.hpp"
 
@@ -55,6 +61,59 @@ std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vect
     if (!polygon.obstruction_only && keep_group[polygon.group]) row_of[p] = rows++;
   }
   return row_of;
+}
+
+/// Per row, the sky view factor: the cosine-weighted fraction of the hemisphere above the row's
+/// elements (sources[first[r] .. first[r + 1]), area-weighted) in which no polygon lies, from
+/// `rays` stratified rays per element (points and directions each stratified, paired by a
+/// random permutation), each drawn from the element's own stream. Fills out.sky and
+/// out.sky_standard_error (binomial over the row's rays).
+void row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& sources,
+             const std::vector<std::uint64_t>& first, const FormFactorOptions& ff, ViewFactorMatrix& out) {
+  const std::size_t rows = first.size() - 1;
+  const detail::RayScene occluders = detail::RayScene::from_polygons(scene);
+  const float epsilon = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
+  const std::uint32_t n = ff.hemisphere_rays;
+  std::vector<double> escaped(sources.size(), 0.0);
+  detail::parallel_for(ff.threads, sources.size(), 16, [&](std::size_t begin, std::size_t end) {
+    std::vector<glm::vec2> points(n), directions(n);
+    std::vector<glm::vec3> origin(n), direction(n);
+    std::vector<std::uint8_t> blocked(n);
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t e = sources[k];
+      const glm::vec3 normal = hierarchy.normal(e);
+      glm::vec3 t, b;
+      detail::tangent_frame(normal, t, b);
+      detail::Rng rng(ff.seed, e, detail::stream_key(detail::Stream::view_factor_sky));
+      detail::stratified(n, rng, true, points.data());
+      detail::stratified(n, rng, true, directions.data());
+      detail::shuffle(directions.data(), n, rng);
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const glm::vec3 w = detail::cosine_hemisphere(directions[i]);
+        origin[i] = hierarchy.sample_point(e, points[i]) + epsilon * normal;
+        direction[i] = w.x * t + w.y * b + w.z * normal;
+      }
+      occluders.occluded_incoherent(n, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
+                                    blocked.data());
+      std::uint32_t open = 0;
+      for (const std::uint8_t x : blocked) open += x ? 0 : 1;
+      escaped[k] = static_cast<double>(open) / static_cast<double>(n);
+    }
+  });
+  out.sky.assign(rows, 0.0);
+  out.sky_standard_error.assign(rows, 0.0);
+  for (std::size_t r = 0; r < rows; ++r) {
+    double area = 0.0, sky = 0.0;
+    for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
+      const double a = hierarchy.element(sources[k]).area;
+      area += a;
+      sky += a * escaped[k];
+    }
+    if (!(area > 0.0)) continue;
+    out.sky[r] = sky / area;
+    const double total = static_cast<double>(n) * static_cast<double>(first[r + 1] - first[r]);
+    out.sky_standard_error[r] = std::sqrt(out.sky[r] * (1.0 - out.sky[r]) / total);
+  }
 }
 
 /// The rows of every selected polygon (row_of[p] != kNone) from the estimator `ff` names, on
@@ -159,6 +218,7 @@ void polygon_rows(const Scene& scene, const std::vector<std::uint32_t>& row_of, 
       break;
     }
   }
+  if (!out.cancelled) row_sky(scene, hierarchy, sources, first, ff, out);
 }
 
 /// A scene whose polygons are the leaf elements of `hierarchy` (in leaves() order), with their
@@ -283,6 +343,25 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     out.method = links ? "hierarchical" : to_string(ff.method);
     out.element_count = g.element_count;
     out.cancelled = g.cancelled;
+    if (!out.cancelled) {
+      // The groups' sky view factors, from the elements of their polygons (not obstruction-only).
+      const PatchHierarchy hierarchy(scene, options.mesh);
+      std::vector<std::uint32_t> row_of_group(scene.groups().size(), kNone);
+      for (std::size_t i = 0; i < n; ++i) row_of_group[out.ids[i]] = static_cast<std::uint32_t>(i);
+      std::vector<std::uint64_t> first(n + 1, 0);
+      auto row_of = [&](std::uint32_t e) {
+        const Polygon& p = scene.polygons()[hierarchy.patches()[hierarchy.element(e).patch].polygon];
+        return p.obstruction_only ? kNone : row_of_group[p.group];
+      };
+      for (const std::uint32_t e : hierarchy.leaves())
+        if (row_of(e) != kNone) ++first[row_of(e) + 1];
+      for (std::size_t r = 0; r < n; ++r) first[r + 1] += first[r];
+      std::vector<std::uint32_t> sources(first[n]);
+      std::vector<std::uint64_t> at(first.begin(), first.end() - 1);
+      for (const std::uint32_t e : hierarchy.leaves())
+        if (row_of(e) != kNone) sources[at[row_of(e)]++] = e;
+      row_sky(scene, hierarchy, sources, first, ff, out);
+    }
   } else {
     detail::ProgressGate gate(options.on_progress);
     Progress start;
@@ -319,11 +398,9 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     out.columns = std::move(F.columns);
     out.values = std::move(F.values);
   }
-  out.sky.assign(out.rows(), 0.0);
-  for (std::size_t i = 0; i < out.rows(); ++i) {
-    double s = 0.0;
-    for (std::uint64_t k = out.row_offsets[i]; k < out.row_offsets[i + 1]; ++k) s += static_cast<double>(out.values[k]);
-    out.sky[i] = 1.0 - s;
+  if (out.sky.size() != out.rows()) {  // cancelled before the sky
+    out.sky.assign(out.rows(), 0.0);
+    out.sky_standard_error.assign(out.rows(), 0.0);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;

@@ -133,7 +133,7 @@ inline std::string matrix_market(const radiosity::ViewFactorMatrix& m) {
 }
 
 /// JSON: {"level", "method", "correction", "rows", "non_zeros", "seconds", "ids", "area",
-/// "row_offsets", "columns", "values", "sky", and "row_standard_error" when the estimator states
+/// "row_offsets", "columns", "values", "sky", "sky_standard_error", and "row_standard_error" when the estimator states
 /// one}: the CSR arrays as they are (0-based, columns index rows).
 inline std::string matrix_json(const radiosity::ViewFactorMatrix& m, radiosity::ViewFactorCorrection correction) {
   nlohmann::ordered_json j;
@@ -151,18 +151,24 @@ inline std::string matrix_json(const radiosity::ViewFactorMatrix& m, radiosity::
   for (const float v : m.values) values.push_back(static_cast<double>(v));
   j["values"] = std::move(values);
   j["sky"] = m.sky;
+  j["sky_standard_error"] = m.sky_standard_error;
   if (!m.row_standard_error.empty()) j["row_standard_error"] = m.row_standard_error;
   return j.dump() + "\n";
 }
 
-/// Per row: `row,id,area,row_sum,sky,standard_error` (standard_error empty where the estimator
-/// states none; the group level names the group in `id`).
+/// Per row: `row,id,area,row_sum,sky,sky_standard_error,row_standard_error`: the row's sum of
+/// factors, its sky view factor (ViewFactorMatrix::sky) with its standard error, and the row
+/// sum's standard error where the estimator states one (empty otherwise); the group level names
+/// the group in `id`.
 inline std::string row_sums_csv(const radiosity::ViewFactorMatrix& m) {
-  std::string out = "row,id,area,row_sum,sky,standard_error\n";
+  std::string out = "row,id,area,row_sum,sky,sky_standard_error,row_standard_error\n";
   for (std::size_t i = 0; i < m.rows(); ++i) {
+    double sum = 0.0;
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) sum += static_cast<double>(m.values[k]);
     const std::string id = m.names.empty() ? std::to_string(m.ids[i]) : csv_field(m.names[i]);
-    out += std::to_string(i) + "," + id + "," + csv_number(m.area[i]) + "," + csv_number(1.0 - m.sky[i]) + "," +
-           csv_number(m.sky[i]) + "," + (m.row_standard_error.empty() ? "" : csv_number(m.row_standard_error[i])) + "\n";
+    out += std::to_string(i) + "," + id + "," + csv_number(m.area[i]) + "," + csv_number(sum) + "," +
+           csv_number(m.sky[i]) + "," + csv_number(m.sky_standard_error[i]) + "," +
+           (m.row_standard_error.empty() ? "" : csv_number(m.row_standard_error[i])) + "\n";
   }
   return out;
 }

@@ -59,6 +59,7 @@ void write_npz(const radiosity::ViewFactorMatrix& m, const std::filesystem::path
   members.emplace_back("ids.npy", npy_vector("<u4", m.ids));
   members.emplace_back("area.npy", npy_vector("<f8", m.area));
   members.emplace_back("sky.npy", npy_vector("<f8", m.sky));
+  members.emplace_back("sky_standard_error.npy", npy_vector("<f8", m.sky_standard_error));
   if (!m.row_standard_error.empty()) members.emplace_back("row_standard_error.npy", npy_vector("<f8", m.row_standard_error));
 
   auto fail = [&](const std::string& why) {
