@@ -148,7 +148,8 @@ void city_part(const Args& a) {
   for (std::size_t i = 0; i < m.rows(); ++i) {
     double sum = m.sky[i];
     for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) sum += static_cast<double>(m.values[k]);
-    over += sum > 1.0 + 3.0 * m.sky_standard_error[i] + 1e-6 ? 1 : 0;
+    const double se = std::hypot(m.sky_standard_error[i], m.row_standard_error[i]);
+    over += sum > 1.0 + 3.0 * se + 1e-6 ? 1 : 0;
   }
   std::printf("\n    rows whose factors and sky add up to more than 1 (beyond 3 standard errors): %zu\n", over);
 }
