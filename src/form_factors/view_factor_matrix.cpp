@@ -68,14 +68,19 @@ std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vect
 /// `rays` stratified rays per element (points and directions each stratified, paired by a
 /// random permutation), each drawn from the element's own stream. Fills out.sky and
 /// out.sky_standard_error (binomial over the row's rays).
-void row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& sources,
-             const std::vector<std::uint64_t>& first, const FormFactorOptions& ff, ViewFactorMatrix& out) {
+/// Reports progress through `gate` between blocks of elements, from `done` (a fraction of
+/// Phase::form_factors already reported) to 1; returns false when cancelled (out.sky is then
+/// left empty).
+bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& sources,
+             const std::vector<std::uint64_t>& first, const FormFactorOptions& ff, detail::ProgressGate& gate,
+             double done, ViewFactorMatrix& out) {
   const std::size_t rows = first.size() - 1;
   const detail::RayScene occluders = detail::RayScene::from_polygons(scene);
   const float epsilon = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
   const std::uint32_t n = ff.hemisphere_rays;
   std::vector<double> escaped(sources.size(), 0.0);
-  detail::parallel_for(ff.threads, sources.size(), 16, [&](std::size_t begin, std::size_t end) {
+  // Elements [begin, end) of `sources`: their fractions of rays that meet nothing.
+  auto trace = [&](std::size_t begin, std::size_t end) {
     std::vector<glm::vec2> points(n), directions(n);
     std::vector<glm::vec3> origin(n), direction(n);
     std::vector<std::uint8_t> blocked(n);
@@ -99,7 +104,16 @@ void row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
       for (const std::uint8_t x : blocked) open += x ? 0 : 1;
       escaped[k] = static_cast<double>(open) / static_cast<double>(n);
     }
-  });
+  };
+  for (std::size_t block = 0; block < sources.size(); block += kChunkElements) {
+    const std::size_t block_end = std::min(sources.size(), block + kChunkElements);
+    detail::parallel_for(ff.threads, block_end - block, 16,
+                         [&](std::size_t begin, std::size_t end) { trace(block + begin, block + end); });
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = done + (1.0 - done) * static_cast<double>(block_end) / static_cast<double>(sources.size());
+    if (!gate.report(p, block_end == sources.size())) return false;
+  }
   out.sky.assign(rows, 0.0);
   out.sky_standard_error.assign(rows, 0.0);
   for (std::size_t r = 0; r < rows; ++r) {
@@ -114,6 +128,7 @@ void row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
     const double total = static_cast<double>(n) * static_cast<double>(first[r + 1] - first[r]);
     out.sky_standard_error[r] = std::sqrt(out.sky[r] * (1.0 - out.sky[r]) / total);
   }
+  return true;
 }
 
 /// The rows of every selected polygon (row_of[p] != kNone) from the estimator `ff` names, on
@@ -159,6 +174,9 @@ void polygon_rows(const Scene& scene, const std::vector<std::uint32_t>& row_of, 
   }
   out.element_count = sources.size();
   const bool monte_carlo = ff.method == FormFactorMethod::monte_carlo;
+  // The rows' share of the progress (the sky's rays come after them): about half of the rays
+  // for Monte Carlo, most of the work for the other estimators.
+  const double rows_share = monte_carlo ? 0.5 : 0.9;
   if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
 
   const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(scene, hierarchy, ff);
@@ -211,14 +229,14 @@ void polygon_rows(const Scene& scene, const std::vector<std::uint32_t>& row_of, 
     row = end;
     Progress p;
     p.phase = Phase::form_factors;
-    p.fraction = static_cast<double>(row) / static_cast<double>(rows);
-    if (!gate.report(p, row == rows)) {
+    p.fraction = rows_share * static_cast<double>(row) / static_cast<double>(rows);
+    if (!gate.report(p, false)) {
       out.cancelled = true;
       for (std::size_t r = row; r < rows; ++r) out.row_offsets[r + 1] = out.columns.size();
       break;
     }
   }
-  if (!out.cancelled) row_sky(scene, hierarchy, sources, first, ff, out);
+  if (!out.cancelled) out.cancelled = !row_sky(scene, hierarchy, sources, first, ff, gate, rows_share, out);
 }
 
 /// A scene whose polygons are the leaf elements of `hierarchy` (in leaves() order), with their
@@ -360,7 +378,9 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
       std::vector<std::uint64_t> at(first.begin(), first.end() - 1);
       for (const std::uint32_t e : hierarchy.leaves())
         if (row_of(e) != kNone) sources[at[row_of(e)]++] = e;
-      row_sky(scene, hierarchy, sources, first, ff, out);
+      // view_factors() reported its rows; the sky's rays report at the end, and may cancel.
+      detail::ProgressGate gate(options.on_progress);
+      out.cancelled = !row_sky(scene, hierarchy, sources, first, ff, gate, 1.0, out);
     }
   } else {
     detail::ProgressGate gate(options.on_progress);

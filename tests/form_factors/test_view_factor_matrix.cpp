@@ -320,6 +320,17 @@ TEST_SUITE("form_factors") {
     const rad::ViewFactorMatrix stopped = rad::view_factor_matrix(s, o);
     CHECK(stopped.cancelled);
     CHECK(stopped.row_offsets.size() == stopped.rows() + 1);
+    // Cancelled late, while the sky's rays are cast: every row there, the sky left at 0.
+    double last = 0.0;
+    o.on_progress = [&last](const rad::Progress& p) {
+      last = p.fraction;
+      return p.fraction < 0.95;
+    };
+    const rad::ViewFactorMatrix late = rad::view_factor_matrix(s, o);
+    CHECK(late.cancelled);
+    CHECK(late.rows() == 6);
+    CHECK(late.sky.size() == 6);
+    CHECK(last >= 0.95);
   }
 
   TEST_CASE("radiosity factors --format npz: scipy.sparse's CSR archive - members - headers aligned to 64 bytes - the "
