@@ -9,6 +9,7 @@ packages=(
   libstb-dev nlohmann-json3-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev
   libtinygltf-dev libassimp-dev
+  python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
 )
 
 missing=()
