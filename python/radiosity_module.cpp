@@ -670,7 +670,8 @@ PYBIND11_MODULE(radiosity, m) {
 
   py::class_<PolygonList>(m, "PolygonList",
                           "scene.polygons: a sequence view of the scene's polygons (len, indexing, iteration); "
-                          "each item is a Polygon copy.")
+                          "each item is a Polygon copy. It keeps its scene alive and sees its changes. Thread "
+                          "safety: as the scene's const methods.")
       .def("__len__", [](const PolygonList& l) { return l.scene->polygons().size(); })
       .def("__getitem__", [](const PolygonList& l, py::ssize_t i) {
         const auto n = static_cast<py::ssize_t>(l.scene->polygons().size());
@@ -869,7 +870,8 @@ PYBIND11_MODULE(radiosity, m) {
       "the file and line. Thread safety: releases the GIL; concurrent calls are safe.");
   m.def("cornell_box", &rad::cornell_box,
         "The Cornell box (geometry in mm, measured reflectances, light E = pi (17, 12, 4)); groups floor, ceiling, "
-        "back_wall, red_wall, green_wall, light, short_block, tall_block.");
+        "back_wall, red_wall, green_wall, light, short_block, tall_block. Thread safety: may be called "
+        "concurrently.");
   m.def("solve", &solve, kSolveDoc, py::arg("scene"), py::arg("method") = "auto", py::kw_only(),
         py::arg("tolerance") = 1e-3, py::arg("max_iterations") = 0, py::arg("threads") = 0u, py::arg("seed") = 1u,
         py::arg("form_factors") = "auto", py::arg("max_patch_area") = 0.0, py::arg("max_element_area") = 0.0,

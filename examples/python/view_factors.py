@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """View factors between a scene's polygons with the radiosity Python module (docs/PYTHON.md).
 
-    python3 examples/python/view_factors.py [SCENE] [OUT.npz]
+    PYTHONPATH=build/python /usr/bin/python3 examples/python/view_factors.py [SCENE] [OUT.npz]
+
+(PYTHONPATH is not needed once the module is installed; /usr/bin/python3 is the interpreter the
+module was built for on Debian, see docs/PYTHON.md.)
 
 Loads SCENE (default: tests/data/view3d/cube.vs3, a closed 2 m cube), computes the polygon-to-
 polygon view-factor matrix with ray-cast factors, prints each row's sum and sky view factor
