@@ -10,6 +10,7 @@ packages=(
   libnanoflann-dev libbenchmark-dev
   libtinygltf-dev libassimp-dev
   libzip-dev pkg-config
+  python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
 )
 
 missing=()

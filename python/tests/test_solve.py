@@ -1,0 +1,109 @@
+"""solve(): the furnace test on a closed cube, the Cornell box's energy balance, progress,
+cancel and errors."""
+import numpy as np
+import pytest
+
+import radiosity
+from conftest import unit_cube_arrays
+
+
+def test_furnace_closed_cube_gives_e_over_1_minus_rho():
+    vertices, faces, _ = unit_cube_arrays()
+    scene = radiosity.Scene(vertices, faces, reflectance=[0.5, 0.6, 0.7], emission=[1.0, 2.0, 3.0])
+    solution = radiosity.solve(scene, "gauss-seidel", tolerance=1e-7, max_patch_area=0.25)
+    assert solution.status == "converged"
+    expected = np.array([1.0, 2.0, 3.0]) / (1 - np.array([0.5, 0.6, 0.7]))
+    b = solution.polygon_radiosity()
+    assert b.shape == (6, 3)
+    np.testing.assert_allclose(b, np.tile(expected, (6, 1)), rtol=1e-3)
+    e = solution.element_radiosity()
+    assert e.shape == (len(solution.element_areas()), 3)
+    np.testing.assert_allclose(e, np.tile(expected, (len(e), 1)), rtol=1e-3)
+    assert solution.element_areas().sum() == pytest.approx(6.0)
+
+
+def test_cornell_box_solution_is_finite_and_balances_energy():
+    scene = radiosity.cornell_box()
+    phases = []
+    solution = radiosity.solve(scene, progress=lambda p: phases.append(p["phase"]))
+    assert solution.status == "converged"
+    assert solution.method in ("gauss-seidel", "hierarchical")
+    assert solution.iterations > 0 and solution.residual < 1e-3 and solution.seconds > 0
+    assert "form_factors" in phases
+    b = solution.polygon_radiosity()
+    assert b.shape == (len(scene.polygons), 3)
+    assert np.all(np.isfinite(b)) and np.all(b >= 0)
+    is_light = scene.polygon_group_ids() == scene.groups.index("light")
+    assert b[is_light].sum(axis=1).min() > 10 * b[~is_light].sum(axis=1).max()
+    np.testing.assert_allclose(solution.group_radiosity("light"), b[is_light][0], rtol=1e-3)
+    # Emitted = absorbed + escaped (the box is open at the front).
+    r = solution.report
+    np.testing.assert_allclose(r["emitted_power"], r["absorbed_power"] + r["escaped_power"], rtol=1e-3)
+    assert np.all(r["escaped_power"] > 0)
+    irradiance = solution.element_values("irradiance")
+    assert irradiance.shape == solution.element_radiosity().shape
+    assert np.all(solution.element_polygons() < len(scene.polygons))
+
+
+def test_mesh_vertex_values_on_a_triangle_scene():
+    vertices, quads, _ = unit_cube_arrays()
+    triangles = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    scene = radiosity.Scene(vertices, triangles, reflectance=[0.5] * 3, emission=[1.0] * 3)
+    solution = radiosity.solve(scene, tolerance=1e-6, max_patch_area=0.25)
+    values = solution.mesh_vertex_values(0)
+    assert values.shape == (8, 3)
+    np.testing.assert_allclose(values, np.full((8, 3), 2.0), rtol=5e-3)  # interpolated
+    assert solution.mesh_triangle_values(0, "irradiance").shape == (12, 3)
+
+
+def test_progress_can_cancel_and_its_exceptions_propagate(cube):
+    vertices, faces, _ = unit_cube_arrays()
+    scene = radiosity.Scene(vertices, faces, emission=[1.0] * 3)
+    cancelled = radiosity.solve(scene, progress=lambda p: False)
+    assert cancelled.status == "cancelled"
+
+    def fail(progress):
+        raise KeyError("from the callback")
+
+    with pytest.raises(KeyError, match="from the callback"):
+        radiosity.solve(scene, progress=fail)
+
+
+def test_solve_errors():
+    scene = radiosity.cornell_box()
+    with pytest.raises(radiosity.Error, match="tolerance") as info:
+        radiosity.solve(scene, tolerance=-1.0)
+    assert info.value.code == "invalid_argument"
+    with pytest.raises(ValueError, match="method"):
+        radiosity.solve(scene, "newton")
+    with pytest.raises(ValueError, match="quantity"):
+        radiosity.solve(radiosity.Scene(*unit_cube_arrays()[:2], emission=[1.0] * 3),
+                        max_patch_area=1.0).polygon_values("heat")
+
+
+def test_concurrent_solves_from_python_threads_agree():
+    # The GIL is released while solving and taken back for the progress callback: two threads
+    # solving at once finish, and give what one solve gives.
+    import threading
+
+    vertices, faces, _ = unit_cube_arrays()
+    emission = np.zeros((6, 3))
+    emission[5] = 1.0
+    scene = radiosity.Scene(vertices, faces, emission=emission)
+    reference = radiosity.solve(scene, max_patch_area=0.25, threads=1).element_radiosity()
+    results, calls = [None, None], [0, 0]
+
+    def work(k):
+        def count(progress):
+            calls[k] += 1
+
+        results[k] = radiosity.solve(scene, max_patch_area=0.25, threads=1, progress=count).element_radiosity()
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for k in range(2):
+        assert calls[k] > 0
+        np.testing.assert_array_equal(results[k], reference)
