@@ -525,6 +525,7 @@ py::object view_factor_matrix(const rad::Scene& scene, const std::string& level,
   info["names"] = string_list(m.names);
   info["area"] = vector_array<double>(m.area);
   info["sky"] = vector_array<double>(m.sky);
+  info["sky_standard_error"] = vector_array<double>(m.sky_standard_error);
   info["row_standard_error"] = m.row_standard_error.empty() ? py::object(py::none())
                                                             : py::object(vector_array<double>(m.row_standard_error));
   py::dict c;
