@@ -5,13 +5,19 @@
 //    error and row standard errors before the correction, the sky view factors per group;
 //  - a closed, obstructed enclosure of facets (a faceted room around a faceted block) in exact
 //    mode (ray_cast: contour integrals, occlusion by shaft-culled rays) and fast mode, both
-//    enclosure-corrected: their agreement per row sum and per large factor, and the speed ratio.
+//    enclosure-corrected: their agreement per row sum and per large factor, and the speed ratio;
+//    and, side by side with NIST View3D (G. N. Walton, "Calculation of obstructed view factors by
+//    adaptive integration", NISTIR 6925, 2002), built apart from this repository: --write-vs3
+//    writes the room as View3D's input file, --view3d-output reads View3D's text output for it
+//    and compares both modes with it per row sum, per large factor and overall.
 // Each part runs in one process after the other, so its peak RSS is the largest so far.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -30,14 +36,21 @@ struct Args {
   std::uint32_t rays = rad::FormFactorOptions{}.hemisphere_rays;
   unsigned threads = 0;
   bool city_part = true, enclosure_part = true;
-  float room_facet = 0.25f;  ///< the enclosure's facet size (a 4 m room): 0.25 gives 1 632 facets
+  /// The enclosure's facet size (a 4 m room): 0.25 gives 1 648 facets; 1/6 (0.1666667) 3 708, the
+  /// most below 4 000 whose floor facets end at the block's footprint (at 0.16 some lie partly
+  /// under it, see nothing there, and the enclosure correction refuses the room).
+  float room_facet = 0.25f;
+  std::string write_vs3;      ///< write the room as a View3D input file here (before computing)
+  std::string view3d_output;  ///< View3D's text output file (out=0) for that room, to compare with
+  double view3d_seconds = 0.0;  ///< View3D's wall time for it, measured outside (0: not given)
 };
 
 int usage(const char* bad) {
   if (bad) std::fprintf(stderr, "bench_view_factors: bad argument '%s'\n", bad);
   std::fprintf(stderr,
                "usage: bench_view_factors [22k|246k] [--blocks N] [--facet METRES] [--rays N] [--threads T]\n"
-               "                          [--room-facet METRES] [--only city|enclosure]\n");
+               "                          [--room-facet METRES] [--only city|enclosure]\n"
+               "                          [--write-vs3 FILE] [--view3d-output FILE [--view3d-seconds S]]\n");
   return bad ? 2 : 0;
 }
 
@@ -119,6 +132,166 @@ rad::Scene faceted_room(float facet) {
   return scene;
 }
 
+/// View3D's text output file (out=0; docs/SCENE_VS3.md, "Output file"; written by View3D's
+/// SaveF0): the header "<program> <version> <out> <encl> <emit> <N>", then the N areas, N rows
+/// F(i -> 1..N) ("%.6f") and the N emissivities, each a line of numbers.
+struct View3DOutput {
+  std::string program, version;
+  int enclosure = 0, script_f = 0;
+  std::size_t n = 0;
+  std::vector<double> area;
+  std::vector<float> factors;  ///< dense, row-major: F(i -> j) = factors[i * n + j], 0-based
+  double at(std::size_t i, std::size_t j) const { return static_cast<double>(factors[i * n + j]); }
+};
+
+/// Reads `path` into `out`; false, with a message on stderr, for a file that is not one.
+bool read_view3d_output(const std::string& path, View3DOutput& out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "bench_view_factors: cannot open View3D output '%s'\n", path.c_str());
+    return false;
+  }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const char* p = text.c_str();
+  char program[64] = {}, version[64] = {};
+  int format = -1, consumed = 0;
+  unsigned long n = 0;
+  if (std::sscanf(p, "%63s %63s %d %d %d %lu%n", program, version, &format, &out.enclosure, &out.script_f, &n,
+                  &consumed) != 6 ||
+      n == 0 || n > 20000) {
+    std::fprintf(stderr, "bench_view_factors: '%s' does not start with View3D's output header\n", path.c_str());
+    return false;
+  }
+  if (format != 0) {
+    std::fprintf(stderr, "bench_view_factors: '%s' is View3D output format %d; only the text format (out=0) is read\n",
+                 path.c_str(), format);
+    return false;
+  }
+  out.program = program;
+  out.version = version;
+  out.n = n;
+  p += consumed;
+  // The numbers follow in order; strtod skips the blanks and line ends between them.
+  auto next = [&p](double& v) {
+    char* end = nullptr;
+    v = std::strtod(p, &end);
+    if (end == p) return false;
+    p = end;
+    return true;
+  };
+  out.area.resize(out.n);
+  out.factors.resize(out.n * out.n);
+  double v = 0.0;
+  for (std::size_t i = 0; i < out.n; ++i)
+    if (!next(out.area[i])) {
+      std::fprintf(stderr, "bench_view_factors: '%s': area %zu is missing\n", path.c_str(), i + 1);
+      return false;
+    }
+  for (std::size_t k = 0; k < out.n * out.n; ++k) {
+    if (!next(v)) {
+      std::fprintf(stderr, "bench_view_factors: '%s': factor %zu of row %zu is missing\n", path.c_str(),
+                   k % out.n + 1, k / out.n + 1);
+      return false;
+    }
+    out.factors[k] = static_cast<float>(v);
+  }
+  for (std::size_t i = 0; i < out.n; ++i)
+    if (!next(v)) {
+      std::fprintf(stderr, "bench_view_factors: '%s': emissivity %zu is missing\n", path.c_str(), i + 1);
+      return false;
+    }
+  // View3D's normalisation (encl=1) divides each row by its sum: a row that sees nothing (a
+  // floor facet under the block) turns the whole matrix into NaN.
+  const std::size_t broken = static_cast<std::size_t>(
+      std::count_if(out.factors.begin(), out.factors.end(), [](float f) { return !std::isfinite(f); }));
+  if (broken > 0) {
+    std::fprintf(stderr,
+                 "bench_view_factors: '%s' holds %zu factors that are not numbers (View3D's encl=1 normalisation"
+                 " divides by the zero sums of rows that see nothing; write the room with encl=0)\n",
+                 path.c_str(), broken);
+    return false;
+  }
+  return true;
+}
+
+/// Largest and RMS of |difference| over a set of values, and where the largest is.
+struct Deviation {
+  double largest = 0.0, squares = 0.0;
+  std::size_t count = 0, where = 0;
+  void add(double d, std::size_t at = 0) {
+    if (std::fabs(d) > largest) {
+      largest = std::fabs(d);
+      where = at;
+    }
+    squares += d * d;
+    ++count;
+  }
+  double rms() const { return count ? std::sqrt(squares / static_cast<double>(count)) : 0.0; }
+};
+
+/// `m` against View3D's matrix: row sums, factors where View3D's is >= 0.01, and all N^2
+/// factors. Row r of `m` is polygon m.ids[r], which save_view3d() wrote as surface ids[r] + 1
+/// (the room has no obstruction-only polygons), so View3D's row and column ids[r].
+struct Agreement {
+  Deviation row_sums, large, all;
+};
+Agreement against_view3d(const rad::ViewFactorMatrix& m, const View3DOutput& v) {
+  Agreement a;
+  std::vector<double> row(v.n);
+  for (std::size_t r = 0; r < m.rows(); ++r) {
+    std::fill(row.begin(), row.end(), 0.0);
+    double ours = 0.0, theirs = 0.0;
+    for (std::uint64_t k = m.row_offsets[r]; k < m.row_offsets[r + 1]; ++k) {
+      row[m.ids[m.columns[k]]] = static_cast<double>(m.values[k]);
+      ours += static_cast<double>(m.values[k]);
+    }
+    const std::size_t i = m.ids[r];
+    for (std::size_t j = 0; j < v.n; ++j) {
+      const double f = v.at(i, j);
+      theirs += f;
+      a.all.add(row[j] - f, i);
+      if (f >= 0.01) a.large.add(row[j] - f, i);
+    }
+    a.row_sums.add(ours - theirs, i);
+  }
+  return a;
+}
+
+/// Checks that `m`'s rows are View3D's surfaces (the same count, each once, areas within 1e-4);
+/// false, with a message on stderr, when they are not.
+bool same_surfaces(const rad::ViewFactorMatrix& m, const View3DOutput& v) {
+  if (m.rows() != v.n) {
+    std::fprintf(stderr, "bench_view_factors: View3D's output has %zu surfaces, the room %zu rows: not the same room\n",
+                 v.n, m.rows());
+    return false;
+  }
+  std::vector<bool> seen(v.n, false);
+  double worst = 0.0;
+  for (std::size_t r = 0; r < m.rows(); ++r) {
+    if (m.ids[r] >= v.n || seen[m.ids[r]]) {
+      std::fprintf(stderr, "bench_view_factors: row %zu (polygon %u) has no View3D surface of its own\n", r, m.ids[r]);
+      return false;
+    }
+    seen[m.ids[r]] = true;
+    worst = std::max(worst, std::fabs(v.area[m.ids[r]] - m.area[r]) / m.area[r]);
+  }
+  if (worst > 1e-4) {
+    std::fprintf(stderr, "bench_view_factors: areas differ from View3D's by up to %.3g (relative): not the same room\n",
+                 worst);
+    return false;
+  }
+  return true;
+}
+
+/// One line of the comparison; the polygons (0-based) whose row sum and whose large factor
+/// differ most follow in brackets.
+void print_agreement(const char* what, const Agreement& a, const rad::Scene& scene) {
+  auto group = [&](std::size_t polygon) { return scene.groups()[scene.polygons()[polygon].group].c_str(); };
+  std::printf("    %-24s %9.3g %9.3g   %9.3g %9.3g   %9.3g %9.3g   (row sum: polygon %zu, %s; factor: row %zu, %s)\n",
+              what, a.row_sums.largest, a.row_sums.rms(), a.large.largest, a.large.rms(), a.all.largest, a.all.rms(),
+              a.row_sums.where, group(a.row_sums.where), a.large.where, group(a.large.where));
+}
+
 void city_part(const Args& a) {
   const bench::City city = bench::city(a.city);
   std::printf("city: %d x %d blocks, facet %.2f m: %zu facets (open, under the sky)\n", a.city.blocks, a.city.blocks,
@@ -154,10 +327,24 @@ void city_part(const Args& a) {
   std::printf("\n    rows whose factors and sky add up to more than 1 (beyond 3 standard errors): %zu\n", over);
 }
 
-void enclosure_part(const Args& a) {
+bool enclosure_part(const Args& a) {
   const rad::Scene scene = faceted_room(a.room_facet);
-  std::printf("enclosure: a 4 m room around a block on its floor, facet %.3g m: %zu facets (closed)\n", a.room_facet,
+  std::printf("enclosure: a 4 m room around a block on its floor, facet %.4g m: %zu facets (closed)\n", a.room_facet,
               scene.polygons().size());
+  if (!a.write_vs3.empty()) {
+    // encl=0: View3D then writes its factors as integrated, without its own row normalisation
+    // (NormAF), so its row sums' distance from 1 is its own error and one file serves as the
+    // reference for both our uncorrected and our corrected factors. Other controls: View3D 3.2's
+    // defaults (eps 1e-4, maxU 12, maxO 8, minO 0), text output.
+    rad::View3DControl control;
+    control.enclosure = false;
+    control.output_format = 0;
+    char title[96];
+    std::snprintf(title, sizeof title, "bench_view_factors room around a block, facet %.4g m", a.room_facet);
+    rad::save_view3d(scene, control, title, a.write_vs3);
+    std::printf("  wrote %s: View3D input, %zu surfaces (surface i + 1 = polygon i), encl=0, eps=%g, out=0\n",
+                a.write_vs3.c_str(), scene.polygons().size(), static_cast<double>(control.epsilon));
+  }
   rad::ViewFactorOptions o;
   o.level = rad::ViewFactorLevel::polygon;
   o.correction = rad::ViewFactorCorrection::enclosure;
@@ -187,6 +374,47 @@ void enclosure_part(const Args& a) {
   std::printf("  fast against exact, over the %zu factors >= 0.01: largest |difference| %.3g, RMS %.3g\n", large, worst,
               large ? std::sqrt(squares / static_cast<double>(large)) : 0.0);
   std::printf("  speed: fast is %.1fx the exact mode's\n", exact.seconds / fast.seconds);
+  if (a.view3d_output.empty()) return true;
+
+  // Side by side with View3D: our exact mode once more without correction, then both modes
+  // against View3D's factors (its rows as it wrote them, normalised only if its encl was 1).
+  // Read only now, so that the peak memory printed above is ours alone.
+  View3DOutput view3d;
+  if (!read_view3d_output(a.view3d_output, view3d) || !same_surfaces(exact, view3d)) return false;
+  o.form_factors.method = rad::FormFactorMethod::ray_cast;
+  o.correction = rad::ViewFactorCorrection::none;
+  const rad::ViewFactorMatrix raw = rad::view_factor_matrix(scene, o);
+  std::printf("  View3D: %s (%s %s, encl=%d, emit=%d, %zu surfaces); exact without correction took %.2f s\n",
+              a.view3d_output.c_str(), view3d.program.c_str(), view3d.version.c_str(), view3d.enclosure,
+              view3d.script_f, view3d.n, raw.seconds);
+  Deviation own;
+  std::size_t blind = 0;
+  for (std::size_t i = 0; i < view3d.n; ++i) {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < view3d.n; ++j) sum += view3d.at(i, j);
+    if (sum < 0.5)
+      ++blind;  // a floor facet under the block: it sees nothing, in View3D as here
+    else
+      own.add(1.0 - sum);
+  }
+  std::printf("    View3D's own row sums: |1 - sum| up to %.3g, RMS %.3g (over the %zu rows that see something; %zu"
+              " see nothing)\n",
+              own.largest, own.rms(), own.count, blind);
+  std::printf("    |ours - View3D's|:       row sums (max, RMS)  factors >= 0.01 (max, RMS)  all N^2 (max, RMS)\n");
+  const Agreement exact_raw = against_view3d(raw, view3d);
+  std::printf("    (%zu rows; %zu factors >= 0.01 in View3D's matrix; %zu factors in all)\n", exact_raw.row_sums.count,
+              exact_raw.large.count, exact_raw.all.count);
+  print_agreement("exact, no correction", exact_raw, scene);
+  print_agreement("exact, enclosure", against_view3d(exact, view3d), scene);
+  print_agreement("fast, enclosure", against_view3d(fast, view3d), scene);
+  if (a.view3d_seconds > 0.0) {
+    const unsigned threads = a.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : a.threads;
+    std::printf("  time: View3D %.1f s (one thread; measured outside) against the exact mode's %.2f s on %u threads"
+                " (with correction): View3D / exact = %.2f; View3D / fast (%.2f s) = %.1f\n",
+                a.view3d_seconds, exact.seconds, threads, a.view3d_seconds / exact.seconds, fast.seconds,
+                a.view3d_seconds / fast.seconds);
+  }
+  return true;
 }
 
 }  // namespace
@@ -221,6 +449,14 @@ int main(int argc, char** argv) {
       const double v = std::strtod(argv[++i], &end);
       if (*end != '\0' || !(v > 0.01) || v > 4.0) return usage(argv[i]);
       a.room_facet = static_cast<float>(v);
+    } else if (arg == "--write-vs3" && has_value) {
+      a.write_vs3 = argv[++i];
+    } else if (arg == "--view3d-output" && has_value) {
+      a.view3d_output = argv[++i];
+    } else if (arg == "--view3d-seconds" && has_value) {
+      const double v = std::strtod(argv[++i], &end);
+      if (*end != '\0' || !(v > 0.0) || !std::isfinite(v)) return usage(argv[i]);
+      a.view3d_seconds = v;
     } else if (arg == "--only" && has_value) {
       const std::string which = argv[++i];
       if (which != "city" && which != "enclosure") return usage(argv[i]);
@@ -232,7 +468,7 @@ int main(int argc, char** argv) {
   }
   std::printf("bench_view_factors: radiosity %s, %u threads\n", rad::version(),
               a.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : a.threads);
-  if (a.enclosure_part) enclosure_part(a);
+  if (a.enclosure_part && !enclosure_part(a)) return 1;
   if (a.city_part) city_part(a);
   return 0;
 }
