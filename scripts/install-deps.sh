@@ -9,6 +9,7 @@ packages=(
   libstb-dev nlohmann-json3-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev
   libtinygltf-dev libassimp-dev
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()
