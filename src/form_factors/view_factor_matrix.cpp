@@ -23,6 +23,7 @@
 #include "core/progress.hpp"
 #include "form_factors/estimators.hpp"
 #include "form_factors/view_factor_correction.hpp"
+#include "form_factors/view_factor_rows.hpp"
 #include "radiosity/form_factors.hpp"
 
 namespace radiosity {
@@ -55,110 +56,6 @@ std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vect
     if (!polygon.obstruction_only && keep_group[polygon.group]) row_of[p] = rows++;
   }
   return row_of;
-}
-
-/// The rows of every selected polygon (row_of[p] != kNone) from the estimator `ff` names, on
-/// `scene` meshed with `mesh`. Fills ids, area, the CSR, row_standard_error (Monte Carlo),
-/// element_count and cancelled of `out`.
-void polygon_rows(const Scene& scene, const std::vector<std::uint32_t>& row_of, const FormFactorOptions& ff,
-                  const MeshOptions& mesh, detail::ProgressGate& gate, ViewFactorMatrix& out) {
-  const std::size_t polygons = scene.polygons().size();
-  std::size_t rows = 0;
-  out.ids.clear();
-  for (std::size_t p = 0; p < polygons; ++p)
-    if (row_of[p] != kNone) {
-      out.ids.push_back(static_cast<std::uint32_t>(p));
-      ++rows;
-    }
-  out.area.assign(rows, 0.0);
-  out.row_offsets.assign(rows + 1, 0);
-  out.columns.clear();
-  out.values.clear();
-
-  const PatchHierarchy hierarchy(scene, mesh);
-  const std::vector<Patch>& patches = hierarchy.patches();
-  std::vector<std::uint32_t> column_of_patch(patches.size());
-  for (std::size_t j = 0; j < patches.size(); ++j) column_of_patch[j] = row_of[patches[j].polygon];
-
-  // Source elements grouped by row (in element order within a row).
-  std::vector<std::uint32_t> sources;
-  std::vector<std::uint64_t> first(rows + 1, 0);
-  for (const std::uint32_t e : hierarchy.leaves()) {
-    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
-    if (r == kNone) continue;
-    ++first[r + 1];
-    out.area[r] += hierarchy.element(e).area;
-  }
-  for (std::size_t r = 0; r < rows; ++r) first[r + 1] += first[r];
-  sources.resize(first[rows]);
-  {
-    std::vector<std::uint64_t> at(first.begin(), first.end() - 1);
-    for (const std::uint32_t e : hierarchy.leaves()) {
-      const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
-      if (r != kNone) sources[at[r]++] = e;
-    }
-  }
-  out.element_count = sources.size();
-  const bool monte_carlo = ff.method == FormFactorMethod::monte_carlo;
-  if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
-
-  const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(scene, hierarchy, ff);
-  std::vector<double> sum(rows, 0.0);       // the accumulator of one row, by column
-  std::vector<std::uint32_t> touched;
-  std::vector<std::uint32_t> batch;
-  std::vector<SparseFactors> element_rows;
-  std::size_t row = 0;
-  while (row < rows) {
-    // The chunk: whole rows until it holds kChunkElements elements.
-    std::size_t end = row;
-    while (end < rows && (end == row || first[end] - first[row] < kChunkElements)) ++end;
-    batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
-                 sources.begin() + static_cast<std::ptrdiff_t>(first[end]));
-    estimator->sparse_element_rows(batch, element_rows);
-    for (std::size_t r = row; r < end; ++r) {
-      touched.clear();
-      for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
-        const std::uint32_t e = sources[k];
-        const double a = hierarchy.element(e).area;
-        const SparseFactors& f = element_rows[k - first[row]];
-        for (std::size_t m = 0; m < f.index.size(); ++m) {
-          // Backs of two-sided patches (indices past the patches) are not surfaces here.
-          if (f.index[m] >= patches.size()) continue;
-          const std::uint32_t c = column_of_patch[f.index[m]];
-          if (c == kNone) continue;
-          if (sum[c] == 0.0) touched.push_back(c);
-          sum[c] += a * static_cast<double>(f.value[m]);
-        }
-      }
-      std::sort(touched.begin(), touched.end());
-      const double inverse_area = out.area[r] > 0.0 ? 1.0 / out.area[r] : 0.0;
-      double row_sum = 0.0;
-      for (const std::uint32_t c : touched) {
-        const float v = static_cast<float>(sum[c] * inverse_area);
-        sum[c] = 0.0;
-        if (!(v > 0.0f)) continue;
-        out.columns.push_back(c);
-        out.values.push_back(v);
-        row_sum += static_cast<double>(v);
-      }
-      out.row_offsets[r + 1] = out.columns.size();
-      if (monte_carlo) {
-        // Binomial: the row's rays each reach a surface of the matrix or not.
-        const double s = std::clamp(row_sum, 0.0, 1.0);
-        const double n = static_cast<double>(ff.hemisphere_rays) * static_cast<double>(first[r + 1] - first[r]);
-        out.row_standard_error[r] = std::sqrt(s * (1.0 - s) / n);
-      }
-    }
-    row = end;
-    Progress p;
-    p.phase = Phase::form_factors;
-    p.fraction = static_cast<double>(row) / static_cast<double>(rows);
-    if (!gate.report(p, row == rows)) {
-      out.cancelled = true;
-      for (std::size_t r = row; r < rows; ++r) out.row_offsets[r + 1] = out.columns.size();
-      break;
-    }
-  }
 }
 
 /// A scene whose polygons are the leaf elements of `hierarchy` (in leaves() order), with their
@@ -250,11 +147,7 @@ const char* to_string(ViewFactorCorrection correction) {
 ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factor_matrix: the scene has no polygons");
-  FormFactorOptions ff = detail::resolve(options.form_factors);
-  if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
-  // The view factors of surfaces that send and receive on their fronts (as View3D's).
-  ff.diffuse_transmission = false;
-  ff.specular_depth = 0;
+  const FormFactorOptions ff = detail::view_factor_estimator_options(options);
   const bool links = options.method == ViewFactorMethod::hierarchical;
   if (links && options.level != ViewFactorLevel::group)
     throw Error(ErrorCode::invalid_argument,
@@ -290,44 +183,205 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     out.cancelled = !gate.report(start, true);
     out.method = to_string(ff.method);
     if (!out.cancelled) {
-      const std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
-      if (options.level == ViewFactorLevel::polygon) {
-        polygon_rows(scene, row_of, ff, options.mesh, gate, out);
-      } else {
-        // Elements: the polygon level of a scene made of the leaf elements, meshed as they are.
-        const PatchHierarchy hierarchy(scene, options.mesh);
-        const Scene elements = element_scene(scene, hierarchy);
-        std::vector<std::uint32_t> element_row_of(elements.polygons().size(), kNone);
-        for (std::size_t k = 0; k < hierarchy.leaves().size(); ++k)
-          element_row_of[k] = row_of[hierarchy.patches()[hierarchy.element(hierarchy.leaves()[k]).patch].polygon];
-        // Rows renumbered densely in leaf order.
-        std::uint32_t rows = 0;
-        for (std::uint32_t& r : element_row_of)
-          if (r != kNone) r = rows++;
-        MeshOptions whole;
-        whole.max_patch_area = whole.max_element_area = std::numeric_limits<float>::max();
-        polygon_rows(elements, element_row_of, ff, whole, gate, out);
-        for (std::uint32_t& id : out.ids) id = hierarchy.leaves()[id];  // leaf position -> element id
-      }
+      const detail::ViewFactorRows rows(scene, options);
+      rows.compute(0, rows.rows(), gate, out);
     }
   }
-  if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
-  if (!out.cancelled) {
-    detail::SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
-    out.correction = detail::correct_view_factors(options.correction, out.area, F, ff.threads);
-    out.row_offsets = std::move(F.offsets);
-    out.columns = std::move(F.columns);
-    out.values = std::move(F.values);
-  }
-  out.sky.assign(out.rows(), 0.0);
-  for (std::size_t i = 0; i < out.rows(); ++i) {
-    double s = 0.0;
-    for (std::uint64_t k = out.row_offsets[i]; k < out.row_offsets[i + 1]; ++k) s += static_cast<double>(out.values[k]);
-    out.sky[i] = 1.0 - s;
-  }
+  detail::finish_view_factor_matrix(scene, options, out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 
 }  // namespace v1
 }  // namespace radiosity
+
+namespace radiosity::detail {
+
+FormFactorOptions view_factor_estimator_options(const ViewFactorOptions& options) {
+  FormFactorOptions ff = resolve(options.form_factors);
+  if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
+  // The view factors of surfaces that send and receive on their fronts (as View3D's).
+  ff.diffuse_transmission = false;
+  ff.specular_depth = 0;
+  return ff;
+}
+
+struct ViewFactorRows::Impl {
+  ViewFactorLevel level = ViewFactorLevel::polygon;
+  FormFactorOptions ff;
+  /// Element level: the given scene's mesh (its leaves name the rows) and the scene whose
+  /// polygons are its leaf elements, on which the rows are computed.
+  std::optional<PatchHierarchy> element_mesh;
+  std::optional<Scene> elements;
+  const Scene* scene = nullptr;  ///< the scene the rows are computed on
+  PatchHierarchy hierarchy;      ///< its mesh
+  std::vector<std::uint32_t> ids;             ///< per row: its polygon of *scene
+  std::vector<double> area;                   ///< per row
+  std::vector<std::uint32_t> column_of_patch;  ///< per patch: the row (and column) of its polygon, or kNone
+  /// Source elements grouped by row (in element order within a row): row r's are
+  /// sources[first[r] .. first[r + 1]).
+  std::vector<std::uint32_t> sources;
+  std::vector<std::uint64_t> first;
+};
+
+ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.level = options.level;
+  m.ff = view_factor_estimator_options(options);
+  std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
+  MeshOptions mesh = options.mesh;
+  m.scene = &scene;
+  if (options.level == ViewFactorLevel::element) {
+    // Elements: the polygon level of a scene made of the leaf elements, meshed as they are.
+    const PatchHierarchy& hierarchy = m.element_mesh.emplace(scene, options.mesh);
+    m.scene = &m.elements.emplace(element_scene(scene, hierarchy));
+    std::vector<std::uint32_t> element_row_of(m.elements->polygons().size(), kNone);
+    for (std::size_t k = 0; k < hierarchy.leaves().size(); ++k)
+      element_row_of[k] = row_of[hierarchy.patches()[hierarchy.element(hierarchy.leaves()[k]).patch].polygon];
+    // Rows renumbered densely in leaf order.
+    std::uint32_t rows = 0;
+    for (std::uint32_t& r : element_row_of)
+      if (r != kNone) r = rows++;
+    row_of = std::move(element_row_of);
+    mesh = MeshOptions{};
+    mesh.max_patch_area = mesh.max_element_area = std::numeric_limits<float>::max();
+  }
+
+  const std::size_t polygons = m.scene->polygons().size();
+  for (std::size_t p = 0; p < polygons; ++p)
+    if (row_of[p] != kNone) m.ids.push_back(static_cast<std::uint32_t>(p));
+  const std::size_t rows = m.ids.size();
+  m.area.assign(rows, 0.0);
+  m.hierarchy = PatchHierarchy(*m.scene, mesh);
+  const PatchHierarchy& hierarchy = m.hierarchy;
+  const std::vector<Patch>& patches = hierarchy.patches();
+  m.column_of_patch.resize(patches.size());
+  for (std::size_t j = 0; j < patches.size(); ++j) m.column_of_patch[j] = row_of[patches[j].polygon];
+
+  m.first.assign(rows + 1, 0);
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
+    if (r == kNone) continue;
+    ++m.first[r + 1];
+    m.area[r] += hierarchy.element(e).area;
+  }
+  for (std::size_t r = 0; r < rows; ++r) m.first[r + 1] += m.first[r];
+  m.sources.resize(m.first[rows]);
+  std::vector<std::uint64_t> at(m.first.begin(), m.first.end() - 1);
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
+    if (r != kNone) m.sources[at[r]++] = e;
+  }
+}
+
+ViewFactorRows::~ViewFactorRows() = default;
+
+std::size_t ViewFactorRows::rows() const { return impl_->ids.size(); }
+
+const std::vector<std::uint64_t>& ViewFactorRows::source_offsets() const { return impl_->first; }
+
+void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& gate, ViewFactorMatrix& out) const {
+  const Impl& m = *impl_;
+  const PatchHierarchy& hierarchy = m.hierarchy;
+  const std::vector<Patch>& patches = hierarchy.patches();
+  const std::vector<std::uint64_t>& first = m.first;
+  const std::vector<std::uint32_t>& sources = m.sources;
+  const std::size_t rows = end - begin;
+  out.level = m.level;
+  out.method = to_string(m.ff.method);
+  out.ids.assign(m.ids.begin() + static_cast<std::ptrdiff_t>(begin), m.ids.begin() + static_cast<std::ptrdiff_t>(end));
+  // Element level: leaf position -> element id.
+  if (m.element_mesh)
+    for (std::uint32_t& id : out.ids) id = m.element_mesh->leaves()[id];
+  out.area.assign(m.area.begin() + static_cast<std::ptrdiff_t>(begin), m.area.begin() + static_cast<std::ptrdiff_t>(end));
+  out.row_offsets.assign(rows + 1, 0);
+  out.columns.clear();
+  out.values.clear();
+  out.element_count = first[end] - first[begin];
+  out.cancelled = false;
+  const bool monte_carlo = m.ff.method == FormFactorMethod::monte_carlo;
+  out.row_standard_error.clear();
+  if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
+  if (rows == 0) return;
+
+  const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(*m.scene, hierarchy, m.ff);
+  std::vector<double> sum(m.ids.size(), 0.0);  // the accumulator of one row, by column
+  std::vector<std::uint32_t> touched;
+  std::vector<std::uint32_t> batch;
+  std::vector<SparseFactors> element_rows;
+  std::size_t row = begin;
+  while (row < end) {
+    // The chunk: whole rows until it holds kChunkElements elements.
+    std::size_t last = row;
+    while (last < end && (last == row || first[last] - first[row] < kChunkElements)) ++last;
+    batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
+                 sources.begin() + static_cast<std::ptrdiff_t>(first[last]));
+    estimator->sparse_element_rows(batch, element_rows);
+    for (std::size_t r = row; r < last; ++r) {
+      touched.clear();
+      for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
+        const std::uint32_t e = sources[k];
+        const double a = hierarchy.element(e).area;
+        const SparseFactors& f = element_rows[k - first[row]];
+        for (std::size_t n = 0; n < f.index.size(); ++n) {
+          // Backs of two-sided patches (indices past the patches) are not surfaces here.
+          if (f.index[n] >= patches.size()) continue;
+          const std::uint32_t c = m.column_of_patch[f.index[n]];
+          if (c == kNone) continue;
+          if (sum[c] == 0.0) touched.push_back(c);
+          sum[c] += a * static_cast<double>(f.value[n]);
+        }
+      }
+      std::sort(touched.begin(), touched.end());
+      const double inverse_area = m.area[r] > 0.0 ? 1.0 / m.area[r] : 0.0;
+      double row_sum = 0.0;
+      for (const std::uint32_t c : touched) {
+        const float v = static_cast<float>(sum[c] * inverse_area);
+        sum[c] = 0.0;
+        if (!(v > 0.0f)) continue;
+        out.columns.push_back(c);
+        out.values.push_back(v);
+        row_sum += static_cast<double>(v);
+      }
+      out.row_offsets[r - begin + 1] = out.columns.size();
+      if (monte_carlo) {
+        // Binomial: the row's rays each reach a surface of the matrix or not.
+        const double s = std::clamp(row_sum, 0.0, 1.0);
+        const double n = static_cast<double>(m.ff.hemisphere_rays) * static_cast<double>(first[r + 1] - first[r]);
+        out.row_standard_error[r - begin] = std::sqrt(s * (1.0 - s) / n);
+      }
+    }
+    row = last;
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = static_cast<double>(row - begin) / static_cast<double>(rows);
+    if (!gate.report(p, row == end)) {
+      out.cancelled = true;
+      for (std::size_t r = row; r < end; ++r) out.row_offsets[r - begin + 1] = out.columns.size();
+      break;
+    }
+  }
+}
+
+void set_view_factor_sky(ViewFactorMatrix& m) {
+  m.sky.assign(m.rows(), 0.0);
+  for (std::size_t i = 0; i < m.rows(); ++i) {
+    double s = 0.0;
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) s += static_cast<double>(m.values[k]);
+    m.sky[i] = 1.0 - s;
+  }
+}
+
+void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options, ViewFactorMatrix& out) {
+  if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
+  if (!out.cancelled) {
+    SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
+    out.correction = correct_view_factors(options.correction, out.area, F, view_factor_estimator_options(options).threads);
+    out.row_offsets = std::move(F.offsets);
+    out.columns = std::move(F.columns);
+    out.values = std::move(F.values);
+  }
+  set_view_factor_sky(out);
+}
+
+}  // namespace radiosity::detail
