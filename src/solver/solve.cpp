@@ -177,8 +177,8 @@ struct Problem::Impl {
   void choose_method();
   /// The lights' first shot for `elements` that lack it; false when cancelled.
   bool shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate);
-  /// light_shooter->shoot(elements, shot, gate, only), or, split, each process's block of the
-  /// elements that lack a value, gathered.
+  /// light_shooter->shoot(elements, shot, gate, only), or, split, each process's share of the
+  /// elements that lack a value (dealt out in turn), gathered.
   bool shoot(const std::vector<std::uint32_t>& elements, detail::LightShot& shot, detail::ProgressGate& gate,
              const std::vector<char>* only = nullptr);
 };
@@ -222,8 +222,11 @@ bool Problem::Impl::shoot_lights(const std::vector<std::uint32_t>& elements, det
 bool Problem::Impl::shoot(const std::vector<std::uint32_t>& elements, detail::LightShot& shot,
                           detail::ProgressGate& gate, const std::vector<char>* only) {
   if (!processes) return light_shooter->shoot(elements, shot, gate, only);
-  // Every process has the same `done` flags: the elements to shoot, split evenly (each element
-  // side and light draws from its own stream, so who shoots it does not matter).
+  // Every process has the same `done` flags, so the same elements to shoot. They are dealt out
+  // in turn (element k to process k mod P): an element's cost varies by orders of magnitude (a
+  // roof sees all the sky and needs no ray, a street between towers a thousand), and neighbours
+  // in the list cost alike, so contiguous blocks would leave one process all the work. Who
+  // shoots an element does not matter: each element side and light has its own stream.
   const std::size_t count = hierarchy.elements().size();
   shot.front.resize(count, Rgb(0.0f));
   shot.back.resize(count, Rgb(0.0f));
@@ -231,24 +234,28 @@ bool Problem::Impl::shoot(const std::vector<std::uint32_t>& elements, detail::Li
   std::vector<std::uint32_t> todo;
   for (std::uint32_t e : elements)
     if (!shot.done[e]) todo.push_back(e);
-  const std::vector<std::size_t> blocks = detail::even_blocks(todo.size(), processes->size());
-  const auto rank = static_cast<std::size_t>(processes->rank());
-  const std::vector<std::uint32_t> mine(todo.begin() + static_cast<std::ptrdiff_t>(blocks[rank]),
-                                        todo.begin() + static_cast<std::ptrdiff_t>(blocks[rank + 1]));
+  const auto P = static_cast<std::size_t>(processes->size()), rank = static_cast<std::size_t>(processes->rank());
+  // Process r shoots todo[r], todo[r + P], ...: a block of its own in the gathered arrays.
+  std::vector<std::size_t> blocks(P + 1, 0);
+  for (std::size_t r = 0; r < P; ++r) blocks[r + 1] = blocks[r] + (todo.size() + P - 1 - r) / P;
+  std::vector<std::uint32_t> mine;
+  for (std::size_t k = rank; k < todo.size(); k += P) mine.push_back(todo[k]);
   const std::uint64_t rays = shot.rays;
   const bool completed = light_shooter->shoot(mine, shot, gate, only);
   std::vector<Rgb> front(todo.size(), Rgb(0.0f)), back(todo.size(), Rgb(0.0f));
-  for (std::size_t k = blocks[rank]; k < blocks[rank + 1]; ++k) {
-    front[k] = shot.front[todo[k]];
-    back[k] = shot.back[todo[k]];
+  for (std::size_t j = 0; j < mine.size(); ++j) {
+    front[blocks[rank] + j] = shot.front[mine[j]];
+    back[blocks[rank] + j] = shot.back[mine[j]];
   }
   processes->all_gather(front, blocks);
   processes->all_gather(back, blocks);
-  for (std::size_t k = 0; k < todo.size(); ++k) {
-    shot.front[todo[k]] = front[k];
-    shot.back[todo[k]] = back[k];
-    shot.done[todo[k]] = 1;
-  }
+  for (std::size_t r = 0; r < P; ++r)
+    for (std::size_t j = 0; j < blocks[r + 1] - blocks[r]; ++j) {
+      const std::uint32_t e = todo[r + j * P];
+      shot.front[e] = front[blocks[r] + j];
+      shot.back[e] = back[blocks[r] + j];
+      shot.done[e] = 1;
+    }
   shot.rays = rays + processes->sum(shot.rays - rays);
   return completed;
 }
