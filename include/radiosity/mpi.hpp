@@ -35,7 +35,8 @@ namespace mpi {
 /// rank 0 computes it alone and the other ranks return an empty matrix of that level. Memory
 /// per process: the scene, its mesh and ray scene, and its block's rows; rank 0 holds the whole
 /// matrix as well. on_progress is called on every process for its block; a cancel stops that
-/// process's block, and the matrix is then `cancelled` on every rank. Errors are collective:
+/// process's block, and the matrix is then `cancelled` on every rank, which returns its own
+/// (incomplete) block: nothing is gathered. Errors are collective:
 /// an Error any process meets (bad options, an open scene refused by the enclosure
 /// correction on rank 0) is thrown on every process, with the same code and message.
 /// Thread safety: collective; one call at a time per communicator.
@@ -72,8 +73,8 @@ RADIOSITY_API ViewFactorBlock view_factor_block(const Scene& scene, const ViewFa
 
 /// solve(scene, options) as a Jacobi iteration split among the processes of `comm`: every
 /// process meshes the scene, computes and keeps the form-factor rows of its contiguous block of
-/// unknowns (element sides, split evenly) and the lights' first shot of its block of elements,
-/// and per sweep computes its block of the irradiance H = F B; the blocks are exchanged
+/// unknowns (element sides, split evenly) and its share of the lights' first shot (every P-th
+/// element: their costs vary), and per sweep computes its block of the irradiance H = F B; the blocks are exchanged
 /// (MPI_Allgatherv: 12 bytes per unknown reach every process), after which every process
 /// updates all of B and the residual in one process's order, and a flag is all-reduced (a
 /// cancel asked for by any process's on_progress stops every process at the end of that

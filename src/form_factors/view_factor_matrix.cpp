@@ -10,7 +10,9 @@
 //
 // Rows are made a chunk of whole polygons at a time from the estimator's sparse element rows,
 // so memory is the result plus one chunk; the element level is the polygon level of a scene
-// whose polygons are the mesh's leaf elements.
+// whose polygons are the mesh's leaf elements. The rows of any block come from
+// detail::ViewFactorRows (view_factor_rows.hpp), which the MPI module (src/mpi/) calls for each
+// process's block; the correction is the end, on the whole matrix.
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -158,8 +158,8 @@ struct Problem::Impl {
   /// During a light group's solve: that group's lights alone (solve_light_groups()).
   const detail::LightShot* group_light_shot = nullptr;
   /// The processes a Jacobi solve is split among (detail::solve_split(), docs/MPI.md), or null.
-  /// Split, every process holds the whole problem, computes the rows and the lights' first shot
-  /// of its block of unknowns and gathers the rest, so each returns the single process's
+  /// Split, every process holds the whole problem, computes the rows of its block of unknowns
+  /// and its share of the lights' first shot and gathers the rest, so each returns the single process's
   /// solution; on_progress then never cancels at once (a process cannot stop alone): a cancel
   /// is agreed on at the end of the form factors and of each sweep.
   const detail::Communicator* processes = nullptr;
