@@ -11,6 +11,7 @@ packages=(
   libtinygltf-dev libassimp-dev
   libzip-dev pkg-config
   python3-dev pybind11-dev python3-numpy python3-scipy python3-pytest
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

@@ -14,6 +14,9 @@
 #include "radiosity/scene.hpp"
 
 namespace radiosity {
+namespace detail {
+struct SplitSolve;  // the way of the MPI module (src/mpi/) into Problem; not API
+}  // namespace detail
 inline namespace v1 {
 
 enum class SolverMethod {
@@ -380,6 +383,7 @@ class RADIOSITY_API Problem {
  private:
   struct Impl;
   friend Solution solve(const Scene& scene, const SolveOptions& options);
+  friend struct detail::SplitSolve;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -10,7 +10,9 @@
 //
 // Rows are made a chunk of whole polygons at a time from the estimator's sparse element rows,
 // so memory is the result plus one chunk; the element level is the polygon level of a scene
-// whose polygons are the mesh's leaf elements.
+// whose polygons are the mesh's leaf elements. The rows of any block come from
+// detail::ViewFactorRows (view_factor_rows.hpp), which the MPI module (src/mpi/) calls for each
+// process's block; the correction is the end, on the whole matrix.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,9 +28,10 @@
 #include "core/rng.hpp"
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
-#include "form_factors/estimators.hpp"
 #include "geometry/ray_scene.hpp"
+#include "form_factors/estimators.hpp"
 #include "form_factors/view_factor_correction.hpp"
+#include "form_factors/view_factor_rows.hpp"
 #include "radiosity/form_factors.hpp"
 
 namespace radiosity {
@@ -71,14 +74,16 @@ std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vect
 /// Reports progress through `gate` between blocks of elements, from `done` (a fraction of
 /// Phase::form_factors already reported) to 1; returns false when cancelled (out.sky is then
 /// left empty).
+/// Rows [row_begin, row_end) of `first` only, into out.sky[r - row_begin].
 bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& sources,
-             const std::vector<std::uint64_t>& first, const FormFactorOptions& ff, detail::ProgressGate& gate,
-             double done, ViewFactorMatrix& out) {
-  const std::size_t rows = first.size() - 1;
+             const std::vector<std::uint64_t>& first, std::size_t row_begin, std::size_t row_end,
+             const FormFactorOptions& ff, detail::ProgressGate& gate, double done, ViewFactorMatrix& out) {
+  const std::size_t rows = row_end - row_begin;
+  const std::size_t element_begin = first[row_begin], element_end = first[row_end];
   const detail::RayScene occluders = detail::RayScene::from_polygons(scene);
   const float epsilon = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
   const std::uint32_t n = ff.hemisphere_rays;
-  std::vector<double> escaped(sources.size(), 0.0);
+  std::vector<double> escaped(element_end - element_begin, 0.0);  // per source of the rows
   // Elements [begin, end) of `sources`: their fractions of rays that meet nothing.
   auto trace = [&](std::size_t begin, std::size_t end) {
     std::vector<glm::vec2> points(n), directions(n);
@@ -102,141 +107,35 @@ bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
                                     blocked.data());
       std::uint32_t open = 0;
       for (const std::uint8_t x : blocked) open += x ? 0 : 1;
-      escaped[k] = static_cast<double>(open) / static_cast<double>(n);
+      escaped[k - element_begin] = static_cast<double>(open) / static_cast<double>(n);
     }
   };
-  for (std::size_t block = 0; block < sources.size(); block += kChunkElements) {
-    const std::size_t block_end = std::min(sources.size(), block + kChunkElements);
+  for (std::size_t block = element_begin; block < element_end; block += kChunkElements) {
+    const std::size_t block_end = std::min<std::size_t>(element_end, block + kChunkElements);
     detail::parallel_for(ff.threads, block_end - block, 16,
                          [&](std::size_t begin, std::size_t end) { trace(block + begin, block + end); });
     Progress p;
     p.phase = Phase::form_factors;
-    p.fraction = done + (1.0 - done) * static_cast<double>(block_end) / static_cast<double>(sources.size());
-    if (!gate.report(p, block_end == sources.size())) return false;
+    p.fraction = done + (1.0 - done) * static_cast<double>(block_end - element_begin) /
+                            static_cast<double>(element_end - element_begin);
+    if (!gate.report(p, block_end == element_end)) return false;
   }
   out.sky.assign(rows, 0.0);
   out.sky_standard_error.assign(rows, 0.0);
-  for (std::size_t r = 0; r < rows; ++r) {
+  for (std::size_t r = row_begin; r < row_end; ++r) {
     double area = 0.0, sky = 0.0;
     for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
       const double a = hierarchy.element(sources[k]).area;
       area += a;
-      sky += a * escaped[k];
+      sky += a * escaped[k - element_begin];
     }
     if (!(area > 0.0)) continue;
-    out.sky[r] = sky / area;
+    const double v = sky / area;
     const double total = static_cast<double>(n) * static_cast<double>(first[r + 1] - first[r]);
-    out.sky_standard_error[r] = std::sqrt(out.sky[r] * (1.0 - out.sky[r]) / total);
+    out.sky[r - row_begin] = v;
+    out.sky_standard_error[r - row_begin] = std::sqrt(v * (1.0 - v) / total);
   }
   return true;
-}
-
-/// The rows of every selected polygon (row_of[p] != kNone) from the estimator `ff` names, on
-/// `scene` meshed with `mesh`. Fills ids, area, the CSR, row_standard_error (Monte Carlo),
-/// element_count and cancelled of `out`.
-void polygon_rows(const Scene& scene, const std::vector<std::uint32_t>& row_of, const FormFactorOptions& ff,
-                  const MeshOptions& mesh, detail::ProgressGate& gate, ViewFactorMatrix& out) {
-  const std::size_t polygons = scene.polygons().size();
-  std::size_t rows = 0;
-  out.ids.clear();
-  for (std::size_t p = 0; p < polygons; ++p)
-    if (row_of[p] != kNone) {
-      out.ids.push_back(static_cast<std::uint32_t>(p));
-      ++rows;
-    }
-  out.area.assign(rows, 0.0);
-  out.row_offsets.assign(rows + 1, 0);
-  out.columns.clear();
-  out.values.clear();
-
-  const PatchHierarchy hierarchy(scene, mesh);
-  const std::vector<Patch>& patches = hierarchy.patches();
-  std::vector<std::uint32_t> column_of_patch(patches.size());
-  for (std::size_t j = 0; j < patches.size(); ++j) column_of_patch[j] = row_of[patches[j].polygon];
-
-  // Source elements grouped by row (in element order within a row).
-  std::vector<std::uint32_t> sources;
-  std::vector<std::uint64_t> first(rows + 1, 0);
-  for (const std::uint32_t e : hierarchy.leaves()) {
-    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
-    if (r == kNone) continue;
-    ++first[r + 1];
-    out.area[r] += hierarchy.element(e).area;
-  }
-  for (std::size_t r = 0; r < rows; ++r) first[r + 1] += first[r];
-  sources.resize(first[rows]);
-  {
-    std::vector<std::uint64_t> at(first.begin(), first.end() - 1);
-    for (const std::uint32_t e : hierarchy.leaves()) {
-      const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
-      if (r != kNone) sources[at[r]++] = e;
-    }
-  }
-  out.element_count = sources.size();
-  const bool monte_carlo = ff.method == FormFactorMethod::monte_carlo;
-  // The rows' share of the progress (the sky's rays come after them): about half of the rays
-  // for Monte Carlo, most of the work for the other estimators.
-  const double rows_share = monte_carlo ? 0.5 : 0.9;
-  if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
-
-  const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(scene, hierarchy, ff);
-  std::vector<double> sum(rows, 0.0);       // the accumulator of one row, by column
-  std::vector<std::uint32_t> touched;
-  std::vector<std::uint32_t> batch;
-  std::vector<SparseFactors> element_rows;
-  std::size_t row = 0;
-  while (row < rows) {
-    // The chunk: whole rows until it holds kChunkElements elements.
-    std::size_t end = row;
-    while (end < rows && (end == row || first[end] - first[row] < kChunkElements)) ++end;
-    batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
-                 sources.begin() + static_cast<std::ptrdiff_t>(first[end]));
-    estimator->sparse_element_rows(batch, element_rows);
-    for (std::size_t r = row; r < end; ++r) {
-      touched.clear();
-      for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
-        const std::uint32_t e = sources[k];
-        const double a = hierarchy.element(e).area;
-        const SparseFactors& f = element_rows[k - first[row]];
-        for (std::size_t m = 0; m < f.index.size(); ++m) {
-          // Backs of two-sided patches (indices past the patches) are not surfaces here.
-          if (f.index[m] >= patches.size()) continue;
-          const std::uint32_t c = column_of_patch[f.index[m]];
-          if (c == kNone) continue;
-          if (sum[c] == 0.0) touched.push_back(c);
-          sum[c] += a * static_cast<double>(f.value[m]);
-        }
-      }
-      std::sort(touched.begin(), touched.end());
-      const double inverse_area = out.area[r] > 0.0 ? 1.0 / out.area[r] : 0.0;
-      double row_sum = 0.0;
-      for (const std::uint32_t c : touched) {
-        const float v = static_cast<float>(sum[c] * inverse_area);
-        sum[c] = 0.0;
-        if (!(v > 0.0f)) continue;
-        out.columns.push_back(c);
-        out.values.push_back(v);
-        row_sum += static_cast<double>(v);
-      }
-      out.row_offsets[r + 1] = out.columns.size();
-      if (monte_carlo) {
-        // Binomial: the row's rays each reach a surface of the matrix or not.
-        const double s = std::clamp(row_sum, 0.0, 1.0);
-        const double n = static_cast<double>(ff.hemisphere_rays) * static_cast<double>(first[r + 1] - first[r]);
-        out.row_standard_error[r] = std::sqrt(s * (1.0 - s) / n);
-      }
-    }
-    row = end;
-    Progress p;
-    p.phase = Phase::form_factors;
-    p.fraction = rows_share * static_cast<double>(row) / static_cast<double>(rows);
-    if (!gate.report(p, false)) {
-      out.cancelled = true;
-      for (std::size_t r = row; r < rows; ++r) out.row_offsets[r + 1] = out.columns.size();
-      break;
-    }
-  }
-  if (!out.cancelled) out.cancelled = !row_sky(scene, hierarchy, sources, first, ff, gate, rows_share, out);
 }
 
 /// A scene whose polygons are the leaf elements of `hierarchy` (in leaves() order), with their
@@ -328,11 +227,7 @@ const char* to_string(ViewFactorCorrection correction) {
 ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factor_matrix: the scene has no polygons");
-  FormFactorOptions ff = detail::resolve(options.form_factors);
-  if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
-  // The view factors of surfaces that send and receive on their fronts (as View3D's).
-  ff.diffuse_transmission = false;
-  ff.specular_depth = 0;
+  const FormFactorOptions ff = detail::view_factor_estimator_options(options);
   const bool links = options.method == ViewFactorMethod::hierarchical;
   if (links && options.level != ViewFactorLevel::group)
     throw Error(ErrorCode::invalid_argument,
@@ -380,7 +275,7 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
         if (row_of(e) != kNone) sources[at[row_of(e)]++] = e;
       // view_factors() reported its rows; the sky's rays report at the end, and may cancel.
       detail::ProgressGate gate(options.on_progress);
-      out.cancelled = !row_sky(scene, hierarchy, sources, first, ff, gate, 1.0, out);
+      out.cancelled = !row_sky(scene, hierarchy, sources, first, 0, n, ff, gate, 1.0, out);
     }
   } else {
     detail::ProgressGate gate(options.on_progress);
@@ -389,42 +284,209 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     out.cancelled = !gate.report(start, true);
     out.method = to_string(ff.method);
     if (!out.cancelled) {
-      const std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
-      if (options.level == ViewFactorLevel::polygon) {
-        polygon_rows(scene, row_of, ff, options.mesh, gate, out);
-      } else {
-        // Elements: the polygon level of a scene made of the leaf elements, meshed as they are.
-        const PatchHierarchy hierarchy(scene, options.mesh);
-        const Scene elements = element_scene(scene, hierarchy);
-        std::vector<std::uint32_t> element_row_of(elements.polygons().size(), kNone);
-        for (std::size_t k = 0; k < hierarchy.leaves().size(); ++k)
-          element_row_of[k] = row_of[hierarchy.patches()[hierarchy.element(hierarchy.leaves()[k]).patch].polygon];
-        // Rows renumbered densely in leaf order.
-        std::uint32_t rows = 0;
-        for (std::uint32_t& r : element_row_of)
-          if (r != kNone) r = rows++;
-        MeshOptions whole;
-        whole.max_patch_area = whole.max_element_area = std::numeric_limits<float>::max();
-        polygon_rows(elements, element_row_of, ff, whole, gate, out);
-        for (std::uint32_t& id : out.ids) id = hierarchy.leaves()[id];  // leaf position -> element id
-      }
+      const detail::ViewFactorRows rows(scene, options);
+      rows.compute(0, rows.rows(), gate, out);
     }
   }
-  if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
-  if (!out.cancelled) {
-    detail::SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
-    out.correction = detail::correct_view_factors(options.correction, out.area, F, ff.threads);
-    out.row_offsets = std::move(F.offsets);
-    out.columns = std::move(F.columns);
-    out.values = std::move(F.values);
-  }
-  if (out.sky.size() != out.rows()) {  // cancelled before the sky
-    out.sky.assign(out.rows(), 0.0);
-    out.sky_standard_error.assign(out.rows(), 0.0);
-  }
+  detail::finish_view_factor_matrix(scene, options, out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 
 }  // namespace v1
 }  // namespace radiosity
+
+namespace radiosity::detail {
+
+FormFactorOptions view_factor_estimator_options(const ViewFactorOptions& options) {
+  FormFactorOptions ff = resolve(options.form_factors);
+  if (ff.method == FormFactorMethod::automatic) ff.method = FormFactorMethod::ray_cast;
+  // The view factors of surfaces that send and receive on their fronts (as View3D's).
+  ff.diffuse_transmission = false;
+  ff.specular_depth = 0;
+  return ff;
+}
+
+struct ViewFactorRows::Impl {
+  ViewFactorLevel level = ViewFactorLevel::polygon;
+  FormFactorOptions ff;
+  /// Element level: the given scene's mesh (its leaves name the rows) and the scene whose
+  /// polygons are its leaf elements, on which the rows are computed.
+  std::optional<PatchHierarchy> element_mesh;
+  std::optional<Scene> elements;
+  const Scene* scene = nullptr;  ///< the scene the rows are computed on
+  PatchHierarchy hierarchy;      ///< its mesh
+  std::vector<std::uint32_t> ids;             ///< per row: its polygon of *scene
+  std::vector<double> area;                   ///< per row
+  std::vector<std::uint32_t> column_of_patch;  ///< per patch: the row (and column) of its polygon, or kNone
+  /// Source elements grouped by row (in element order within a row): row r's are
+  /// sources[first[r] .. first[r + 1]).
+  std::vector<std::uint32_t> sources;
+  std::vector<std::uint64_t> first;
+};
+
+ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.level = options.level;
+  m.ff = view_factor_estimator_options(options);
+  std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
+  MeshOptions mesh = options.mesh;
+  m.scene = &scene;
+  if (options.level == ViewFactorLevel::element) {
+    // Elements: the polygon level of a scene made of the leaf elements, meshed as they are.
+    const PatchHierarchy& hierarchy = m.element_mesh.emplace(scene, options.mesh);
+    m.scene = &m.elements.emplace(element_scene(scene, hierarchy));
+    std::vector<std::uint32_t> element_row_of(m.elements->polygons().size(), kNone);
+    for (std::size_t k = 0; k < hierarchy.leaves().size(); ++k)
+      element_row_of[k] = row_of[hierarchy.patches()[hierarchy.element(hierarchy.leaves()[k]).patch].polygon];
+    // Rows renumbered densely in leaf order.
+    std::uint32_t rows = 0;
+    for (std::uint32_t& r : element_row_of)
+      if (r != kNone) r = rows++;
+    row_of = std::move(element_row_of);
+    mesh = MeshOptions{};
+    mesh.max_patch_area = mesh.max_element_area = std::numeric_limits<float>::max();
+  }
+
+  const std::size_t polygons = m.scene->polygons().size();
+  for (std::size_t p = 0; p < polygons; ++p)
+    if (row_of[p] != kNone) m.ids.push_back(static_cast<std::uint32_t>(p));
+  const std::size_t rows = m.ids.size();
+  m.area.assign(rows, 0.0);
+  m.hierarchy = PatchHierarchy(*m.scene, mesh);
+  const PatchHierarchy& hierarchy = m.hierarchy;
+  const std::vector<Patch>& patches = hierarchy.patches();
+  m.column_of_patch.resize(patches.size());
+  for (std::size_t j = 0; j < patches.size(); ++j) m.column_of_patch[j] = row_of[patches[j].polygon];
+
+  m.first.assign(rows + 1, 0);
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
+    if (r == kNone) continue;
+    ++m.first[r + 1];
+    m.area[r] += hierarchy.element(e).area;
+  }
+  for (std::size_t r = 0; r < rows; ++r) m.first[r + 1] += m.first[r];
+  m.sources.resize(m.first[rows]);
+  std::vector<std::uint64_t> at(m.first.begin(), m.first.end() - 1);
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
+    if (r != kNone) m.sources[at[r]++] = e;
+  }
+}
+
+ViewFactorRows::~ViewFactorRows() = default;
+
+std::size_t ViewFactorRows::rows() const { return impl_->ids.size(); }
+
+const std::vector<std::uint64_t>& ViewFactorRows::source_offsets() const { return impl_->first; }
+
+void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& gate, ViewFactorMatrix& out) const {
+  const Impl& m = *impl_;
+  const PatchHierarchy& hierarchy = m.hierarchy;
+  const std::vector<Patch>& patches = hierarchy.patches();
+  const std::vector<std::uint64_t>& first = m.first;
+  const std::vector<std::uint32_t>& sources = m.sources;
+  const std::size_t rows = end - begin;
+  out.level = m.level;
+  out.method = to_string(m.ff.method);
+  out.ids.assign(m.ids.begin() + static_cast<std::ptrdiff_t>(begin), m.ids.begin() + static_cast<std::ptrdiff_t>(end));
+  // Element level: leaf position -> element id.
+  if (m.element_mesh)
+    for (std::uint32_t& id : out.ids) id = m.element_mesh->leaves()[id];
+  out.area.assign(m.area.begin() + static_cast<std::ptrdiff_t>(begin), m.area.begin() + static_cast<std::ptrdiff_t>(end));
+  out.row_offsets.assign(rows + 1, 0);
+  out.columns.clear();
+  out.values.clear();
+  out.element_count = first[end] - first[begin];
+  out.cancelled = false;
+  const bool monte_carlo = m.ff.method == FormFactorMethod::monte_carlo;
+  // The rows' share of the progress (the sky's rays come after them): about half of the rays
+  // for Monte Carlo, most of the work for the other estimators.
+  const double rows_share = monte_carlo ? 0.5 : 0.9;
+  out.sky.clear();
+  out.sky_standard_error.clear();
+  out.row_standard_error.clear();
+  if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
+  if (rows == 0) return;
+
+  const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(*m.scene, hierarchy, m.ff);
+  std::vector<double> sum(m.ids.size(), 0.0);  // the accumulator of one row, by column
+  std::vector<std::uint32_t> touched;
+  std::vector<std::uint32_t> batch;
+  std::vector<SparseFactors> element_rows;
+  std::size_t row = begin;
+  while (row < end) {
+    // The chunk: whole rows until it holds kChunkElements elements.
+    std::size_t last = row;
+    while (last < end && (last == row || first[last] - first[row] < kChunkElements)) ++last;
+    batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
+                 sources.begin() + static_cast<std::ptrdiff_t>(first[last]));
+    estimator->sparse_element_rows(batch, element_rows);
+    for (std::size_t r = row; r < last; ++r) {
+      touched.clear();
+      for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
+        const std::uint32_t e = sources[k];
+        const double a = hierarchy.element(e).area;
+        const SparseFactors& f = element_rows[k - first[row]];
+        for (std::size_t n = 0; n < f.index.size(); ++n) {
+          // Backs of two-sided patches (indices past the patches) are not surfaces here.
+          if (f.index[n] >= patches.size()) continue;
+          const std::uint32_t c = m.column_of_patch[f.index[n]];
+          if (c == kNone) continue;
+          if (sum[c] == 0.0) touched.push_back(c);
+          sum[c] += a * static_cast<double>(f.value[n]);
+        }
+      }
+      std::sort(touched.begin(), touched.end());
+      const double inverse_area = m.area[r] > 0.0 ? 1.0 / m.area[r] : 0.0;
+      double row_sum = 0.0;
+      for (const std::uint32_t c : touched) {
+        const float v = static_cast<float>(sum[c] * inverse_area);
+        sum[c] = 0.0;
+        if (!(v > 0.0f)) continue;
+        out.columns.push_back(c);
+        out.values.push_back(v);
+        row_sum += static_cast<double>(v);
+      }
+      out.row_offsets[r - begin + 1] = out.columns.size();
+      if (monte_carlo) {
+        // Binomial: the row's rays each reach a surface of the matrix or not.
+        const double s = std::clamp(row_sum, 0.0, 1.0);
+        const double n = static_cast<double>(m.ff.hemisphere_rays) * static_cast<double>(first[r + 1] - first[r]);
+        out.row_standard_error[r - begin] = std::sqrt(s * (1.0 - s) / n);
+      }
+    }
+    row = last;
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = rows_share * static_cast<double>(row - begin) / static_cast<double>(rows);
+    if (!gate.report(p, false)) {
+      out.cancelled = true;
+      for (std::size_t r = row; r < end; ++r) out.row_offsets[r - begin + 1] = out.columns.size();
+      break;
+    }
+  }
+  if (!out.cancelled)
+    out.cancelled = !row_sky(*m.scene, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
+}
+
+void fill_missing_sky(ViewFactorMatrix& m) {
+  if (m.sky.size() == m.rows() && m.sky_standard_error.size() == m.rows()) return;
+  m.sky.assign(m.rows(), 0.0);
+  m.sky_standard_error.assign(m.rows(), 0.0);
+}
+
+void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options, ViewFactorMatrix& out) {
+  if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
+  if (!out.cancelled) {
+    SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
+    out.correction = correct_view_factors(options.correction, out.area, F, view_factor_estimator_options(options).threads);
+    out.row_offsets = std::move(F.offsets);
+    out.columns = std::move(F.columns);
+    out.values = std::move(F.values);
+  }
+  fill_missing_sky(out);
+}
+
+}  // namespace radiosity::detail

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/assert.hpp"
 #include "core/parallel.hpp"
 #include "solver/system.hpp"
 
@@ -81,8 +82,24 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   auto slot_of = [&](std::size_t u) -> std::uint32_t& {
     return (u < sys.fronts() ? store.slot : store.back_slot)[sys.element(u)];
   };
+  // This process's unknowns: all of them, or its block when the solve is split among processes
+  // (Jacobi only: its sweeps read nothing of the sweep they are in). The rows of other unknowns
+  // (a split process's block before adaptive subdivision renumbered the unknowns) are freed.
+  const Communicator* split = ctx.split;
+  RADIOSITY_ASSERT(split == nullptr || !gauss_seidel);
+  const std::vector<std::size_t> blocks = split ? even_blocks(m, split->size()) : std::vector<std::size_t>{0, m};
+  const std::size_t own_first = split ? blocks[static_cast<std::size_t>(split->rank())] : 0;
+  const std::size_t own_last = split ? blocks[static_cast<std::size_t>(split->rank()) + 1] : m;
+  if (split)
+    for (std::size_t u = 0; u < m; ++u) {
+      std::uint32_t& slot = slot_of(u);
+      if ((u >= own_first && u < own_last) || slot == kNone) continue;
+      store.rows[slot] = FactorVector{};
+      store.free_slots.push_back(slot);
+      slot = kNone;
+    }
   std::vector<std::uint32_t> missing;
-  for (std::size_t u = 0; u < m; ++u)
+  for (std::size_t u = own_first; u < own_last; ++u)
     if (slot_of(u) == kNone) missing.push_back(static_cast<std::uint32_t>(u));
   // Memory, stated before anything is computed. Rows with backs come from the sparse calls
   // (the dense ones keep to fronts).
@@ -153,8 +170,13 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   }
   result.seconds_form_factors = seconds_since(t0);
   result.form_factor_bytes = store.bytes();
-  std::vector<const FactorVector*> row_of(m);
-  for (std::size_t u = 0; u < m; ++u) row_of[u] = &store.rows[slot_of(u)];
+  // Split: a cancel asked for on any process stops every one, here with the starting estimate.
+  if (split && split->any(split->cancel_requested)) {
+    result.status = SolveStatus::cancelled;
+    return result;
+  }
+  std::vector<const FactorVector*> row_of(m, nullptr);
+  for (std::size_t u = own_first; u < own_last; ++u) row_of[u] = &store.rows[slot_of(u)];
   auto row = [&](std::size_t i) -> const FactorVector& { return *row_of[i]; };
   // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp; E_u with the lights' first shot); opaque
   // sides have no twin.
@@ -174,9 +196,12 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
     if (!gauss_seidel) {
       // Jacobi: every side from the previous sweep's patch radiosity; rows are independent.
       // Translucent sides need the other side's irradiance, so all of H comes first.
-      parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) result.H[i] = row(i).dot(patch_B);
+      // Split: this process's block of H, then every block from the others (12 bytes per
+      // unknown), and B and the residual over every unknown in this order on every process.
+      parallel_for(ctx.options.threads, own_last - own_first, 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = own_first + begin; i < own_first + end; ++i) result.H[i] = row(i).dot(patch_B);
       });
+      if (split) split->all_gather(result.H, blocks);
       for (std::size_t i = 0; i < m; ++i) next[i] = radiosity(i, result.H[i]);
       for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * l1(next[i] - result.B[i]);
       result.B.swap(next);
@@ -198,14 +223,22 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       }
     }
     // Form factors included in the time: the first sweep waits for them.
-    if (end_sweep(ctx, result, it, change, seconds_since(t0))) break;
+    const bool stop = end_sweep(ctx, result, it, change, seconds_since(t0));
+    // Split: every process has the same residual, so they agree on convergence; a cancel is
+    // agreed on here (one all-reduce of a flag per sweep).
+    if (split && split->any(split->cancel_requested)) {
+      result.status = SolveStatus::cancelled;
+      break;
+    }
+    if (stop) break;
   }
 
   // Irradiance for the energy balance: H_e = sum_j F_ej B_j with the final radiosity.
   sys.patch_means(result.B, patch_B);
-  parallel_for(ctx.options.threads, m, 256, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) result.H[i] = row(i).dot(patch_B);
+  parallel_for(ctx.options.threads, own_last - own_first, 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = own_first + begin; i < own_first + end; ++i) result.H[i] = row(i).dot(patch_B);
   });
+  if (split) split->all_gather(result.H, blocks);
   return result;
 }
 

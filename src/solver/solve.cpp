@@ -15,6 +15,7 @@
 #include "solver/hierarchical/link_hierarchy.hpp"
 #include "solver/light_groups.hpp"
 #include "solver/light_shot.hpp"
+#include "solver/split_solve.hpp"
 #include "solver/system.hpp"
 #include "core/assert.hpp"
 
@@ -32,20 +33,28 @@ constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
 /// straight from the emitters and the lights. The matrix
 /// methods have every row in `store`; progressive refinement takes the emitting targets'
 /// columns, from `columns` when it holds them for these leaves, else from the estimator.
+/// Split among processes (Jacobi), each has the rows of its block of unknowns
+/// (solve_matrix()): each computes its block, and the blocks are gathered.
 std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const FormFactorEstimator& estimator,
                                    bool progressive, const detail::MatrixStore& store,
-                                   const detail::ColumnStore& columns) {
+                                   const detail::ColumnStore& columns, const detail::Communicator* split) {
   std::vector<Rgb> patch_E;
   sys.patch_means(sys.emission, patch_E);
   std::vector<Rgb> out(sys.fronts(), Rgb(0.0f));
   if (!sys.light.empty())
     for (std::size_t u = 0; u < sys.fronts(); ++u) out[u] = sys.light[u];
   if (!progressive) {
-    for (std::size_t u = 0; u < sys.fronts(); ++u) {
+    // The fronts of this process's block of unknowns (solve_matrix()'s), or all of them.
+    std::vector<std::size_t> blocks = split ? detail::even_blocks(sys.unknowns(), split->size())
+                                            : std::vector<std::size_t>{0, sys.unknowns()};
+    for (std::size_t& b : blocks) b = std::min(b, sys.fronts());
+    const std::size_t rank = split ? static_cast<std::size_t>(split->rank()) : 0;
+    for (std::size_t u = blocks[rank]; u < blocks[rank + 1]; ++u) {
       const std::uint32_t slot = store.slot[sys.element(u)];
-      RADIOSITY_ASSERT(slot != kNone);  // solve_matrix() made a row for every unknown
+      RADIOSITY_ASSERT(slot != kNone);  // solve_matrix() made a row for every unknown of the block
       out[u] += store.rows[slot].dot(patch_E);
     }
+    if (split) split->all_gather(out, blocks);
     return out;
   }
   const bool kept = columns.leaf_count == sys.fronts() && columns.columns.size() == sys.patches();
@@ -148,8 +157,14 @@ struct Problem::Impl {
   std::unique_ptr<detail::LinkHierarchy> links;
   /// During a light group's solve: that group's lights alone (solve_light_groups()).
   const detail::LightShot* group_light_shot = nullptr;
+  /// The processes a Jacobi solve is split among (detail::solve_split(), docs/MPI.md), or null.
+  /// Split, every process holds the whole problem, computes the rows of its block of unknowns
+  /// and its share of the lights' first shot and gathers the rest, so each returns the single process's
+  /// solution; on_progress then never cancels at once (a process cannot stop alone): a cancel
+  /// is agreed on at the end of the form factors and of each sweep.
+  const detail::Communicator* processes = nullptr;
 
-  Impl(const Scene& s, const SolveOptions& options);
+  Impl(const Scene& s, const SolveOptions& options, const detail::Communicator* split_among = nullptr);
   /// One solve; `emission` per polygon or null (the materials'). With `last` the hierarchy is
   /// moved into the Solution (the facade's single solve: no copy).
   Solution solve(const std::vector<Rgb>* emission, bool last);
@@ -162,6 +177,10 @@ struct Problem::Impl {
   void choose_method();
   /// The lights' first shot for `elements` that lack it; false when cancelled.
   bool shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate);
+  /// light_shooter->shoot(elements, shot, gate, only), or, split, each process's share of the
+  /// elements that lack a value (dealt out in turn), gathered.
+  bool shoot(const std::vector<std::uint32_t>& elements, detail::LightShot& shot, detail::ProgressGate& gate,
+             const std::vector<char>* only = nullptr);
 };
 
 void Problem::Impl::choose_method() {
@@ -197,14 +216,70 @@ bool Problem::Impl::shoot_lights(const std::vector<std::uint32_t>& elements, det
   if (!light_shooter)
     light_shooter =
         std::make_unique<detail::LightShooter>(scene, hierarchy, options.seed, options.threads, options.sky_rays);
-  return light_shooter->shoot(elements, light_shot, gate);
+  return shoot(elements, light_shot, gate);
 }
 
-Problem::Impl::Impl(const Scene& s, const SolveOptions& given) : scene(s), options(given) {
+bool Problem::Impl::shoot(const std::vector<std::uint32_t>& elements, detail::LightShot& shot,
+                          detail::ProgressGate& gate, const std::vector<char>* only) {
+  if (!processes) return light_shooter->shoot(elements, shot, gate, only);
+  // Every process has the same `done` flags, so the same elements to shoot. They are dealt out
+  // in turn (element k to process k mod P): an element's cost varies by orders of magnitude (a
+  // roof sees all the sky and needs no ray, a street between towers a thousand), and neighbours
+  // in the list cost alike, so contiguous blocks would leave one process all the work. Who
+  // shoots an element does not matter: each element side and light has its own stream.
+  const std::size_t count = hierarchy.elements().size();
+  shot.front.resize(count, Rgb(0.0f));
+  shot.back.resize(count, Rgb(0.0f));
+  shot.done.resize(count, 0);
+  std::vector<std::uint32_t> todo;
+  for (std::uint32_t e : elements)
+    if (!shot.done[e]) todo.push_back(e);
+  const auto P = static_cast<std::size_t>(processes->size()), rank = static_cast<std::size_t>(processes->rank());
+  // Process r shoots todo[r], todo[r + P], ...: a block of its own in the gathered arrays.
+  std::vector<std::size_t> blocks(P + 1, 0);
+  for (std::size_t r = 0; r < P; ++r) blocks[r + 1] = blocks[r] + (todo.size() + P - 1 - r) / P;
+  std::vector<std::uint32_t> mine;
+  for (std::size_t k = rank; k < todo.size(); k += P) mine.push_back(todo[k]);
+  const std::uint64_t rays = shot.rays;
+  const bool completed = light_shooter->shoot(mine, shot, gate, only);
+  std::vector<Rgb> front(todo.size(), Rgb(0.0f)), back(todo.size(), Rgb(0.0f));
+  for (std::size_t j = 0; j < mine.size(); ++j) {
+    front[blocks[rank] + j] = shot.front[mine[j]];
+    back[blocks[rank] + j] = shot.back[mine[j]];
+  }
+  processes->all_gather(front, blocks);
+  processes->all_gather(back, blocks);
+  for (std::size_t r = 0; r < P; ++r)
+    for (std::size_t j = 0; j < blocks[r + 1] - blocks[r]; ++j) {
+      const std::uint32_t e = todo[r + j * P];
+      shot.front[e] = front[blocks[r] + j];
+      shot.back[e] = back[blocks[r] + j];
+      shot.done[e] = 1;
+    }
+  shot.rays = rays + processes->sum(shot.rays - rays);
+  return completed;
+}
+
+Problem::Impl::Impl(const Scene& s, const SolveOptions& given, const detail::Communicator* split_among)
+    : scene(s), options(given), processes(split_among) {
   validate(given);
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "solve: the scene has no polygons");
 
   SolveOptions& o = options;
+  if (processes) {
+    // A process cannot stop alone (the others would wait for it): the callback's cancel is
+    // remembered and agreed on at the end of the form factors and of each sweep.
+    if (o.method != SolverMethod::jacobi)
+      throw Error(ErrorCode::invalid_argument,
+                  "mpi::solve: method must be SolverMethod::jacobi, the one whose sweeps split among processes bit "
+                  "for bit (Gauss-Seidel's sweep runs through the unknowns in turn; progressive and hierarchical "
+                  "are not split)");
+    if (o.on_progress)
+      o.on_progress = [callback = given.on_progress, split_among](const Progress& p) {
+        if (!callback(p)) split_among->cancel_requested = true;
+        return true;
+      };
+  }
   if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
   // Automatic starts as Gauss-Seidel; the first solve, which knows the rows' size, may switch.
   if (o.method == SolverMethod::automatic) {
@@ -289,7 +364,7 @@ std::vector<LightGroupSolution> Problem::Impl::solve_light_groups(const std::vec
     if (!lights.empty()) {
       shot = detail::LightShot{};
       if (!light_shooter && !shoot_lights({}, gate)) return {};  // makes the shooter
-      if (!light_shooter->shoot(hierarchy.leaves(), shot, gate, &g.lights)) return {};
+      if (!shoot(hierarchy.leaves(), shot, gate, &g.lights)) return {};
       group_light_shot = &shot;
     }
     const Solution part = solve_once(&group_emission, false);
@@ -341,9 +416,18 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   report.method_choice = method_choice;
   const bool hierarchical = o.method == SolverMethod::hierarchical;
   if (!estimator && !hierarchical) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
-  if (o.method != SolverMethod::progressive && !hierarchical && store.rows.empty() && !translucency)
-    detail::check_row_memory(hierarchy.leaves().size(), hierarchy.leaves().size(), estimator->target_count(),
-                             estimator->sparse(), estimator->max_row_entries(), o.memory_budget_bytes);
+  if (o.method != SolverMethod::progressive && !hierarchical && store.rows.empty() && !translucency) {
+    // Split, a process holds the rows of its block only.
+    const std::size_t leaves = hierarchy.leaves().size();
+    std::size_t rows = leaves;
+    if (processes) {
+      const std::vector<std::size_t> blocks = detail::even_blocks(leaves, processes->size());
+      const auto rank = static_cast<std::size_t>(processes->rank());
+      rows = blocks[rank + 1] - blocks[rank];
+    }
+    detail::check_row_memory(rows, leaves, estimator->target_count(), estimator->sparse(),
+                             estimator->max_row_entries(), o.memory_budget_bytes);
+  }
 
   // The lights' first shot (once per Problem): their direct irradiance on every element.
   const double light_seconds = light_shot.seconds;
@@ -500,7 +584,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       }
       if (solved && split.empty() && stats.links_replaced == 0) break;  // nothing changed
       report.refinement_passes = pass;
-      detail::SolverContext context{scene, hierarchy, *system, nullptr, o, gate};
+      detail::SolverContext context{scene, hierarchy, *system, nullptr, o, gate, nullptr};
       r = links->solve(context, solved ? current_B() : std::vector<Rgb>{});
       keep(r);
       status = r.status;
@@ -511,7 +595,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     report.link_count = links->link_count();
     report.form_factor_bytes = std::max(report.form_factor_bytes, links->bytes());
   } else {
-    detail::SolverContext context{scene, hierarchy, *system, estimator.get(), o, gate};
+    detail::SolverContext context{scene, hierarchy, *system, estimator.get(), o, gate, processes};
     r = progressive ? detail::solve_progressive(context, columns)
                     : detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, {});
     keep(r);
@@ -545,7 +629,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
 
       if (!progressive) {
         // Matrix methods: rows for the new elements only, then sweeps from the warm start.
-        detail::SolverContext context{scene, hierarchy, *system, estimator.get(), o, gate};
+        detail::SolverContext context{scene, hierarchy, *system, estimator.get(), o, gate, processes};
         r = detail::solve_matrix(context, o.method == SolverMethod::gauss_seidel, store, current_B());
         keep(r);
         status = r.status;
@@ -636,7 +720,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       if (!system->light.empty())
         for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->light[u];
     } else {
-      direct = direct_irradiance(*system, *estimator, progressive, store, columns);
+      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes);
     }
     H_direct.assign(hierarchy.elements().size(), Rgb(0.0f));
     for (std::size_t u = 0; u < system->fronts(); ++u) H_direct[system->leaves[u]] = direct[u];
@@ -705,3 +789,18 @@ Solution solve(const Scene& scene, const SolveOptions& options) {
 
 }  // namespace v1
 }  // namespace radiosity
+
+namespace radiosity::detail {
+
+struct SplitSolve {
+  static Solution solve(const Scene& scene, const SolveOptions& options, const Communicator& split) {
+    Problem::Impl problem(scene, options, &split);
+    return problem.solve(nullptr, true);
+  }
+};
+
+Solution solve_split(const Scene& scene, const SolveOptions& options, const Communicator& split) {
+  return SplitSolve::solve(scene, options, split);
+}
+
+}  // namespace radiosity::detail

@@ -10,6 +10,7 @@
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 #include "radiosity/solver.hpp"
+#include "core/communicator.hpp"
 #include "core/progress.hpp"
 #include "solver/light_shot.hpp"
 
@@ -97,6 +98,10 @@ struct SolverContext {
   const FormFactorEstimator* estimator;  ///< null for SolverMethod::hierarchical (no form factors)
   const SolveOptions& options;  ///< with max_iterations and memory_budget_bytes resolved
   ProgressGate& progress;
+  /// The processes the solve is split among (Jacobi only, docs/MPI.md), or null for this one
+  /// alone: each computes and keeps the rows of its block of unknowns (even_blocks()) and the
+  /// blocks of each sweep's irradiance are gathered, so every process holds all of B.
+  const Communicator* split;
 };
 
 /// The end of sweep `it` of a sweeping solver (the matrix methods, hierarchical): records the
@@ -177,6 +182,10 @@ std::size_t row_memory_bytes(std::size_t rows, std::size_t patches, bool sparse,
 
 /// Jacobi or Gauss-Seidel sweeps. Computes the rows `store` lacks for the system's leaves (all
 /// of them on the first call), then iterates from `B0` (per unknown; empty = start from E).
+/// Split among processes (context.split, Jacobi only), a process computes and keeps the rows of
+/// its block of unknowns only (and frees those of other unknowns), gathers each sweep's
+/// irradiance from the others and computes B and the residual over every unknown in the
+/// single process's order: the result is bit for bit one process's, on every process.
 SolverResult solve_matrix(const SolverContext& context, bool gauss_seidel, MatrixStore& store,
                           const std::vector<Rgb>& B0);
 /// Progressive refinement, reusing and adding to the columns in `store`.

@@ -9,9 +9,14 @@
 #include <memory>
 #include <sstream>
 
+#include "cli_mpi.hpp"
 #include "factors_format.hpp"
 #include "npz_format.hpp"
 #include "view3d_format.hpp"
+
+#if RADIOSITY_HAS_MPI
+#include "radiosity/mpi.hpp"
+#endif
 
 namespace cli {
 
@@ -24,6 +29,7 @@ struct FactorsArgs {
   std::string level = "group";
   std::string correction = "none";
   std::string row_sums;
+  std::string blocks;  ///< --blocks DIR
   bool sparse = false;
   bool level_given = false, correction_given = false;  // set from the options' counts
   std::string output;
@@ -59,6 +65,86 @@ void write_text(const std::string& path, const std::string& text) {
   out << text;
   out.close();
   if (!out) throw rad::Error(rad::ErrorCode::io_error, "cannot write '" + path + "'");
+}
+
+/// --blocks DIR: each process's rows (one block without mpirun) as DIR/block-K.mtx (Matrix
+/// Market, the whole matrix's numbering) and DIR/block-K.rows.csv (row_sums_csv() of its rows),
+/// and DIR/manifest.json from rank 0: what a matrix larger than one node's memory is written as
+/// (docs/MPI.md). Uncorrected. Returns the exit code.
+int write_blocks(const rad::Scene& scene, const rad::ViewFactorOptions& o, const FactorsArgs& a,
+                 const std::string& level, ProgressBar& bar) {
+  struct Range {
+    std::size_t first = 0, last = 0;
+    std::uint64_t non_zeros = 0;
+    std::size_t source_elements = 0;
+  };
+  rad::ViewFactorMatrix rows;
+  std::size_t first_row = 0, total_rows = 0;
+  std::vector<Range> ranges;
+#if RADIOSITY_HAS_MPI
+  rad::mpi::ViewFactorBlock block = rad::mpi::view_factor_block(scene, o, MPI_COMM_WORLD);
+  rows = std::move(block.rows);
+  first_row = block.first_row;
+  total_rows = block.total_rows;
+  for (const rad::mpi::RowBlock& b : block.blocks)
+    ranges.push_back(Range{b.first_row, b.last_row, b.non_zeros, b.source_elements});
+#else
+  rows = rad::view_factor_matrix(scene, o);
+  total_rows = rows.rows();
+  ranges.push_back(Range{0, rows.rows(), rows.non_zeros(), rows.element_count});
+#endif
+  bar.finish();
+  const int rank = process_rank();
+  const std::filesystem::path folder(a.blocks);
+  const std::string matrix_file = "block-" + std::to_string(rank) + ".mtx",
+                    rows_file = "block-" + std::to_string(rank) + ".rows.csv";
+  std::string error;
+  try {
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);  // every process: the folder may be its own disk's
+    if (!std::filesystem::is_directory(folder))
+      throw rad::Error(rad::ErrorCode::io_error, "cannot create the output folder '" + a.blocks + "'");
+    write_text((folder / matrix_file).string(),
+               matrix_market_block(rows, first_row, total_rows, static_cast<std::size_t>(rank), ranges.size()));
+    write_text((folder / rows_file).string(), row_sums_csv(rows, first_row));
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  error = agree_on_error(error);  // a process that cannot write stops them all, and rank 0 says why
+  if (!error.empty()) throw rad::Error(rad::ErrorCode::io_error, error);
+  if (rank != 0) return 0;
+
+  nlohmann::ordered_json manifest;
+  manifest["format"] = "radiosity view-factor blocks";
+  manifest["level"] = level;
+  manifest["method"] = rows.method;
+  manifest["correction"] = "none";
+  manifest["seed"] = a.seed;
+  manifest["rows"] = total_rows;
+  manifest["columns"] = total_rows;
+  std::uint64_t non_zeros = 0;
+  std::size_t elements = 0;
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (std::size_t r = 0; r < ranges.size(); ++r) {
+    non_zeros += ranges[r].non_zeros;
+    elements += ranges[r].source_elements;
+    list.push_back({{"rank", r},
+                    {"first_row", ranges[r].first},
+                    {"last_row", ranges[r].last},
+                    {"non_zeros", ranges[r].non_zeros},
+                    {"source_elements", ranges[r].source_elements},
+                    {"matrix", "block-" + std::to_string(r) + ".mtx"},
+                    {"rows", "block-" + std::to_string(r) + ".rows.csv"}});
+  }
+  manifest["non_zeros"] = non_zeros;
+  manifest["source_elements"] = elements;
+  manifest["blocks"] = std::move(list);
+  write_text((folder / "manifest.json").string(), manifest.dump(2) + "\n");
+  std::fprintf(stderr, "factors: %zu %ss, %llu factors, %zu source elements, %s, %zu block%s (one per process), "
+               "%.3f s, wrote %s\n",
+               total_rows, level.c_str(), static_cast<unsigned long long>(non_zeros), elements, rows.method.c_str(),
+               ranges.size(), ranges.size() == 1 ? "" : "s", rows.seconds, (folder / "manifest.json").c_str());
+  return 0;
 }
 
 int run_factors(const FactorsArgs& a) {
@@ -121,15 +207,41 @@ int run_factors(const FactorsArgs& a) {
       throw rad::Error(rad::ErrorCode::invalid_argument, "--format mtx is for --level polygon or element");
     ProgressBar bar;
     o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
+    if (!a.blocks.empty()) {
+      if (o.level == rad::ViewFactorLevel::group || o.method == rad::ViewFactorMethod::hierarchical)
+        throw rad::Error(rad::ErrorCode::invalid_argument, "--blocks is for --level polygon or element (the estimator's rows)");
+      if (o.correction != rad::ViewFactorCorrection::none)
+        throw rad::Error(rad::ErrorCode::invalid_argument,
+                         "--blocks writes uncorrected rows: the " + correction + " correction needs the whole matrix");
+      if (!a.output.empty() || !a.row_sums.empty())
+        throw rad::Error(rad::ErrorCode::invalid_argument,
+                         "--blocks writes its own files (Matrix Market and row sums per block): leave out -o and --row-sums");
+      return write_blocks(scene, o, a, level, bar);
+    }
+    // Under mpirun the rows are split among the processes and rank 0 writes the result; the group
+    // level is not split (each group's sums run over all its elements in turn): rank 0 alone.
+    const int processes = process_count();
+    if (processes > 1 && o.level == rad::ViewFactorLevel::group) {
+      if (process_rank() != 0) return 0;
+      std::fprintf(stderr, "factors: the group level is not split among MPI processes: rank 0 computes it alone\n");
+    }
+    const bool split = processes > 1 && o.level != rad::ViewFactorLevel::group;
     // The group level without a correction is view_factors() itself, as before the levels.
     const bool matrix = o.level != rad::ViewFactorLevel::group || o.correction != rad::ViewFactorCorrection::none ||
                         a.format == "view3d" || a.format == "npz";
     rad::ViewFactorMatrix m;
     rad::GroupViewFactors v;
-    if (matrix)
+    if (split) {
+#if RADIOSITY_HAS_MPI
+      m = rad::mpi::view_factor_matrix(scene, o, MPI_COMM_WORLD);
+#endif
+      bar.finish();
+      if (process_rank() != 0) return 0;  // its block only: rank 0 has the whole matrix and writes it
+    } else if (matrix) {
       m = rad::view_factor_matrix(scene, o);
-    else
+    } else {
       v = rad::view_factors(scene, o);
+    }
     bar.finish();
     if (matrix && o.level == rad::ViewFactorLevel::group) v = group_factors(m, 0);
 
@@ -169,8 +281,10 @@ int run_factors(const FactorsArgs& a) {
                    v.groups.size(), v.patch_count, v.element_count, a.method.c_str(), links.c_str(), v.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
     } else {
-      std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s, %.3f s%s%s\n", m.rows(),
-                   level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), m.seconds,
+      const std::string processes_text =
+          split ? ", split among " + std::to_string(processes) + " MPI processes" : std::string();
+      std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s%s, %.3f s%s%s\n", m.rows(),
+                   level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), processes_text.c_str(), m.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
       // Rows that see nothing: one-sided polygons whose fronts face away from everything.
       std::size_t blind = 0;
@@ -236,8 +350,12 @@ Command add_factors_command(CLI::App& app) {
       ->check(CLI::IsMember({"csv", "json", "mtx", "view3d", "npz"}))
       ->capture_default_str();
   cmd->add_option("--row-sums", a.row_sums,
-                  "Also write each row's area, sum, sky view factor (1 - sum) and standard error as CSV here");
+                  "Also write each row's area, sum, sky view factor and standard errors as CSV here");
   cmd->add_flag("--sparse", a.sparse, "Only the non-zero factors (CSV: from,to,factor rows)");
+  cmd->add_option("--blocks", a.blocks,
+                  "Write the rows as blocks into this folder, one per MPI process (one without mpirun): "
+                  "block-K.mtx (Matrix Market, the whole matrix's numbering), block-K.rows.csv and manifest.json; "
+                  "for matrices larger than one node's memory; uncorrected (docs/MPI.md)");
   cmd->add_option("-o,--output", a.output, "Write here instead of stdout");
   cmd->add_option("--groups", a.groups, "Comma-separated groups to report, in this order (default: all)");
   cmd->add_option("--samples", a.samples,

@@ -111,6 +111,15 @@ inline std::string matrix_csv(const radiosity::ViewFactorMatrix& m) {
   return out;
 }
 
+/// The entries of Matrix Market's coordinate format, one line `row column factor` each, 1-based,
+/// the rows of `m` numbered from first_row + 1.
+inline void matrix_market_entries(const radiosity::ViewFactorMatrix& m, std::size_t first_row, std::string& out) {
+  for (std::size_t i = 0; i < m.rows(); ++i)
+    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k)
+      out += std::to_string(first_row + i + 1) + " " + std::to_string(m.columns[k] + 1) + " " +
+             csv_number(static_cast<double>(m.values[k])) + "\n";
+}
+
 /// Matrix Market coordinate format (NIST), 1-based: row and column k are the matrix's k-th
 /// surface (ids[k - 1]; the `%ids` comment lists them when they are not 0, 1, 2, ... in order).
 inline std::string matrix_market(const radiosity::ViewFactorMatrix& m) {
@@ -125,10 +134,25 @@ inline std::string matrix_market(const radiosity::ViewFactorMatrix& m) {
     out += "\n";
   }
   out += std::to_string(m.rows()) + " " + std::to_string(m.rows()) + " " + std::to_string(m.non_zeros()) + "\n";
-  for (std::size_t i = 0; i < m.rows(); ++i)
-    for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k)
-      out += std::to_string(i + 1) + " " + std::to_string(m.columns[k] + 1) + " " +
-             csv_number(static_cast<double>(m.values[k])) + "\n";
+  matrix_market_entries(m, 0, out);
+  return out;
+}
+
+/// One block of rows of a `total_rows`-square matrix (`factors --blocks`: a process's rows,
+/// [first_row, first_row + block.rows())) in Matrix Market's coordinate format: a whole-size
+/// matrix that holds the block's factors only, rows and columns numbered as in the whole matrix
+/// (1-based), so the blocks' entries, concatenated in order, are the whole matrix's. The ids of
+/// the rows are in the blocks' row files (row_sums_csv()).
+inline std::string matrix_market_block(const radiosity::ViewFactorMatrix& block, std::size_t first_row,
+                                       std::size_t total_rows, std::size_t index, std::size_t blocks) {
+  std::string out = "%%MatrixMarket matrix coordinate real general\n";
+  out += std::string("% radiosity view factors F(row -> column): level ") + radiosity::to_string(block.level) +
+         ", method " + block.method + "\n";
+  out += "% block " + std::to_string(index + 1) + " of " + std::to_string(blocks) + ": rows " +
+         std::to_string(first_row + 1) + " to " + std::to_string(first_row + block.rows()) + " (1-based) of " +
+         std::to_string(total_rows) + ", uncorrected; rows and columns number the whole matrix's rows\n";
+  out += std::to_string(total_rows) + " " + std::to_string(total_rows) + " " + std::to_string(block.non_zeros()) + "\n";
+  matrix_market_entries(block, first_row, out);
   return out;
 }
 
@@ -159,14 +183,14 @@ inline std::string matrix_json(const radiosity::ViewFactorMatrix& m, radiosity::
 /// Per row: `row,id,area,row_sum,sky,sky_standard_error,row_standard_error`: the row's sum of
 /// factors, its sky view factor (ViewFactorMatrix::sky) with its standard error, and the row
 /// sum's standard error where the estimator states one (empty otherwise); the group level names
-/// the group in `id`.
-inline std::string row_sums_csv(const radiosity::ViewFactorMatrix& m) {
+/// the group in `id`. Rows are numbered from `first_row` (a block's, `factors --blocks`), 0-based.
+inline std::string row_sums_csv(const radiosity::ViewFactorMatrix& m, std::size_t first_row = 0) {
   std::string out = "row,id,area,row_sum,sky,sky_standard_error,row_standard_error\n";
   for (std::size_t i = 0; i < m.rows(); ++i) {
     double sum = 0.0;
     for (std::uint64_t k = m.row_offsets[i]; k < m.row_offsets[i + 1]; ++k) sum += static_cast<double>(m.values[k]);
     const std::string id = m.names.empty() ? std::to_string(m.ids[i]) : csv_field(m.names[i]);
-    out += std::to_string(i) + "," + id + "," + csv_number(m.area[i]) + "," + csv_number(sum) + "," +
+    out += std::to_string(first_row + i) + "," + id + "," + csv_number(m.area[i]) + "," + csv_number(sum) + "," +
            csv_number(m.sky[i]) + "," + csv_number(m.sky_standard_error[i]) + "," +
            (m.row_standard_error.empty() ? "" : csv_number(m.row_standard_error[i])) + "\n";
   }

@@ -9,11 +9,19 @@
 #include "cli_common.hpp"
 #include "bake.hpp"
 #include "check.hpp"
+#include "cli_mpi.hpp"
 #include "factors.hpp"
+
+#if RADIOSITY_HAS_MPI
+#include "radiosity/mpi.hpp"
+#endif
 
 using namespace cli;
 
 int main(int argc, char** argv) {
+  // Under mpirun, factors and solve --method jacobi split their work among the processes
+  // (docs/MPI.md); rank 0 prints and writes, the other ranks are silent.
+  const MpiSession mpi(argc, argv);
   CLI::App app{"radiosity " + std::string(rad::version()) +
                ": global illumination by the radiosity method.\nWith no SCENE, the built-in Cornell box is used."};
   app.require_subcommand(1);
@@ -85,6 +93,13 @@ int main(int argc, char** argv) {
   Command bake = add_bake_command(app);
 
   if (const std::optional<int> code = parse_command_line(app, argc, argv)) return *code;
+  // The rest is not split: rank 0 runs it alone (the others would only repeat it).
+  const bool split = *factors.app || (*solve && solve_args.method == "jacobi");
+  if (process_count() > 1 && !split) {
+    if (process_rank() != 0) return 0;
+    std::fprintf(stderr, "radiosity: note: only factors and solve --method jacobi are split among MPI processes; "
+                         "rank 0 runs this alone\n");
+  }
   if (*factors.app) return factors.run();
   if (*check.app) return check.run();
   if (*bake.app) return bake.run();
@@ -229,8 +244,17 @@ int main(int argc, char** argv) {
       rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.two_sided, solve_args.photometric);
       print_warnings(scene.warnings());
       const rad::SolveOptions options = to_options(solve_args, bar);
+#if RADIOSITY_HAS_MPI
+      // Jacobi split among the processes: every rank gets the whole solution; rank 0 reports it.
+      rad::Solution sol = process_count() > 1 ? rad::mpi::solve(scene, options, MPI_COMM_WORLD) : rad::solve(scene, options);
+#else
       rad::Solution sol = rad::solve(scene, options);
+#endif
       bar.finish();
+      if (process_rank() != 0) return 0;
+      if (process_count() > 1)
+        std::printf("mpi: Jacobi split among %d processes (form-factor rows and lights by blocks of unknowns)\n",
+                    process_count());
       print_summary(sol);
       print_estimator(sol, options);
       print_solve_warnings(scene, sol);

@@ -1,0 +1,75 @@
+# Runs the radiosity CLI once alone and once under mpirun with 2 processes, and compares
+# (ctest: cmake -P this file, from tests/mpi/CMakeLists.txt).
+#   -DEXE=<path>             the radiosity executable
+#   -DMPIRUN=<a|b|c>         the launcher and its flags, separated by '|'
+#   -DNUMPROC_FLAG=<-n>      its process-count flag
+#   -DMODE=stdout            the two runs' stdout must be the same, byte for byte
+#   -DMODE=file              the file FILE (written where ARGS say @FILE@) must be the same
+#   -DMODE=blocks            the split run gets --blocks FILE; the blocks' entries, in order, must
+#                            be the lines of the single run's Matrix Market output (stdout)
+#   -DARGS=<a|b|c>           the CLI's arguments, separated by '|'
+#   -DSTDOUT=, -DSTDERR=     optional regexes the split run's stdout / stderr must match
+cmake_minimum_required(VERSION 3.20)
+string(REPLACE "|" ";" mpirun "${MPIRUN}")
+
+function(run_cli label with_mpi file)
+  string(REPLACE "|" ";" args "${ARGS}")
+  string(REPLACE "@FILE@" "${file}" args "${args}")
+  if(MODE STREQUAL "blocks" AND with_mpi)
+    file(REMOVE_RECURSE ${FILE})
+    list(APPEND args --blocks ${FILE})
+  endif()
+  set(launch)
+  if(with_mpi)
+    set(launch ${mpirun} ${NUMPROC_FLAG} 2)
+  endif()
+  execute_process(COMMAND ${launch} ${EXE} ${args} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  set(what "${launch} radiosity ${args}\n--- stdout:\n${out}--- stderr:\n${err}")
+  if(NOT code STREQUAL "0")
+    message(FATAL_ERROR "${label}: exit code ${code}: ${what}")
+  endif()
+  set(${label}_out "${out}" PARENT_SCOPE)
+  set(${label}_err "${err}" PARENT_SCOPE)
+  set(${label}_what "${what}" PARENT_SCOPE)
+endfunction()
+
+run_cli(single OFF "single_${FILE}")
+run_cli(split ON "split_${FILE}")
+if(DEFINED STDOUT AND NOT STDOUT STREQUAL "" AND NOT split_out MATCHES "${STDOUT}")
+  message(FATAL_ERROR "stdout does not match '${STDOUT}': ${split_what}")
+endif()
+if(DEFINED STDERR AND NOT STDERR STREQUAL "" AND NOT split_err MATCHES "${STDERR}")
+  message(FATAL_ERROR "stderr does not match '${STDERR}': ${split_what}")
+endif()
+
+if(MODE STREQUAL "stdout")
+  if(NOT single_out STREQUAL split_out)
+    message(FATAL_ERROR "the outputs differ:\n=== one process: ${single_what}\n=== two: ${split_what}")
+  endif()
+elseif(MODE STREQUAL "file")
+  file(SHA256 "single_${FILE}" a)
+  file(SHA256 "split_${FILE}" b)
+  if(NOT a STREQUAL b)
+    message(FATAL_ERROR "single_${FILE} and split_${FILE} differ: ${split_what}")
+  endif()
+elseif(MODE STREQUAL "blocks")
+  # The single run's entries: the lines after the comments and the size line.
+  string(REGEX REPLACE "^(%[^\n]*\n)*[^\n]*\n" "" expected "${single_out}")
+  file(READ ${FILE}/manifest.json manifest)
+  string(JSON blocks LENGTH "${manifest}" blocks)
+  if(NOT blocks EQUAL 2)
+    message(FATAL_ERROR "manifest with ${blocks} blocks, expected 2: ${manifest}")
+  endif()
+  set(entries "")
+  foreach(k 0 1)
+    string(JSON matrix GET "${manifest}" blocks ${k} matrix)
+    file(READ ${FILE}/${matrix} text)
+    string(REGEX REPLACE "^(%[^\n]*\n)*[^\n]*\n" "" text "${text}")
+    string(APPEND entries "${text}")
+  endforeach()
+  if(NOT entries STREQUAL expected)
+    message(FATAL_ERROR "the blocks' entries are not the single process's matrix: ${split_what}")
+  endif()
+else()
+  message(FATAL_ERROR "unknown MODE '${MODE}'")
+endif()
