@@ -239,13 +239,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
 bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& shot, ProgressGate& gate,
                          const std::vector<char>* only) const {
   const auto t0 = std::chrono::steady_clock::now();
-  const std::size_t count = hierarchy_.elements().size();
-  shot.front.resize(count, Rgb(0.0f));
-  shot.back.resize(count, Rgb(0.0f));
-  shot.done.resize(count, 0);
-  std::vector<std::uint32_t> todo;
-  for (std::uint32_t e : elements)
-    if (!shot.done[e]) todo.push_back(e);
+  const std::vector<std::uint32_t> todo = shot.pending(elements, hierarchy_.elements().size());
   if (todo.empty()) return true;  // kept from an earlier solve: no time spent
   bool completed = true;
   if (!lights_.empty()) {

@@ -42,6 +42,18 @@ struct LightShot {
   std::uint64_t rays = 0;            ///< shadow rays cast so far
   double seconds = 0.0;              ///< time spent so far
 
+  /// Sizes the arrays for `element_count` elements (new ones not done) and returns those of
+  /// `elements` not computed yet, in their order.
+  std::vector<std::uint32_t> pending(const std::vector<std::uint32_t>& elements, std::size_t element_count) {
+    front.resize(element_count, Rgb(0.0f));
+    back.resize(element_count, Rgb(0.0f));
+    done.resize(element_count, 0);
+    std::vector<std::uint32_t> todo;
+    for (const std::uint32_t e : elements)
+      if (!done[e]) todo.push_back(e);
+    return todo;
+  }
+
   /// The irradiance of element `e`'s front (or back): 0 for one not computed.
   Rgb of(std::uint32_t e, bool back_side) const {
     const std::vector<Rgb>& v = back_side ? back : front;

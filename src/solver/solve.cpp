@@ -227,13 +227,7 @@ bool Problem::Impl::shoot(const std::vector<std::uint32_t>& elements, detail::Li
   // roof sees all the sky and needs no ray, a street between towers a thousand), and neighbours
   // in the list cost alike, so contiguous blocks would leave one process all the work. Who
   // shoots an element does not matter: each element side and light has its own stream.
-  const std::size_t count = hierarchy.elements().size();
-  shot.front.resize(count, Rgb(0.0f));
-  shot.back.resize(count, Rgb(0.0f));
-  shot.done.resize(count, 0);
-  std::vector<std::uint32_t> todo;
-  for (std::uint32_t e : elements)
-    if (!shot.done[e]) todo.push_back(e);
+  const std::vector<std::uint32_t> todo = shot.pending(elements, hierarchy.elements().size());
   const auto P = static_cast<std::size_t>(processes->size()), rank = static_cast<std::size_t>(processes->rank());
   // Process r shoots todo[r], todo[r + P], ...: a block of its own in the gathered arrays.
   std::vector<std::size_t> blocks(P + 1, 0);
