@@ -220,4 +220,37 @@ TEST_SUITE("core") {
       CHECK(glm::length(near(u) - affine) < 2e-3f);
     });
   }
+
+  TEST_CASE("stratified points: one per cell of the closest-to-square grid, or a Latin hypercube") {
+    // (rows, columns) the grid must have, or 0 rows for a Latin hypercube: squares, the
+    // sky's 640 = 20 x 32 and 160 = 10 x 16, a prime, and 2 x 97 (too elongated for a grid).
+    const std::array<std::array<unsigned, 3>, 6> cases{{{256, 16, 16}, {640, 20, 32}, {160, 10, 16}, {12, 3, 4},
+                                                         {97, 0, 0}, {194, 0, 0}}};
+    for (const auto& c : cases) {
+      const unsigned count = c[0], rows = c[1], columns = c[2];
+      core::Rng rng(7, count, 0);
+      std::vector<glm::vec2> p(count);
+      core::stratified(count, rng, true, p.data());
+      std::vector<int> cell(count, 0), u_strata(count, 0), v_strata(count, 0);
+      for (const glm::vec2& q : p) {
+        REQUIRE(q.x >= 0.0f);
+        REQUIRE(q.x < 1.0f);
+        REQUIRE(q.y >= 0.0f);
+        REQUIRE(q.y < 1.0f);
+        if (rows > 0)
+          ++cell[static_cast<unsigned>(q.x * rows) * columns + static_cast<unsigned>(q.y * columns)];
+        ++u_strata[static_cast<unsigned>(q.x * count)];
+        ++v_strata[static_cast<unsigned>(q.y * count)];
+      }
+      INFO("count " << count);
+      if (rows > 0) {
+        for (int n : cell) CHECK(n == 1);
+      } else {
+        for (unsigned k = 0; k < count; ++k) {
+          CHECK(u_strata[k] == 1);
+          CHECK(v_strata[k] == 1);
+        }
+      }
+    }
+  }
 }

@@ -176,9 +176,9 @@ TEST_SUITE("form_factors") {
     rad::ViewFactorOptions o;
     o.level = rad::ViewFactorLevel::polygon;
     o.form_factors.method = rad::FormFactorMethod::monte_carlo;
-    o.form_factors.hemisphere_rays = 512;
+    o.form_factors.hemisphere_rays = 128;
     const rad::ViewFactorMatrix raw = rad::view_factor_matrix(s, o);
-    CHECK(raw.correction.reciprocity_before > 0.003);  // 512 rays per facet: noisy pairs (measured 0.0092)
+    CHECK(raw.correction.reciprocity_before > 0.003);  // 128 rays per facet: noisy pairs
     CHECK(reciprocity_error(raw) > 0.05);
 
     o.correction = rad::ViewFactorCorrection::reciprocity;
@@ -199,7 +199,7 @@ TEST_SUITE("form_factors") {
     CHECK(enc.correction.iterations > 0);
     CHECK(enc.correction.rms_change < 0.01);
     CHECK(enc.non_zeros() == rec.non_zeros());  // the sparsity is kept
-    MESSAGE("512 rays per facet: reciprocity before " << raw.correction.reciprocity_before << ", row sums before "
+    MESSAGE("128 rays per facet: reciprocity before " << raw.correction.reciprocity_before << ", row sums before "
                                                       << raw.correction.row_sum_error_before << ", enclosure change largest "
                                                       << enc.correction.largest_change << " rms " << enc.correction.rms_change
                                                       << " in " << enc.correction.iterations << " iterations");
