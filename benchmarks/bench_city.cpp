@@ -10,14 +10,15 @@
 //
 // Usage: bench_city [PRESET] [--blocks N] [--facet S] [--seed K] [--threads T] [--memory-budget MIB]
 //                   [--epsilon E] [--only monte-carlo|hierarchical] [--city-only] [--sky-rays N]
-//                   [--make-reference FILE | --reference FILE] [--plot FILE.svg]
+//                   [--make-reference FILE | --reference FILE [--elements PREFIX]] [--plot FILE.svg]
 //   PRESET: 22k (3 blocks, 2.25 m facets: 23.5k facets), 246k (10 blocks: 250k), 1M (20 blocks:
 //   991k); the options after a preset change it. Default: 22k. --memory-budget sets
 //   SolveOptions::memory_budget_bytes (default: the library's 4 GiB). --city-only builds the city
 //   and prints its facets without solving. --sky-rays sets SolveOptions::sky_rays.
 //   --make-reference FILE solves the city with 16 times the rays of the configuration
 //   (form factors and sky; Gauss-Seidel to a tolerance of 1e-5) and writes its element radiosity;
-//   --reference FILE then prints every solve's element RMS relative difference to it.
+//   --reference FILE then prints every solve's element RMS relative difference to it, and with
+//   --elements PREFIX writes PREFIX.monte-carlo.csv / PREFIX.hierarchical.csv, one line per element.
 // Prints the city (facets per group, buildings, time to build it), then per configuration the
 // elements, the time of each phase (meshing, the sky's first shot, the estimator's set-up,
 // form factors, solving; from SolveReport, the set-up is the rest of the wall time), sweeps,
@@ -60,6 +61,7 @@ struct Args {
   std::uint32_t sky_rays = rad::SolveOptions{}.sky_rays;  ///< SolveOptions::sky_rays of every solve
   std::string make_reference;           ///< --make-reference FILE: solve the reference, write its radiosity
   std::string reference;                ///< --reference FILE: compare every solve with that reference
+  std::string elements;                 ///< --elements PREFIX: with --reference, every element as CSV
 };
 
 /// The reference's rays: 16 times the configuration, for form factors and the sky.
@@ -90,6 +92,22 @@ std::vector<float> mean_channel(const std::vector<rad::Rgb>& B) {
   std::vector<float> v(B.size());
   for (std::size_t i = 0; i < B.size(); ++i) v[i] = (B[i].x + B[i].y + B[i].z) / 3.0f;
   return v;
+}
+
+/// --elements: one line per element (group, centroid, normal, mean-channel radiosity, the
+/// reference's), for finding where a solve's differences lie (docs/HIERARCHICAL.md).
+bool write_elements(const std::string& path, const rad::Solution& sol, const std::vector<std::uint32_t>& group,
+                    const std::vector<float>& ref) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) return false;
+  std::fprintf(f, "group,x,y,z,nx,ny,nz,radiosity,reference\n");
+  const std::vector<float> B = mean_channel(sol.radiosity());
+  for (std::size_t e = 0; e < B.size() && e < ref.size(); ++e) {
+    const auto id = static_cast<std::uint32_t>(e);
+    const glm::vec3 c = sol.hierarchy().element(id).centroid, n = sol.hierarchy().normal(id);
+    std::fprintf(f, "%u,%g,%g,%g,%g,%g,%g,%g,%g\n", group[e], c.x, c.y, c.z, n.x, n.y, n.z, B[e], ref[e]);
+  }
+  return std::fclose(f) == 0;
 }
 
 /// Prints how far `got` (mean channel per element) lies from `ref`: the RMS relative difference
@@ -230,6 +248,9 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
       for (std::size_t e = 0; e < group.size(); ++e)
         group[e] = sol.hierarchy().patches()[sol.hierarchy().element(static_cast<std::uint32_t>(e)).patch].group;
       compare(mean_channel(sol.radiosity()), ref, group, city.scene.groups());
+      if (!a.elements.empty() && !write_elements(a.elements + (hierarchical ? ".hierarchical.csv" : ".monte-carlo.csv"),
+                                                  sol, group, ref))
+        std::printf("  could not write the elements to %s.*.csv\n", a.elements.c_str());
     }
     std::fflush(stdout);
     if (!g_record_path.empty())
@@ -279,7 +300,8 @@ int usage(const char* bad) {
   std::fprintf(stderr,
                "usage: bench_city [22k|246k|1M] [--blocks N] [--facet METRES] [--seed K] [--threads T]\n"
                "                  [--memory-budget MIB] [--epsilon E] [--only monte-carlo|hierarchical] [--city-only]\n"
-               "                  [--sky-rays N] [--make-reference FILE | --reference FILE] [--plot FILE.svg]\n"
+               "                  [--sky-rays N] [--make-reference FILE | --reference FILE [--elements PREFIX]]\n"
+               "                  [--plot FILE.svg]\n"
                "  presets: 22k = --blocks 3 --facet 2.25 (23.5k facets), 246k = --blocks 10 --facet 2.25 (250k),\n"
                "           1M = --blocks 20 --facet 2.25 (991k)\n");
   return bad ? 2 : 0;
@@ -406,6 +428,8 @@ int main(int argc, char** argv) {
       a.make_reference = argv[++i];
     } else if (arg == "--reference" && has_value) {
       a.reference = argv[++i];
+    } else if (arg == "--elements" && has_value) {
+      a.elements = argv[++i];
     } else if (arg == "--plot" && has_value) {
       a.plot = argv[++i];
     } else if (arg == "--city-only") {
