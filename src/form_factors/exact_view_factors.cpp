@@ -39,6 +39,7 @@
 #include <numeric>
 
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "form_factors/estimators.hpp"
 #include "form_factors/sampling.hpp"
@@ -98,6 +99,7 @@ struct Occluder {
   glm::vec3 normal{0.0f};
   float offset = 0.0f;  ///< dot(normal, corner 0)
   Sphere sphere;
+  glm::vec3 lower{0.0f}, upper{0.0f};  ///< bounding box
   std::uint32_t first_facet = 0;  ///< Impl::facets[first_facet, first_facet + facet_count) are its polygons
   std::uint32_t facet_count = 0;
 };
@@ -178,7 +180,7 @@ struct ExactPolygonTransport::Impl {
 
   void add_cluster(std::uint32_t begin, std::uint32_t end);
   void candidates(std::uint32_t s, std::uint32_t r, std::vector<std::uint32_t>& out) const;
-  double unobstructed(const Face& S, const Face& R, ExactPairCounters& counts) const;
+  double unobstructed(const Face& S, const Face& R) const;
   double visible_factor(const glm::vec3& point, const Face& S, const Face& R, Workspace& w) const;
   template <typename PointFactor>
   double integrate(const Face& S, const PointFactor& g, int max_depth) const;
@@ -285,7 +287,12 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
     glm::vec3 centre(0.0f);
     for (const glm::vec3& v : corners) centre += v;
     o.sphere.centre = centre / static_cast<float>(corners.size());
-    for (const glm::vec3& v : corners) o.sphere.radius = std::max(o.sphere.radius, glm::length(v - o.sphere.centre));
+    o.lower = o.upper = corners[0];
+    for (const glm::vec3& v : corners) {
+      o.sphere.radius = std::max(o.sphere.radius, glm::length(v - o.sphere.centre));
+      o.lower = glm::min(o.lower, v);
+      o.upper = glm::max(o.upper, v);
+    }
     o.first_facet = static_cast<std::uint32_t>(facets.size());
     o.facet_count = static_cast<std::uint32_t>(count);
     facets.insert(facets.end(), members, members + count);
@@ -373,12 +380,19 @@ void ExactPolygonTransport::Impl::candidates(std::uint32_t s, std::uint32_t r, s
   const Face& R = faces[r];
   const glm::vec3 a = S.centroid, ab = R.centroid - S.centroid;
   const float len2 = glm::dot(ab, ab), reach = std::max(S.radius, R.radius) + epsilon;
+  // The pair's bounding box holds its shaft.
+  glm::vec3 lower = S.corners[0], upper = lower;
+  for (const glm::vec3& v : S.corners) lower = glm::min(lower, v), upper = glm::max(upper, v);
+  for (const glm::vec3& v : R.corners) lower = glm::min(lower, v), upper = glm::max(upper, v);
+  lower -= glm::vec3(epsilon);
+  upper += glm::vec3(epsilon);
   for (const Cluster& c : clusters) {
     if (distance_to_segment(c.sphere.centre, a, ab, len2) > c.sphere.radius + reach) continue;
     for (std::uint32_t k = c.first; k < c.first + c.count; ++k) {
       if (k == owner[s] || k == owner[r]) continue;
-      const Sphere& o = occluders[k].sphere;
-      if (distance_to_segment(o.centre, a, ab, len2) > o.radius + reach) continue;
+      const Occluder& o = occluders[k];
+      if (glm::any(glm::lessThan(o.upper, lower)) || glm::any(glm::greaterThan(o.lower, upper))) continue;
+      if (distance_to_segment(o.sphere.centre, a, ab, len2) > o.sphere.radius + reach) continue;
       out.push_back(k);
     }
   }
@@ -409,14 +423,13 @@ void ExactPolygonTransport::Impl::candidates(std::uint32_t s, std::uint32_t r, s
   out.resize(kept);
 }
 
-double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R, ExactPairCounters& counts) const {
+double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R) const {
   const float separation = glm::length(R.centroid - S.centroid) / (S.radius + R.radius);
   bool all_in_front = separation > kFarSeparation;
   for (const glm::vec3& v : R.corners) all_in_front = all_in_front && glm::dot(v - S.centroid, S.normal) > epsilon;
   for (const glm::vec3& v : S.corners) all_in_front = all_in_front && glm::dot(v - R.centroid, R.normal) > epsilon;
   if (all_in_front) {
     // G = sum_a sum_b w_a w_b cos_a cos_b / (pi d^2), both cosines positive everywhere here.
-    ++counts.far;
     double sum = 0.0;
     for (std::size_t a = 0; a < S.gauss.size(); ++a)
       for (std::size_t b = 0; b < R.gauss.size(); ++b) {
@@ -427,7 +440,6 @@ double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R, E
       }
     return sum * kInversePi;
   }
-  ++counts.near;
   const int n = static_cast<int>(R.corners.size());
   auto g = [&](const glm::vec3& x) -> double {
     if (glm::dot(x - R.centroid, R.normal) <= 0.0f) return 0.0;  // behind the receiver
@@ -441,7 +453,6 @@ double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R, E
 // shadow of each candidate occluder (w.candidates).
 double ExactPolygonTransport::Impl::visible_factor(const glm::vec3& point, const Face& S, const Face& R,
                                                    Workspace& w) const {
-  ++w.counts.points;
   const glm::dvec3 x(point);
   const glm::dvec3 nr = R.dnormal;
   const double h = glm::dot(nr, x) - R.offset;  // height of x above the receiver's plane
@@ -612,17 +623,6 @@ std::unique_ptr<ExactPolygonTransport::Workspace> ExactPolygonTransport::workspa
   return std::make_unique<Workspace>();
 }
 
-std::size_t ExactPolygonTransport::occluder_count() const { return impl_->facets.size(); }
-
-void ExactPolygonTransport::add(const Workspace& w, ExactPairCounters& out) const {
-  out.pairs += w.counts.pairs;
-  out.far += w.counts.far;
-  out.near += w.counts.near;
-  out.obstructed += w.counts.obstructed;
-  out.points += w.counts.points;
-  out.occluders += w.counts.occluders;
-}
-
 double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Workspace& w) const {
   const Impl& m = *impl_;
   if (i == j) return 0.0;
@@ -637,11 +637,8 @@ double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Worksp
   if (!r_in_front) return 0.0;
   for (const glm::vec3& v : S.corners) s_in_front |= glm::dot(v - R.centroid, R.normal) > m.epsilon;
   if (!s_in_front) return 0.0;
-  ++w.counts.pairs;
   if (!m.clusters.empty()) m.candidates(s, r, w.candidates);
-  if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R, w.counts);
-  ++w.counts.obstructed;
-  w.counts.occluders += w.candidates.size();
+  if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R);
   auto g = [&](const glm::vec3& x) { return m.visible_factor(x, S, R, w); };
   return m.integrate(S, g, kMaxDepthObstructed);
 }
