@@ -181,6 +181,7 @@ struct ExactPolygonTransport::Impl {
   void add_cluster(std::uint32_t begin, std::uint32_t end);
   void candidates(std::uint32_t s, std::uint32_t r, std::vector<std::uint32_t>& out) const;
   double unobstructed(const Face& S, const Face& R) const;
+  bool hidden_by_one(const Face& S, const Face& R, const std::vector<std::uint32_t>& candidates) const;
   double visible_factor(const glm::vec3& point, const Face& S, const Face& R, Workspace& w) const;
   template <typename PointFactor>
   double integrate(const Face& S, const PointFactor& g, int max_depth) const;
@@ -423,6 +424,37 @@ void ExactPolygonTransport::Impl::candidates(std::uint32_t s, std::uint32_t r, s
   out.resize(kept);
 }
 
+// Whether one candidate occluder hides all of R from all of S: every segment between a corner
+// of S and a corner of R crosses its interior. That is enough: for a point y, the points x whose
+// segment to y meets a convex occluder form a convex set, so it holds all of S when it holds
+// S's corners; and for each x, the points of R hidden from it form a convex set too.
+bool ExactPolygonTransport::Impl::hidden_by_one(const Face& S, const Face& R,
+                                                const std::vector<std::uint32_t>& candidates) const {
+  for (const std::uint32_t k : candidates) {
+    const Occluder& O = occluders[k];
+    const std::size_t n = O.corners.size();
+    bool hidden = true;
+    for (std::size_t a = 0; a < S.corners.size() && hidden; ++a)
+      for (std::size_t b = 0; b < R.corners.size() && hidden; ++b) {
+        const glm::vec3 p = S.corners[a], q = R.corners[b];
+        const float dp = glm::dot(O.normal, p) - O.offset, dq = glm::dot(O.normal, q) - O.offset;
+        // Strictly through the plane, and strictly inside every edge where it crosses.
+        if (!((dp > epsilon && dq < -epsilon) || (dp < -epsilon && dq > epsilon))) {
+          hidden = false;
+          break;
+        }
+        const glm::vec3 z = p + (dp / (dp - dq)) * (q - p);
+        for (std::size_t e = 0; e < n && hidden; ++e) {
+          const glm::vec3& u = O.corners[e];
+          const glm::vec3 edge = O.corners[(e + 1) % n] - u;
+          hidden = glm::dot(glm::cross(edge, z - u), O.normal) > epsilon * glm::length(edge);
+        }
+      }
+    if (hidden) return true;
+  }
+  return false;
+}
+
 double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R) const {
   const float separation = glm::length(R.centroid - S.centroid) / (S.radius + R.radius);
   bool all_in_front = separation > kFarSeparation;
@@ -639,6 +671,7 @@ double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Worksp
   if (!s_in_front) return 0.0;
   if (!m.clusters.empty()) m.candidates(s, r, w.candidates);
   if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R);
+  if (m.hidden_by_one(S, R, w.candidates)) return 0.0;
   auto g = [&](const glm::vec3& x) { return m.visible_factor(x, S, R, w); };
   return m.integrate(S, g, kMaxDepthObstructed);
 }
