@@ -57,6 +57,9 @@ constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.2886
 /// source) end the refinement.
 constexpr double kTolerance = 1e-6;
 constexpr int kMaxDepthClear = 5, kMaxDepthObstructed = 6;
+/// Depth to which an obstructed source is refined along an edge that lies in an occluder's
+/// plane (squares of 1/8 of its width along the edge, each with its 2x2 x 4 Gauss points).
+constexpr int kSideDepth = 3;
 /// Above this relative separation d / (r_i + r_j) (centroid distance over the sum of the
 /// polygons' radii) an unobstructed pair, each wholly in front of the other, takes the 2x2 x 2x2
 /// Gauss rule of the point-to-point kernel (its relative error falls as the separation^-4).
@@ -183,17 +186,20 @@ struct ExactPolygonTransport::Impl {
   double unobstructed(const Face& S, const Face& R) const;
   bool hidden_by_one(const Face& S, const Face& R, const std::vector<std::uint32_t>& candidates) const;
   double visible_factor(const glm::vec3& point, const Face& S, const Face& R, Workspace& w) const;
-  template <typename PointFactor>
-  double integrate(const Face& S, const PointFactor& g, int max_depth) const;
+  template <typename PointFactor, typename Forced>
+  double integrate(const Face& S, const PointFactor& g, int max_depth, const Forced& forced) const;
 };
 
 namespace {
 
 /// The mean over the unit square of at(st) (2x2 Gauss on [lo, lo + size]^2 is `coarse`),
 /// refined by quarters until the four quarters' Gauss rules agree with the whole's within the
-/// tolerance, weighted by the square's share 4^-depth.
+/// tolerance, weighted by the square's share 4^-depth. Squares along the sides of the unit
+/// square in `sides` (bit 0: t = 0, 1: s = 1, 2: t = 1, 3: s = 0) are refined down to
+/// `side_depth` whatever their rules say.
 template <typename At>
-double refine(const At& at, glm::vec2 lo, float size, double coarse, int depth, int max_depth) {
+double refine(const At& at, glm::vec2 lo, float size, double coarse, int depth, int max_depth, unsigned sides,
+              int side_depth) {
   const float h = 0.5f * size;
   const glm::vec2 quarter[4] = {lo, lo + glm::vec2(h, 0.0f), lo + glm::vec2(0.0f, h), lo + glm::vec2(h, h)};
   std::array<double, 4> q{};
@@ -204,26 +210,38 @@ double refine(const At& at, glm::vec2 lo, float size, double coarse, int depth, 
                    at(o + h * glm::vec2(kGaussLo, kGaussHi)) + at(o + h * glm::vec2(kGaussHi, kGaussHi)));
     fine += 0.25 * q[k];
   }
-  if (depth >= max_depth || std::ldexp(std::fabs(fine - coarse), -2 * depth) <= kTolerance) return fine;
+  // Dyadic squares: these comparisons are exact.
+  const unsigned touching = (lo.y == 0.0f ? 1u : 0u) | (lo.x + size == 1.0f ? 2u : 0u) |
+                            (lo.y + size == 1.0f ? 4u : 0u) | (lo.x == 0.0f ? 8u : 0u);
+  const bool forced = depth < side_depth && (touching & sides) != 0;
+  if (!forced && (depth >= max_depth || std::ldexp(std::fabs(fine - coarse), -2 * depth) <= kTolerance)) return fine;
   double sum = 0.0;
-  for (std::size_t k = 0; k < 4; ++k) sum += 0.25 * refine(at, quarter[k], h, q[k], depth + 1, max_depth);
+  for (std::size_t k = 0; k < 4; ++k)
+    sum += 0.25 * refine(at, quarter[k], h, q[k], depth + 1, std::max(max_depth, side_depth), sides, side_depth);
   return sum;
 }
 
 }  // namespace
 
 // The integral over the source S of g(x) (a point factor): per cell, its area times the mean of
-// g over the cell by the adaptive Gauss rule, starting from the face's own 2x2 points.
-template <typename PointFactor>
-double ExactPolygonTransport::Impl::integrate(const Face& S, const PointFactor& g, int max_depth) const {
+// g over the cell by the adaptive Gauss rule, starting from the face's own 2x2 points. A cell's
+// side for which forced(a, b) holds (a and b its ends) is refined down to kSideDepth.
+template <typename PointFactor, typename Forced>
+double ExactPolygonTransport::Impl::integrate(const Face& S, const PointFactor& g, int max_depth,
+                                              const Forced& forced) const {
   double total = 0.0;
   for (std::size_t c = 0; c < S.cells.size(); ++c) {
     const Cell& cell = S.cells[c];
     double coarse = 0.0;
     for (std::size_t k = 0; k < 4; ++k) coarse += S.weight[4 * c + k] * g(S.gauss[4 * c + k]);
     coarse /= cell.area;
+    const glm::vec3 corner[4] = {cell.map.point(glm::vec2(0.0f, 0.0f)), cell.map.point(glm::vec2(1.0f, 0.0f)),
+                                 cell.map.point(glm::vec2(1.0f, 1.0f)), cell.map.point(glm::vec2(0.0f, 1.0f))};
+    unsigned sides = 0;
+    for (unsigned k = 0; k < 4; ++k)
+      if (forced(corner[k], corner[(k + 1) % 4])) sides |= 1u << k;
     auto at = [&](glm::vec2 st) { return static_cast<double>(cell.map.density(st)) * g(cell.map.point(st)); };
-    total += cell.area * refine(at, glm::vec2(0.0f), 1.0f, coarse, 0, max_depth);
+    total += cell.area * refine(at, glm::vec2(0.0f), 1.0f, coarse, 0, max_depth, sides, sides ? kSideDepth : 0);
   }
   return total;
 }
@@ -478,7 +496,7 @@ double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R) c
     return n <= 8 ? static_cast<double>(point_to_polygon_factor_fast(x, S.normal, R.corners.data(), n))
                   : point_to_polygon_factor(x, S.normal, R.corners.data(), n);
   };
-  return integrate(S, g, kMaxDepthClear);
+  return integrate(S, g, kMaxDepthClear, [](const glm::vec3&, const glm::vec3&) { return false; });
 }
 
 // F(dx -> the part of R visible from x) for x on S: R clipped to x's hemisphere, less the
@@ -673,7 +691,31 @@ double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Worksp
   if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R);
   if (m.hidden_by_one(S, R, w.candidates)) return 0.0;
   auto g = [&](const glm::vec3& x) { return m.visible_factor(x, S, R, w); };
-  return m.integrate(S, g, kMaxDepthObstructed);
+  // A source edge in the plane of an occluder (a floor facet along a block's face): the shadow
+  // may be a wedge along that edge thinner than the first levels' Gauss points can see.
+  auto in_occluder_plane = [&](const glm::vec3& a, const glm::vec3& b) {
+    for (const std::uint32_t k : w.candidates) {
+      const Occluder& O = m.occluders[k];
+      if (std::fabs(glm::dot(O.normal, a) - O.offset) > m.epsilon ||
+          std::fabs(glm::dot(O.normal, b) - O.offset) > m.epsilon)
+        continue;
+      // In the plane: does the edge reach the occluder (the segment clipped by its sides)?
+      float t0 = 0.0f, t1 = 1.0f;
+      const std::size_t n = O.corners.size();
+      for (std::size_t e = 0; e < n && t0 <= t1; ++e) {
+        const glm::vec3 inward = glm::cross(O.normal, O.corners[(e + 1) % n] - O.corners[e]);
+        const float scale = glm::length(inward);
+        const float da = glm::dot(inward, a - O.corners[e]) + m.epsilon * scale,
+                    db = glm::dot(inward, b - O.corners[e]) + m.epsilon * scale;
+        if (da < 0.0f && db < 0.0f) t1 = -1.0f;
+        else if (da < 0.0f) t0 = std::max(t0, da / (da - db));
+        else if (db < 0.0f) t1 = std::min(t1, da / (da - db));
+      }
+      if (t0 <= t1) return true;
+    }
+    return false;
+  };
+  return m.integrate(S, g, kMaxDepthObstructed, in_occluder_plane);
 }
 
 }  // namespace radiosity::detail
