@@ -251,8 +251,11 @@ bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const
   out.row_offsets.assign(rows + 1, 0);
   for (std::size_t r = 0; r < rows; ++r) out.row_offsets[r + 1] = out.row_offsets[r] + count[r];
   out.columns.assign(out.row_offsets[rows], 0);
-  std::vector<double> value(out.row_offsets[rows], 0.0);  // transports first, factors below
-  std::vector<std::uint64_t> lower(rows), upper(rows);     // next slot of the transposed, own-above parts
+  out.values.assign(out.row_offsets[rows], 0.0f);
+  // F(r -> c) = G_rc / A_r.
+  std::vector<double> inverse_area(rows, 0.0);
+  for (std::size_t r = 0; r < rows; ++r) inverse_area[r] = area[begin + r] > 0.0 ? 1.0 / area[begin + r] : 0.0;
+  std::vector<std::uint64_t> lower(rows), upper(rows);  // next slot of the transposed, own-above parts
   for (std::size_t r = 0; r < rows; ++r) {
     const std::vector<std::uint32_t>& own = columns[r];
     const auto below = static_cast<std::size_t>(
@@ -260,13 +263,13 @@ bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const
     std::uint64_t at = out.row_offsets[r];
     for (std::size_t k = 0; k < below; ++k, ++at) {
       out.columns[at] = own[k];
-      value[at] = static_cast<double>(transports[r][k]);
+      out.values[at] = static_cast<float>(static_cast<double>(transports[r][k]) * inverse_area[r]);
     }
     lower[r] = at;
     upper[r] = out.row_offsets[r + 1] - (own.size() - below);
     for (std::size_t k = below, u = upper[r]; k < own.size(); ++k, ++u) {
       out.columns[u] = own[k];
-      value[u] = static_cast<double>(transports[r][k]);
+      out.values[u] = static_cast<float>(static_cast<double>(transports[r][k]) * inverse_area[r]);
     }
   }
   for (std::size_t q = 0; q < rows; ++q)
@@ -275,16 +278,8 @@ bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const
       if (c < begin || c >= end || c < begin + q) continue;
       const std::uint64_t at = lower[c - begin]++;
       out.columns[at] = static_cast<std::uint32_t>(begin + q);
-      value[at] = static_cast<double>(transports[q][k]);
+      out.values[at] = static_cast<float>(static_cast<double>(transports[q][k]) * inverse_area[c - begin]);
     }
-  columns.clear();
-  transports.clear();
-  out.values.resize(value.size());
-  for (std::size_t r = 0; r < rows; ++r) {
-    const double inverse_area = area[begin + r] > 0.0 ? 1.0 / area[begin + r] : 0.0;
-    for (std::uint64_t k = out.row_offsets[r]; k < out.row_offsets[r + 1]; ++k)
-      out.values[k] = static_cast<float>(value[k] * inverse_area);
-  }
   return true;
 }
 
