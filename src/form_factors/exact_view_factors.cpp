@@ -24,13 +24,16 @@
 //     wholly in front of the other), the point-to-point kernel cos cos / (pi d^2) by 2x2 Gauss
 //     points on both; nearer, the exact point-to-polygon factor at Gauss points of the source,
 //     refined adaptively where two levels disagree (shared edges);
-//   - otherwise, at each source point the receiver (clipped to the point's hemisphere) loses
-//     the shadow of each candidate occluder: the occluder is clipped to the slab between the
-//     point and the receiver's plane, and the receiver is split by the planes through the point
-//     and the occluder's edges (the shadow's cone); the contour integral of the pieces left is
-//     the visible point factor, integrated adaptively over the source.
+//   - otherwise, 0 when one candidate occluder crosses every segment between their corners;
+//     else at each source point the receiver (clipped to the point's hemisphere) loses the
+//     shadow of each candidate occluder: the occluder is clipped to the slab between the point
+//     and the receiver's plane, and the receiver is split by the planes through the point and
+//     the occluder's edges (the shadow's cone); the contour integral of the pieces left is the
+//     visible point factor, integrated adaptively over the source (and at least to 1/8 of its
+//     width along an edge that lies on an occluder, where a thin shadow wedge starts).
 // A polygon can hide something only if some corner of the scene lies strictly on each side of
-// its plane: the walls of a closed room cannot, and are no candidates at all.
+// its plane: the walls of a closed room cannot, and are no candidates at all. Coplanar
+// occluders whose union is convex are merged into one (fewer, larger shadows to clip).
 #include "form_factors/exact_view_factors.hpp"
 
 #include <algorithm>
