@@ -308,7 +308,7 @@ TEST_SUITE("form_factors") {
     for (std::size_t i = 0; i < one.rows(); ++i)
       if (i != under) worst = std::max(worst, std::fabs(row_sum(one, i) - 1.0));
     MESSAGE("exact mode, room around a block: rows within " << worst << " of 1");
-    CHECK(worst < 5e-5);  // measured 6.4e-6
+    CHECK(worst < 5e-5);  // measured 6.5e-6
     CHECK(reciprocity_error(one) < 1e-6);
     // A floor facet beside the block, x0 in [0, 1], sees nothing of the far wall's facets
     // straight behind the block: a segment to (3, y1, z1) with z1 in [1, 2] is at height
