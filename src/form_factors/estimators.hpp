@@ -47,6 +47,10 @@ std::unique_ptr<FormFactorEstimator> make_monte_carlo_estimator(const Scene&, co
 /// point_to_polygon_factor() in float for up to 8 corners: about twice as fast, relative error
 /// ~1e-5 for the configurations of a patch hierarchy (falls back to double when x is a corner).
 float point_to_polygon_factor_fast(const glm::vec3& x, const glm::vec3& n, const glm::vec3* polygon, int vertex_count);
+/// Lambert's contour sum of point_to_polygon_factor() for a polygon already clipped to the
+/// hemisphere above the point: `r` holds its `m` corners relative to the point, `n` is the
+/// point's unit normal. In [0, 1].
+double contour_factor(const glm::dvec3* r, int m, const glm::dvec3& n);
 
 
 /// What a ray-cast (or analytic) estimator has done since it was made, for benchmarks.

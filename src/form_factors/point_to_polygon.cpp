@@ -50,11 +50,20 @@ double point_to_polygon_factor(const glm::vec3& point, const glm::vec3& normal, 
   }
   if (m < 3) return 0.0;
 
+  return detail::contour_factor(out, m, n);
+}
+
+}  // namespace v1
+}  // namespace radiosity
+
+namespace radiosity::detail {
+
+double contour_factor(const glm::dvec3* r, int m, const glm::dvec3& n) {
   // F = 1/(2 pi) sum_i gamma_i n . (R_i x R_{i+1}) / |R_i x R_{i+1}|, gamma_i the angle between
   // the unit vectors to consecutive vertices.
   double sum = 0.0;
   for (int i = 0; i < m; ++i) {
-    glm::dvec3 a = out[i], b = out[(i + 1) % m];
+    glm::dvec3 a = r[i], b = r[(i + 1) % m];
     double la = glm::length(a), lb = glm::length(b);
     if (la <= 0.0 || lb <= 0.0) continue;  // the point is on a vertex: that edge has no extent
     a /= la;
@@ -68,11 +77,6 @@ double point_to_polygon_factor(const glm::vec3& point, const glm::vec3& normal, 
   double f = std::fabs(sum) / (2.0 * 3.14159265358979323846);
   return f > 1.0 ? 1.0 : f;
 }
-
-}  // namespace v1
-}  // namespace radiosity
-
-namespace radiosity::detail {
 
 namespace {
 

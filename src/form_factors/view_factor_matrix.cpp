@@ -30,6 +30,7 @@
 #include "core/streams.hpp"
 #include "geometry/ray_scene.hpp"
 #include "form_factors/estimators.hpp"
+#include "form_factors/exact_view_factors.hpp"
 #include "form_factors/view_factor_correction.hpp"
 #include "form_factors/view_factor_rows.hpp"
 #include "radiosity/form_factors.hpp"
@@ -195,6 +196,91 @@ void check_enclosure(const ViewFactorMatrix& m, const Scene& scene) {
               "polygons: " + std::to_string(off) + " of " + std::to_string(m.rows()) + numbers + what + gap +
                   ". An open scene takes the reciprocity correction; polygons that face outward (an exporter's "
                   "winding) see nothing in front of them");
+}
+
+/// Rows [begin, end) of the exact mode (exact_view_factors.hpp) between the polygons `ids` of
+/// `scene` (row and column r: polygon ids[r]), into out.row_offsets, columns and values: each
+/// unordered pair once, F(r -> c) = G_rc / A_r. A pair with both rows in the block is
+/// integrated by its lower row; a pair with one outside by this block (and by the other's, to
+/// the same bits). Rows are integrated in parallel, a chunk at a time between progress reports;
+/// returns false when `gate` cancels (every row of the block is then left empty).
+bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const std::vector<double>& area,
+                std::size_t begin, std::size_t end, unsigned threads, detail::ProgressGate& gate, double share,
+                ViewFactorMatrix& out) {
+  const detail::ExactPolygonTransport transport(scene);
+  const std::size_t n = ids.size(), rows = end - begin;
+  std::vector<std::vector<std::uint32_t>> columns(rows);
+  std::vector<std::vector<float>> transports(rows);
+  // Chunks of rows of about equal work (row r integrates n - r pairs in a whole matrix).
+  const std::size_t chunk_pairs = std::max<std::size_t>(n, 1) * 64;
+  std::size_t row = begin;
+  while (row < end) {
+    std::size_t last = row, pairs = 0;
+    while (last < end && (last == row || pairs < chunk_pairs)) pairs += n - (last++ - begin);
+    detail::parallel_for(threads, last - row, 1, [&](std::size_t b, std::size_t e) {
+      const auto w = transport.workspace();
+      for (std::size_t r = row + b; r < row + e; ++r) {
+        std::vector<std::uint32_t>& c_out = columns[r - begin];
+        std::vector<float>& g_out = transports[r - begin];
+        for (std::size_t c = 0; c < n; ++c) {
+          if (c == r || (c >= begin && c < r)) continue;  // the lower row of the block has it
+          const double g = transport.transport(ids[r], ids[c], *w);
+          if (!(g > 0.0)) continue;
+          c_out.push_back(static_cast<std::uint32_t>(c));
+          g_out.push_back(static_cast<float>(g));
+        }
+      }
+    });
+    row = last;
+    Progress p;
+    p.phase = Phase::form_factors;
+    p.fraction = share * static_cast<double>(row - begin) / static_cast<double>(rows);
+    if (!gate.report(p, false)) {
+      out.row_offsets.assign(rows + 1, 0);
+      return false;
+    }
+  }
+  // Row r: its own pairs with columns below the block, then those the block's lower rows
+  // integrated (columns [begin, r)), then its own above r; each part in column order.
+  std::vector<std::uint64_t> count(rows, 0);
+  for (std::size_t q = 0; q < rows; ++q) {
+    count[q] += columns[q].size();
+    for (const std::uint32_t c : columns[q])
+      if (c >= begin && c < end) ++count[c - begin];
+  }
+  out.row_offsets.assign(rows + 1, 0);
+  for (std::size_t r = 0; r < rows; ++r) out.row_offsets[r + 1] = out.row_offsets[r] + count[r];
+  out.columns.assign(out.row_offsets[rows], 0);
+  out.values.assign(out.row_offsets[rows], 0.0f);
+  // F(r -> c) = G_rc / A_r.
+  std::vector<double> inverse_area(rows, 0.0);
+  for (std::size_t r = 0; r < rows; ++r) inverse_area[r] = area[begin + r] > 0.0 ? 1.0 / area[begin + r] : 0.0;
+  std::vector<std::uint64_t> lower(rows), upper(rows);  // next slot of the transposed, own-above parts
+  for (std::size_t r = 0; r < rows; ++r) {
+    const std::vector<std::uint32_t>& own = columns[r];
+    const auto below = static_cast<std::size_t>(
+        std::lower_bound(own.begin(), own.end(), static_cast<std::uint32_t>(begin)) - own.begin());
+    std::uint64_t at = out.row_offsets[r];
+    for (std::size_t k = 0; k < below; ++k, ++at) {
+      out.columns[at] = own[k];
+      out.values[at] = static_cast<float>(static_cast<double>(transports[r][k]) * inverse_area[r]);
+    }
+    lower[r] = at;
+    upper[r] = out.row_offsets[r + 1] - (own.size() - below);
+    for (std::size_t k = below, u = upper[r]; k < own.size(); ++k, ++u) {
+      out.columns[u] = own[k];
+      out.values[u] = static_cast<float>(static_cast<double>(transports[r][k]) * inverse_area[r]);
+    }
+  }
+  for (std::size_t q = 0; q < rows; ++q)
+    for (std::size_t k = 0; k < columns[q].size(); ++k) {
+      const std::uint32_t c = columns[q][k];
+      if (c < begin || c >= end || c < begin + q) continue;
+      const std::uint64_t at = lower[c - begin]++;
+      out.columns[at] = static_cast<std::uint32_t>(begin + q);
+      out.values[at] = static_cast<float>(static_cast<double>(transports[q][k]) * inverse_area[c - begin]);
+    }
+  return true;
 }
 
 }  // namespace
@@ -410,6 +496,13 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
   if (rows == 0) return;
 
+  if (m.ff.method == FormFactorMethod::ray_cast) {
+    // The exact mode: polygon pairs integrated once, without rays (exact_view_factors.hpp).
+    out.cancelled = !exact_rows(*m.scene, m.ids, m.area, begin, end, m.ff.threads, gate, rows_share, out);
+    if (!out.cancelled)
+      out.cancelled = !row_sky(*m.scene, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
+    return;
+  }
   const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(*m.scene, hierarchy, m.ff);
   std::vector<double> sum(m.ids.size(), 0.0);  // the accumulator of one row, by column
   std::vector<std::uint32_t> touched;

@@ -42,7 +42,9 @@ class ViewFactorRows {
   /// row_standard_error (Monte Carlo), sky and sky_standard_error (rays per element, so a
 /// block's are the whole matrix's), element_count (the block's source elements), method
   /// and level; cancelled when `gate` says so (the rows after the last whole chunk are left
-  /// empty). Makes its own estimator (Embree BVH). Reports Phase::form_factors with the
+  /// empty; in the exact mode, every row of the block). The exact mode (ray_cast) integrates
+  /// polygon pairs without rays (exact_view_factors.hpp); the other estimators' element rows
+  /// are summed per polygon. Makes its own estimator (Embree BVH). Reports Phase::form_factors with the
   /// fraction of the block done.
   void compute(std::size_t begin, std::size_t end, ProgressGate& gate, ViewFactorMatrix& out) const;
 
