@@ -53,8 +53,6 @@ namespace radiosity::detail {
 namespace {
 
 constexpr double kInversePi = 0.31830988618379067;
-// Gauss-Legendre 2-point nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).
-constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.28867513459481287f;
 /// Absolute accuracy goal of a factor from the source (mean over the source of the point
 /// factor): two levels of the adaptive rule closer than this (weighted by their share of the
 /// source) end the refinement.
@@ -194,39 +192,6 @@ struct ExactPolygonTransport::Impl {
   double integrate(const Face& S, const PointFactor& g, int max_depth, const Forced& forced) const;
 };
 
-namespace {
-
-/// The mean over the unit square of at(st) (2x2 Gauss on [lo, lo + size]^2 is `coarse`),
-/// refined by quarters until the four quarters' Gauss rules agree with the whole's within the
-/// tolerance, weighted by the square's share 4^-depth. Squares along the sides of the unit
-/// square in `sides` (bit 0: t = 0, 1: s = 1, 2: t = 1, 3: s = 0) are refined down to
-/// `side_depth` whatever their rules say.
-template <typename At>
-double refine(const At& at, glm::vec2 lo, float size, double coarse, int depth, int max_depth, unsigned sides,
-              int side_depth) {
-  const float h = 0.5f * size;
-  const glm::vec2 quarter[4] = {lo, lo + glm::vec2(h, 0.0f), lo + glm::vec2(0.0f, h), lo + glm::vec2(h, h)};
-  std::array<double, 4> q{};
-  double fine = 0.0;
-  for (std::size_t k = 0; k < 4; ++k) {
-    const glm::vec2 o = quarter[k];
-    q[k] = 0.25 * (at(o + h * glm::vec2(kGaussLo, kGaussLo)) + at(o + h * glm::vec2(kGaussHi, kGaussLo)) +
-                   at(o + h * glm::vec2(kGaussLo, kGaussHi)) + at(o + h * glm::vec2(kGaussHi, kGaussHi)));
-    fine += 0.25 * q[k];
-  }
-  // Dyadic squares: these comparisons are exact.
-  const unsigned touching = (lo.y == 0.0f ? 1u : 0u) | (lo.x + size == 1.0f ? 2u : 0u) |
-                            (lo.y + size == 1.0f ? 4u : 0u) | (lo.x == 0.0f ? 8u : 0u);
-  const bool forced = depth < side_depth && (touching & sides) != 0;
-  if (!forced && (depth >= max_depth || std::ldexp(std::fabs(fine - coarse), -2 * depth) <= kTolerance)) return fine;
-  double sum = 0.0;
-  for (std::size_t k = 0; k < 4; ++k)
-    sum += 0.25 * refine(at, quarter[k], h, q[k], depth + 1, std::max(max_depth, side_depth), sides, side_depth);
-  return sum;
-}
-
-}  // namespace
-
 // The integral over the source S of g(x) (a point factor): per cell, its area times the mean of
 // g over the cell by the adaptive Gauss rule, starting from the face's own 2x2 points. A cell's
 // side for which forced(a, b) holds (a and b its ends) is refined down to kSideDepth.
@@ -245,7 +210,8 @@ double ExactPolygonTransport::Impl::integrate(const Face& S, const PointFactor& 
     for (unsigned k = 0; k < 4; ++k)
       if (forced(corner[k], corner[(k + 1) % 4])) sides |= 1u << k;
     auto at = [&](glm::vec2 st) { return static_cast<double>(cell.map.density(st)) * g(cell.map.point(st)); };
-    total += cell.area * refine(at, glm::vec2(0.0f), 1.0f, coarse, 0, max_depth, sides, sides ? kSideDepth : 0);
+    total += cell.area * adaptive_gauss_mean(at, glm::vec2(0.0f), 1.0f, coarse, 0, max_depth, kTolerance, sides,
+                                                 sides ? kSideDepth : 0);
   }
   return total;
 }

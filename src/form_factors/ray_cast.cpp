@@ -49,9 +49,6 @@ namespace radiosity::detail {
 
 namespace {
 
-// Gauss-Legendre 2x2 nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).
-constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.28867513459481287f;
-
 class SampledEstimator final : public BackColumnEstimator {
  public:
   SampledEstimator(const Scene& scene, const PatchHierarchy& hierarchy, const FormFactorOptions& options,
@@ -357,27 +354,6 @@ class SampledEstimator final : public BackColumnEstimator {
     return v.value;
   }
 
-  // Gauss-Legendre 2x2 on the square [lo, lo + size]^2 of the element's (s,t) domain: with the
-  // integrand g = F(dx -> patch) x the map's area density, the mean of F over that part.
-  template <typename G>
-  static double gauss_2x2(const G& g, glm::vec2 lo, float size) {
-    return 0.25 * (g(lo + size * glm::vec2(kGaussLo, kGaussLo)) + g(lo + size * glm::vec2(kGaussHi, kGaussLo)) +
-                   g(lo + size * glm::vec2(kGaussLo, kGaussHi)) + g(lo + size * glm::vec2(kGaussHi, kGaussHi)));
-  }
-
-  template <typename G>
-  static double adaptive(const G& g, glm::vec2 lo, float size, double coarse, int depth) {
-    const float h = 0.5f * size;
-    const glm::vec2 corner[4] = {lo, lo + glm::vec2(h, 0.0f), lo + glm::vec2(0.0f, h), lo + glm::vec2(h, h)};
-    double q[4], fine = 0.0;
-    for (int k = 0; k < 4; ++k) fine += 0.25 * (q[k] = gauss_2x2(g, corner[k], h));
-    // A square at depth d carries 4^-d of the element: its error matters in that proportion.
-    if (depth >= kMaxDepth || std::ldexp(std::fabs(fine - coarse), -2 * depth) <= kAbsoluteTolerance) return fine;
-    double sum = 0.0;
-    for (int k = 0; k < 4; ++k) sum += 0.25 * adaptive(g, corner[k], h, q[k], depth + 1);
-    return sum;
-  }
-
   // The unoccluded factor F(e -> patch): the exact point-to-polygon factor integrated over the
   // element. Far pairs have a smooth integrand and one 2x2 Gauss rule suffices; near pairs
   // (shared edges, where the integrand has a logarithmic singularity) are refined adaptively
@@ -399,7 +375,8 @@ class SampledEstimator final : public BackColumnEstimator {
     const double midpoint = s.density[4] * at(s.quadrature[4]);
     if (std::fabs(coarse - midpoint) <= 10.0 * kAbsoluteTolerance) return coarse;
     auto g = [&](glm::vec2 st) -> double { return s.map.density(st) * at(s.map.point(st)); };
-    return adaptive(g, glm::vec2(0.0f), 1.0f, coarse, 0);
+    // A square at depth d carries 4^-d of the element: its error matters in that proportion.
+    return adaptive_gauss_mean(g, glm::vec2(0.0f), 1.0f, coarse, 0, kMaxDepth, kAbsoluteTolerance);
   }
 
   const PatchHierarchy& hierarchy_;
