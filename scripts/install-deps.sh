@@ -5,6 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake
+  clang libclang-rt-14-dev
   libglm-dev doctest-dev libopenexr-dev libembree-dev libtbb-dev
   libstb-dev nlohmann-json3-dev libcli11-dev
   libnanoflann-dev libbenchmark-dev

@@ -6,14 +6,25 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
+#include <exception>
 #include <map>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include "core/thread_sanitizer.hpp"
+
+// ThreadSanitizer sees only instrumented code: oneTBB from Debian is not, so the order its
+// scheduler puts between a task's writes and the waiting thread's reads is invisible to it, and
+// every parallel loop would be reported as racing. Under TSan parallel_for therefore runs its
+// chunks on plain std::threads (same chunks' results, since no result depends on the
+// chunking), whose start and join TSan understands: what it then reports are our own races.
 
 namespace radiosity::detail {
 
@@ -52,6 +63,30 @@ void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const 
     body(std::size_t{0}, count);
     return;
   }
+#if defined(RADIOSITY_THREAD_SANITIZER)
+  // Chunks handed out by a counter to n - 1 new threads and the caller; the first exception
+  // stops the handing out and is rethrown after the join, as tbb::parallel_for does.
+  const std::size_t step = std::max<std::size_t>(grain, 1);
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto work = [&] {
+    for (std::size_t begin = next.fetch_add(step); begin < count; begin = next.fetch_add(step)) {
+      try {
+        body(begin, std::min(count, begin + step));
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next.store(count);
+      }
+    }
+  };
+  std::vector<std::thread> helpers;
+  for (int i = 1; i < n; ++i) helpers.emplace_back(work);
+  work();
+  for (std::thread& t : helpers) t.join();
+  if (error) std::rethrow_exception(error);
+#else
   auto run = [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, std::max<std::size_t>(grain, 1)),
                       [&](const tbb::blocked_range<std::size_t>& r) { body(r.begin(), r.end()); });
@@ -63,6 +98,7 @@ void parallel_for(unsigned threads, std::size_t count, std::size_t grain, const 
     return;
   }
   arena_of(n).execute([&] { tbb::this_task_arena::isolate(run); });
+#endif
 }
 
 }  // namespace radiosity::detail

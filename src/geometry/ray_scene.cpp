@@ -11,6 +11,7 @@
 
 #include <embree3/rtcore.h>
 
+#include "core/thread_sanitizer.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 
@@ -41,12 +42,20 @@ RTCRay single_ray(const glm::vec3& origin, const glm::vec3& dir, float tnear, fl
 
 }  // namespace
 
+const char* embree_device_config() {
+#if defined(RADIOSITY_THREAD_SANITIZER)
+  return "threads=1";
+#else
+  return nullptr;
+#endif
+}
+
 RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& triangles,
                    std::vector<std::uint32_t> ids)
     : ids_(std::move(ids)), indices_(triangles) {
   // Embree must not start its own threads beyond what the caller's TBB arena allows; the
   // default configuration uses TBB, which composes with ours.
-  RTCDevice device = rtcNewDevice(nullptr);
+  RTCDevice device = rtcNewDevice(embree_device_config());
   if (!device)
     throw Error(ErrorCode::internal, "Embree: cannot create a device (error " +
                                          std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");

@@ -18,6 +18,13 @@ class PatchHierarchy;
 
 namespace radiosity::detail {
 
+/// The configuration every Embree device of the library is made with (rtcNewDevice): the
+/// default (nullptr: Embree builds on oneTBB, which composes with our loops), except under
+/// ThreadSanitizer, where it is "threads=1": Debian's Embree and oneTBB are not instrumented,
+/// so a BVH built on oneTBB's workers, calling back into our code, would be reported as racing
+/// with the thread that waited for it (tests/tsan.supp, src/core/parallel.hpp).
+const char* embree_device_config();
+
 /// A triangle mesh with a user id per triangle, committed once and then queried from any
 /// number of threads. Move-only.
 /// Thread safety: occluded() and intersect() may be called concurrently.

@@ -30,6 +30,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "geometry/ray_scene.hpp"
 #include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
@@ -269,7 +270,7 @@ std::vector<PolygonOverlap> find_overlaps(const Scene& scene) {
     s.upper[i] = hi + grow;
   }
 
-  RTCDevice device = rtcNewDevice(nullptr);
+  RTCDevice device = rtcNewDevice(detail::embree_device_config());
   if (!device)
     throw Error(ErrorCode::internal, "find_overlaps: Embree cannot create a device (error " +
                                          std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");

@@ -208,9 +208,14 @@ TEST_SUITE("form_factors") {
                                                       << enc.correction.largest_change << " rms " << enc.correction.rms_change
                                                       << " in " << enc.correction.iterations << " iterations");
     // Against the closed forms, face to face: the corrections do not make them worse.
-    for (const auto& [from, to, exact] : {std::make_tuple("x0", "x1", test::parallel_rectangles(2, 3, 1)),
-                                          std::make_tuple("x0", "y0", test::perpendicular_rectangles(3, 2, 1)),
-                                          std::make_tuple("z0", "y1", test::perpendicular_rectangles(1, 2, 3))}) {
+    for (const auto& face_pair : {std::make_tuple("x0", "x1", test::parallel_rectangles(2, 3, 1)),
+                                  std::make_tuple("x0", "y0", test::perpendicular_rectangles(3, 2, 1)),
+                                  std::make_tuple("z0", "y1", test::perpendicular_rectangles(1, 2, 3))}) {
+      // Plain variables, not structured bindings: INFO captures them in a lambda, which C++17
+      // does not allow for bindings (clang rejects it).
+      const char* const from = std::get<0>(face_pair);
+      const char* const to = std::get<1>(face_pair);
+      const double exact = std::get<2>(face_pair);
       INFO(from, " -> ", to, ": exact ", exact, ", raw ", face_factor(s, raw, from, to), ", enclosure ",
            face_factor(s, enc, from, to));
       CHECK(std::fabs(face_factor(s, enc, from, to) - exact) < 0.01);

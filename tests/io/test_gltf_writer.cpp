@@ -85,7 +85,9 @@ std::map<std::string, std::pair<glm::vec3, double>> group_geometry(const rad::Sc
 void check_same_geometry(const rad::Scene& a, const rad::Scene& b) {
   const auto ga = group_geometry(a), gb = group_geometry(b);
   REQUIRE(ga.size() == gb.size());
-  for (const auto& [name, g] : ga) {
+  for (const auto& entry : ga) {
+    const std::string& name = entry.first;  // not a structured binding: INFO takes it in a lambda
+    const auto& g = entry.second;
     INFO("group " << name);
     REQUIRE(gb.count(name) == 1);
     CHECK(gb.at(name).second == doctest::Approx(g.second).epsilon(1e-5));

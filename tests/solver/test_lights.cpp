@@ -205,8 +205,9 @@ TEST_SUITE("solver") {
       unsigned sky_rays;
       double element, mean;
     };
-    for (const auto& [sky_rays, bound, mean_bound] : {Budget{320u, 0.06, 6e-3}, Budget{1280u, 0.03, 2e-3},
-                                                      Budget{5120u, 0.015, 1e-3}}) {
+    for (const Budget& budget : {Budget{320u, 0.06, 6e-3}, Budget{1280u, 0.03, 2e-3}, Budget{5120u, 0.015, 1e-3}}) {
+      const unsigned sky_rays = budget.sky_rays;  // not a structured binding: CAPTURE takes it in a lambda
+      const double bound = budget.element, mean_bound = budget.mean;
       CAPTURE(sky_rays);
       rad::SolveOptions o;
       o.mesh.max_patch_area = 0.25f;

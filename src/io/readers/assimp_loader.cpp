@@ -26,6 +26,8 @@
 #include <cctype>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -62,20 +64,92 @@ std::string number_text(double v) {
   return s.str();
 }
 
-/// Assimp 5.2's PLY reader loops forever when the header ends before its end_header line (a
-/// truncated file), so the header is looked at first: "end_header" on a line of its own, within
-/// the first MiB.
+/// The size in bytes of a PLY scalar type (char, uchar, ..., float64), 0 for an unknown name.
+std::size_t ply_type_size(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+/// What Assimp 5.2's PLY reader trusts and should not, looked at first:
+/// - a header that ends before its end_header line (a truncated file) makes it loop forever, so
+///   "end_header" must be on a line of its own within the first MiB;
+/// - it allocates what the element counts ask for before reading them, so a count of four
+///   billion in a 1 kB file is an allocation of tens of GB: the counts are checked against the
+///   file's size (each element needs at least its fixed-size properties in a binary file, two
+///   characters per property in an ASCII one, but the last), and a file too short for its header is refused
+///   with both figures.
 void check_ply_header(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::string head(std::size_t{1} << 20, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
+  std::size_t body = std::string::npos;  // offset of the first byte after the header
   for (std::size_t at = head.find("end_header"); at != std::string::npos; at = head.find("end_header", at + 1)) {
     const bool line_start = at > 0 && (head[at - 1] == '\n' || head[at - 1] == '\r');
-    const std::size_t end = at + 10;
-    if (line_start && end < head.size() && (head[end] == '\n' || head[end] == '\r' || head[end] == ' ')) return;
+    std::size_t end = at + 10;
+    if (line_start && end < head.size() && (head[end] == '\n' || head[end] == '\r' || head[end] == ' ')) {
+      while (end < head.size() && head[end] != '\n') ++end;
+      body = end + 1;
+      break;
+    }
   }
-  throw Error(ErrorCode::parse_error, path.string() + ": the PLY header has no end_header line (a truncated file?)");
+  if (body == std::string::npos)
+    throw Error(ErrorCode::parse_error, path.string() + ": the PLY header has no end_header line (a truncated file?)");
+
+  std::error_code ec;
+  const std::uintmax_t file_size = fs::file_size(path, ec);
+  if (ec) return;  // Assimp will say what is wrong
+  const double available = static_cast<double>(file_size) - static_cast<double>(std::min<std::uintmax_t>(body, file_size));
+  std::istringstream lines(head.substr(0, body));
+  std::string line;
+  bool binary = false;
+  struct Element {
+    std::string name;
+    double count = 0.0;
+    double min_bytes = 0.0;  // per element
+  };
+  std::vector<Element> elements;
+  while (std::getline(lines, line)) {
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (word == "format") {
+      std::string format;
+      words >> format;
+      binary = format.rfind("binary", 0) == 0;
+    } else if (word == "element") {
+      Element e;
+      std::string count;
+      words >> e.name >> count;
+      char* end = nullptr;
+      e.count = std::strtod(count.c_str(), &end);
+      if (count.empty() || *end != '\0' || !(e.count >= 0.0))
+        throw Error(ErrorCode::parse_error, path.string() + ": PLY element '" + e.name + "' has the count '" + count +
+                                                "', not a number of elements");
+      elements.push_back(e);
+    } else if (word == "property" && !elements.empty()) {
+      std::string type;
+      words >> type;
+      if (type == "list") words >> type;  // a list needs at least its count
+      elements.back().min_bytes += binary ? static_cast<double>(std::max<std::size_t>(ply_type_size(type), 1)) : 2.0;
+    }
+  }
+  double needed = 0.0;
+  for (const Element& e : elements) needed += e.count * e.min_bytes;
+  if (!binary && needed > 0.0) needed -= 1.0;  // the last value may end the file without a separator
+  if (needed > available) {
+    // Whole numbers in full (a count of 4000000000, not 4e+09), however large.
+    auto whole = [](double v) { return v < 1e19 ? std::to_string(static_cast<std::uint64_t>(v)) : number_text(v); };
+    std::string counts;
+    for (const Element& e : elements) counts += (counts.empty() ? "" : ", ") + whole(e.count) + " " + e.name;
+    throw Error(ErrorCode::parse_error, path.string() + ": the PLY header declares " + counts + ", which need at least " +
+                                            whole(needed) + " bytes, but the file holds " + whole(available) +
+                                            " after its header (a truncated file or a wrong count)");
+  }
 }
 
 /// What Assimp 5.2's COLLADA reader trusts and should not: an index list (<p>) that holds

@@ -1,0 +1,27 @@
+# cli.check_corpus: `radiosity check FILE` on every file of the broken-file corpus
+# (tests/data/corpus, tests/data/fuzz) must exit 0 (solvable) or 1 (an error, said on stderr
+# as "radiosity: error: ..."), never 3 ("unexpected error"), a signal or a hang.
+# -DEXE=<radiosity_cli> -DDATA=<tests/data>
+file(GLOB_RECURSE files LIST_DIRECTORIES false "${DATA}/corpus/*" "${DATA}/fuzz/*")
+list(FILTER files EXCLUDE REGEX "\\.(mtl|py|md|binary)$")
+list(SORT files)
+list(LENGTH files count)
+if(count LESS 50)
+  message(FATAL_ERROR "check_corpus: only ${count} files under ${DATA}/corpus: the corpus is missing")
+endif()
+set(solvable 0)
+set(refused 0)
+foreach(file IN LISTS files)
+  execute_process(COMMAND "${EXE}" check "${file}" RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err TIMEOUT 120)
+  if(rc STREQUAL "0")
+    math(EXPR solvable "${solvable} + 1")
+  elseif(rc STREQUAL "1")
+    if(NOT err MATCHES "radiosity: error: ")
+      message(FATAL_ERROR "check_corpus: ${file}: exit 1 without an error message; stderr:\n${err}")
+    endif()
+    math(EXPR refused "${refused} + 1")
+  else()
+    message(FATAL_ERROR "check_corpus: ${file}: `radiosity check` gave '${rc}' (expected exit 0 or 1); stderr:\n${err}")
+  endif()
+endforeach()
+message(STATUS "check_corpus: ${count} files: ${solvable} solvable (exit 0), ${refused} refused (exit 1)")
