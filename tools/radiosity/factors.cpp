@@ -82,17 +82,20 @@ int write_blocks(const rad::Scene& scene, const rad::ViewFactorOptions& o, const
   std::size_t first_row = 0, total_rows = 0;
   std::vector<Range> ranges;
 #if RADIOSITY_HAS_MPI
-  rad::mpi::ViewFactorBlock block = rad::mpi::view_factor_block(scene, o, MPI_COMM_WORLD);
-  rows = std::move(block.rows);
-  first_row = block.first_row;
-  total_rows = block.total_rows;
-  for (const rad::mpi::RowBlock& b : block.blocks)
-    ranges.push_back(Range{b.first_row, b.last_row, b.non_zeros, b.source_elements});
-#else
-  rows = rad::view_factor_matrix(scene, o);
-  total_rows = rows.rows();
-  ranges.push_back(Range{0, rows.rows(), rows.non_zeros(), rows.element_count});
+  if (process_count() > 1) {
+    rad::mpi::ViewFactorBlock block = rad::mpi::view_factor_block(scene, o, MPI_COMM_WORLD);
+    rows = std::move(block.rows);
+    first_row = block.first_row;
+    total_rows = block.total_rows;
+    for (const rad::mpi::RowBlock& b : block.blocks)
+      ranges.push_back(Range{b.first_row, b.last_row, b.non_zeros, b.source_elements});
+  }
 #endif
+  if (process_count() == 1) {  // without mpirun: one block, the whole matrix
+    rows = rad::view_factor_matrix(scene, o);
+    total_rows = rows.rows();
+    ranges.push_back(Range{0, rows.rows(), rows.non_zeros(), rows.element_count});
+  }
   bar.finish();
   const int rank = process_rank();
   const std::filesystem::path folder(a.blocks);
