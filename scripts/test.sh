@@ -5,7 +5,7 @@
 #    label mpi, under mpirun).
 # 2. clang with AddressSanitizer + UndefinedBehaviorSanitizer (and -Werror): the unit tests and
 #    the CLI tests once more (the tools are built there too), then every reader's libFuzzer target
-#    for FUZZ_SECONDS seconds each (default 20; tests/fuzz/run_fuzzers.sh, docs/FUZZING.md).
+#    for FUZZ_SECONDS seconds each (default 15; tests/fuzz/run_fuzzers.sh, docs/FUZZING.md).
 # 3. clang with ThreadSanitizer: the tests of the modules that run in parallel (form factors,
 #    solvers, renderers, the photon map, lightmaps, core).
 # The Python bindings are part of the first build only: Python under a sanitizer would need its
@@ -39,8 +39,8 @@ phase "tests under ASan + UBSan"
 export LSAN_OPTIONS=suppressions="$PWD/tests/lsan.supp"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j"$jobs"
-phase "fuzzing every reader (${FUZZ_SECONDS:-20} s each)"
-tests/fuzz/run_fuzzers.sh build-sanitize "${FUZZ_SECONDS:-20}"
+phase "fuzzing every reader (${FUZZ_SECONDS:-15} s each)"
+tests/fuzz/run_fuzzers.sh build-sanitize "${FUZZ_SECONDS:-15}"
 
 phase "build (clang: ThreadSanitizer, the parallel modules' tests)"
 cmake -S . -B build-tsan "${sanitizer_flags[@]}" -DRADIOSITY_SANITIZE_THREAD=ON -DRADIOSITY_BUILD_TOOLS=OFF

@@ -3,6 +3,8 @@
 #include <doctest/doctest.h>
 
 #include <atomic>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <tbb/task_arena.h>
@@ -32,6 +34,27 @@ TEST_SUITE("core") {
       for (const auto& h : hits) once = once && h.load() == 1;
       CHECK(once);
       CHECK(widest.load() <= limit);
+    }
+  }
+
+  TEST_CASE("an exception in one chunk of a parallel_for reaches the caller and stops the loop") {
+    // The solvers and estimators rely on it: a progress callback's or an Error's exception
+    // thrown inside a loop must come out of the call, at every thread count (under
+    // ThreadSanitizer, where parallel_for runs on std::threads, too).
+    for (const unsigned threads : {1u, 2u, 4u}) {
+      CAPTURE(threads);
+      constexpr std::size_t n = 100000;
+      std::atomic<std::size_t> done{0};
+      try {
+        core::parallel_for(threads, n, 16, [&](std::size_t begin, std::size_t end) {
+          if (begin <= 5000 && 5000 < end) throw std::runtime_error("chunk at 5000");
+          done += end - begin;
+        });
+        FAIL("no exception came out of parallel_for");
+      } catch (const std::runtime_error& e) {
+        CHECK(std::string(e.what()) == "chunk at 5000");
+      }
+      CHECK(done.load() < n);  // the chunks after it were not all run
     }
   }
 }
