@@ -13,7 +13,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="$(nproc)"
-# Each phase's start in seconds since the script began, to see where the time goes.
+# Each phase's start in seconds since the script began, to see where the time goes. Every ctest
+# run has a 600 s limit per test, so a hang fails the run instead of eating CI's time.
 phase() { echo "== $1 (at ${SECONDS} s) =="; }
 scripts/install-deps.sh
 
@@ -21,7 +22,7 @@ phase "build (Release, -Werror)"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DRADIOSITY_WERROR=ON
 cmake --build build -j"$jobs"
 phase "tests"
-ctest --test-dir build --output-on-failure -j"$jobs"
+ctest --test-dir build --output-on-failure --timeout 600 -j"$jobs"
 
 phase "build (clang: ASan + UBSan, fuzz targets)"
 # Without MPI: OpenMPI's own allocations and busy-waiting processes would only slow it down and
@@ -38,7 +39,7 @@ phase "tests under ASan + UBSan"
 # tests/lsan.supp: leaks inside Debian's Assimp on broken files (not ours), documented there.
 export LSAN_OPTIONS=suppressions="$PWD/tests/lsan.supp"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-sanitize --output-on-failure -j"$jobs"
+  ctest --test-dir build-sanitize --output-on-failure --timeout 600 -j"$jobs"
 phase "fuzzing every reader (${FUZZ_SECONDS:-15} s each)"
 tests/fuzz/run_fuzzers.sh build-sanitize "${FUZZ_SECONDS:-15}"
 

@@ -287,7 +287,8 @@ class RADIOSITY_API Scene {
   /// Consecutive duplicate and collinear vertices are dropped. A non-planar or non-convex polygon
   /// is triangulated (ear clipping in its best-fit plane) and a warning recorded.
   /// `group` names the surface for per-group results; empty means "default".
-  /// Throws Error{invalid_scene} for a NaN or infinite coordinate, fewer than 3 distinct vertices,
+  /// Throws Error{invalid_scene} for a NaN or infinite coordinate or one beyond +-1e9 (the areas and
+  /// normals, computed in float, would overflow), fewer than 3 distinct vertices,
   /// a zero-area (degenerate) polygon, or Error{invalid_argument} for an unknown material id.
   PolygonRange add_polygon(const std::vector<glm::vec3>& vertices, MaterialId material,
                            std::string_view group = {});
@@ -299,7 +300,7 @@ class RADIOSITY_API Scene {
   /// Throws Error{invalid_argument} naming the mesh for an index_count that is not a multiple
   /// of 3, a null array whose count is not 0, or an unknown material id (naming the triangle);
   /// Error{invalid_scene} naming the mesh and the vertex or triangle for a NaN or infinite
-  /// value or an index out of range. A degenerate (zero-area) triangle is skipped, and all of a
+  /// value, a position coordinate beyond +-1e9, or an index out of range. A degenerate (zero-area) triangle is skipped, and all of a
   /// mesh's skipped triangles listed by index in one warning (warnings()); with
   /// options.strict it is an Error{invalid_scene} instead. When it throws the scene is
   /// unchanged. Thread safety: mutates the scene.

@@ -66,6 +66,9 @@ MeshId Scene::add_mesh(const MeshDesc& desc, const LoadOptions& options) {
       if (!ok) fail(ErrorCode::invalid_scene, std::string(what) + " of vertex " + std::to_string(v) + " is NaN or infinite");
     };
     check(finite(desc.positions[v]), "the position");
+    if (!detail::usable_position(desc.positions[v]))
+      fail(ErrorCode::invalid_scene, "the position of vertex " + std::to_string(v) +
+                                         " has a coordinate beyond +-1e9 (its areas and distances would overflow)");
     if (desc.normals) check(finite(desc.normals[v]), "the normal");
     if (desc.uv0) check(finite(desc.uv0[v]), "uv0");
     if (desc.uv1) check(finite(desc.uv1[v]), "uv1");

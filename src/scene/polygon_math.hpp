@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -11,6 +12,18 @@ namespace radiosity::detail {
 
 /// A polygon whose area is at most this times its diameter squared is degenerate (zero-area).
 inline constexpr float kDegenerateAreaRatio = 1e-7f;
+/// The largest coordinate a scene accepts, in scene units. The geometry is computed in float,
+/// and the largest product it takes is the squared length of a cross product of two edges
+/// (areas, normals): up to 144 x this^4, which must stay below float's 3.4e38. Beyond it (a
+/// file's 1e30, or 1e18) an area overflows to infinity, a silently wrong answer; the scene
+/// refuses such a vertex as it refuses NaN (found by fuzzing the STL reader). A billion units
+/// is 1000 km in millimetres, where float's spacing is already 64 units.
+inline constexpr float kMaxCoordinate = 1e9f;
+
+/// Whether `v` is a position a scene can hold: finite, every coordinate within kMaxCoordinate.
+inline bool usable_position(const glm::vec3& v) {
+  return std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate && std::fabs(v.z) <= kMaxCoordinate;
+}
 /// Vertices may leave the best-fit plane by this fraction of the diameter and still be planar.
 inline constexpr float kPlanarityTolerance = 1e-4f;
 

@@ -105,6 +105,9 @@ PolygonRange Scene::add_polygon(const std::vector<glm::vec3>& vertices, Material
     const glm::vec3& v = vertices[i];
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
       throw Error(ErrorCode::invalid_scene, where + ": vertex " + std::to_string(i) + " is NaN or infinite");
+    if (!detail::usable_position(v))
+      throw Error(ErrorCode::invalid_scene, where + ": vertex " + std::to_string(i) +
+                                                " has a coordinate beyond +-1e9 (its areas and distances would overflow)");
   }
   detail::CleanPolygon clean = detail::clean_polygon(vertices);
   if (clean.vertices.size() < 3)

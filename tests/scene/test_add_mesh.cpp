@@ -110,6 +110,10 @@ TEST_SUITE("scene") {
     HostMesh nan;
     nan.positions[3].y = std::nanf("");
     CHECK(error_of(scene, nan.desc(m)) == "add_mesh: mesh 1 (group 'quad'): the position of vertex 3 is NaN or infinite");
+    HostMesh huge;
+    huge.positions[2].x = 1e30f;
+    CHECK(error_of(scene, huge.desc(m)) == "add_mesh: mesh 1 (group 'quad'): the position of vertex 2 has a coordinate "
+                                           "beyond +-1e9 (its areas and distances would overflow)");
     HostMesh inf_uv;
     inf_uv.uv1[1].x = INFINITY;
     CHECK(contains(error_of(scene, inf_uv.desc(m)), "uv1 of vertex 1 is NaN or infinite"));
