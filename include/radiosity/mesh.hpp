@@ -33,6 +33,15 @@ struct MeshOptions {
   /// vertices, never patches or elements, so solves do not depend on it (adaptive subdivision
   /// aside, which reads vertex values).
   float crease_angle_deg = 30.0f;
+  /// Cut each polygon along the lines where another polygon divides it: stands on it or passes
+  /// through it from border to border (a partition between two rooms that share one floor
+  /// polygon, one ceiling, one side wall), so that no element and no interpolated vertex spans
+  /// the line: the lit room's light would otherwise show in the dark room. A cut polygon is
+  /// meshed as convex pieces (up to 64 lines each) and shares no vertices with its neighbours.
+  /// Contacts that end inside a polygon (a block standing on a floor) cut nothing: rays and
+  /// hemicubes find what they hide. Neither do lines along a polygon's border (T-junctions,
+  /// walls meeting at a corner) nor coplanar neighbours. false meshes every polygon whole.
+  bool split_at_contacts = true;
 };
 
 /// A node of a patch's quadtree. Leaves carry the radiosity unknowns; an inner node's value is

@@ -102,6 +102,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         options_(options),
         analytic_(make_analytic_estimator(scene, hierarchy, options)) {
     epsilon_ = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
+    backs_inside_ = RayScene::backs_inside(scene, hierarchy);
     const auto& patches = hierarchy.patches();
     const auto& polygons = scene.polygons();
     specular_depth_ = options.specular_depth;
@@ -645,7 +646,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       std::lock_guard<std::mutex> lock(leaf_mutex_);
       if (leaf_rays_ && leaf_count_ == leaves) return leaf_rays_;
     }
-    RayScene scene = RayScene::from_leaves(hierarchy_);
+    RayScene scene = RayScene::from_leaves(hierarchy_, backs_inside_);
     std::vector<std::uint32_t> patch, polygon, back;
     for (std::uint32_t e : scene.triangle_ids()) {
       patch.push_back(hierarchy_.element(e).patch);
@@ -663,6 +664,9 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   }
 
   const PatchHierarchy& hierarchy_;
+  /// Per patch: its back is no surface (RayScene::backs_inside()), for the leaves' ray scene.
+  /// Patches added by adaptive subdivision are none: only leaves are, under existing patches.
+  std::vector<std::uint8_t> backs_inside_;
   FormFactorOptions options_;
   std::unique_ptr<BackColumnEstimator> analytic_;  ///< unoccluded factors to emitting patches
   /// Per polygon, for extended form factors: mean reflectance of an ideal mirror, mean

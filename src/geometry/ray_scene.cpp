@@ -12,6 +12,7 @@
 #include <embree3/rtcore.h>
 
 #include "core/thread_sanitizer.hpp"
+#include "scene/overlap.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 
@@ -40,6 +41,18 @@ RTCRay single_ray(const glm::vec3& origin, const glm::vec3& dir, float tnear, fl
   return ray;
 }
 
+// Keeps only hits on a triangle's front (the ray against its geometric normal): the second
+// query of RayScene::prefer_front().
+void front_only(const RTCFilterFunctionNArguments* args) {
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const float dot = RTCRayN_dir_x(args->ray, args->N, i) * RTCHitN_Ng_x(args->hit, args->N, i) +
+                      RTCRayN_dir_y(args->ray, args->N, i) * RTCHitN_Ng_y(args->hit, args->N, i) +
+                      RTCRayN_dir_z(args->ray, args->N, i) * RTCHitN_Ng_z(args->hit, args->N, i);
+    if (dot > 0.0f) args->valid[i] = 0;
+  }
+}
+
 }  // namespace
 
 const char* embree_device_config() {
@@ -51,8 +64,8 @@ const char* embree_device_config() {
 }
 
 RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& triangles,
-                   std::vector<std::uint32_t> ids)
-    : ids_(std::move(ids)), indices_(triangles) {
+                   std::vector<std::uint32_t> ids, std::vector<std::uint8_t> back_is_inside)
+    : ids_(std::move(ids)), indices_(triangles), back_is_inside_(std::move(back_is_inside)) {
   // Embree must not start its own threads beyond what the caller's TBB arena allows; the
   // default configuration uses TBB, which composes with ours.
   RTCDevice device = rtcNewDevice(embree_device_config());
@@ -63,7 +76,18 @@ RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<st
   RTCScene scene = rtcNewScene(device);
   scene_ = scene;
   rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
-  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+  // Context filters: prefer_front()'s second query, which only hits fronts.
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+  if (!positions.empty()) {
+    glm::vec3 lo = positions[0], hi = positions[0];
+    for (const glm::vec3& p : positions) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    const glm::vec3 extent = glm::max(glm::abs(lo), glm::abs(hi));
+    coincidence_ = static_cast<float>(std::max(kOverlapRelativeTolerance * static_cast<double>(glm::length(hi - lo)),
+                                               2.5e-7 * static_cast<double>(std::max({extent.x, extent.y, extent.z}))));
+  }
 
   if (!indices_.empty()) {
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -96,8 +120,10 @@ RayScene::RayScene(RayScene&& other) noexcept
     : device_(other.device_),
       scene_(other.scene_),
       packet_width_(other.packet_width_),
+      coincidence_(other.coincidence_),
       ids_(std::move(other.ids_)),
-      indices_(std::move(other.indices_)) {
+      indices_(std::move(other.indices_)),
+      back_is_inside_(std::move(other.back_is_inside_)) {
   other.device_ = nullptr;
   other.scene_ = nullptr;
 }
@@ -108,8 +134,10 @@ RayScene& RayScene::operator=(RayScene&& other) noexcept {
     device_ = other.device_;
     scene_ = other.scene_;
     packet_width_ = other.packet_width_;
+    coincidence_ = other.coincidence_;
     ids_ = std::move(other.ids_);
     indices_ = std::move(other.indices_);
+    back_is_inside_ = std::move(other.back_is_inside_);
     other.device_ = nullptr;
     other.scene_ = nullptr;
   }
@@ -125,35 +153,67 @@ void RayScene::release() noexcept {
   device_ = nullptr;
 }
 
+namespace {
+
+// 1 when a material's back is no surface: one-sided, opaque, its own BRDF unset (which may
+// transmit).
+std::uint8_t back_is_inside(const Material& m) {
+  const bool transmits = m.transmittance.x > 0.0f || m.transmittance.y > 0.0f || m.transmittance.z > 0.0f ||
+                         m.diffuse_transmittance.x > 0.0f || m.diffuse_transmittance.y > 0.0f ||
+                         m.diffuse_transmittance.z > 0.0f;
+  return m.two_sided || transmits || m.brdf ? 0 : 1;
+}
+
+}  // namespace
+
 RayScene RayScene::from_polygons(const Scene& scene) {
   std::vector<glm::vec3> positions;
   std::vector<std::uint32_t> triangles, ids;
+  std::vector<std::uint8_t> inside;
   const auto& polygons = scene.polygons();
   for (std::size_t p = 0; p < polygons.size(); ++p) {
     const auto& v = polygons[p].vertices;
     auto base = static_cast<std::uint32_t>(positions.size());
     positions.insert(positions.end(), v.begin(), v.end());
+    const std::uint8_t flag = back_is_inside(scene.material(polygons[p].material));
     // Polygons are convex, so a fan covers them exactly.
     for (std::uint32_t k = 1; k + 1 < v.size(); ++k) {
       triangles.insert(triangles.end(), {base, base + k, base + k + 1});
       ids.push_back(static_cast<std::uint32_t>(p));
+      inside.push_back(flag);
     }
   }
-  return RayScene(positions, triangles, std::move(ids));
+  return RayScene(positions, triangles, std::move(ids), std::move(inside));
 }
 
-RayScene RayScene::from_leaves(const PatchHierarchy& hierarchy) {
+std::vector<std::uint8_t> RayScene::backs_inside(const Scene& scene, const PatchHierarchy& hierarchy) {
+  std::vector<std::uint8_t> out;
+  out.reserve(hierarchy.patches().size());
+  // A hierarchy from another scene (which the callers refuse after this) must not index past
+  // the materials: such patches get 0.
+  for (const Patch& p : hierarchy.patches())
+    out.push_back(p.material < scene.materials().size() ? back_is_inside(scene.material(p.material)) : 0);
+  return out;
+}
+
+RayScene RayScene::from_leaves(const PatchHierarchy& hierarchy, const std::vector<std::uint8_t>& back_is_inside) {
   std::vector<std::uint32_t> triangles, ids;
+  std::vector<std::uint8_t> inside;
+  const bool flags = !back_is_inside.empty();
   for (std::uint32_t e : hierarchy.leaves()) {
     const Element& el = hierarchy.element(e);
+    const std::uint8_t flag = flags ? back_is_inside[el.patch] : 0;
     triangles.insert(triangles.end(), {el.corners[0], el.corners[1], el.corners[2]});
     ids.push_back(e);
+    inside.push_back(flag);
     if (el.corner_count() == 4) {
       triangles.insert(triangles.end(), {el.corners[0], el.corners[2], el.corners[3]});
       ids.push_back(e);
+      inside.push_back(flag);
     }
   }
-  return RayScene(hierarchy.vertices(), triangles, std::move(ids));
+  if (!flags) inside.clear();
+  return RayScene(hierarchy.vertices(), triangles, std::move(ids), std::move(inside));
 }
 
 bool RayScene::occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const {
@@ -281,20 +341,23 @@ void RayScene::intersect(std::size_t count, const glm::vec3* origin, const glm::
   switch (packet_width_) {
     case 16:
       intersect_packets<16, RTCRayHit16>(scene, ids_, count, origin, dir, tnear, tfar, hits, found, rtcIntersect16);
-      return;
+      break;
     case 8:
       intersect_packets<8, RTCRayHit8>(scene, ids_, count, origin, dir, tnear, tfar, hits, found, rtcIntersect8);
-      return;
+      break;
     case 4:
       intersect_packets<4, RTCRayHit4>(scene, ids_, count, origin, dir, tnear, tfar, hits, found, rtcIntersect4);
-      return;
+      break;
     default:
       for (std::size_t i = 0; i < count; ++i) {
         const std::optional<Hit> h = intersect(origin[i], dir[i], tnear, tfar);
         found[i] = h ? 1 : 0;
         if (h) hits[i] = *h;
       }
+      return;
   }
+  for (std::size_t i = 0; i < count; ++i)
+    if (found[i]) prefer_front(origin[i], dir[i], tnear, hits[i]);
 }
 
 std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear,
@@ -315,7 +378,34 @@ std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const 
   h.u = rh.hit.u;
   h.v = rh.hit.v;
   h.geometric_normal = glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+  prefer_front(origin, dir, tnear, h);
   return h;
+}
+
+void RayScene::prefer_front(const glm::vec3& origin, const glm::vec3& dir, float tnear, Hit& h) const {
+  if (back_is_inside_.empty() || back_is_inside_[h.triangle] == 0) return;
+  const float facing = glm::dot(dir, h.geometric_normal);
+  if (!(facing > 0.0f)) return;  // a front (or edge-on): nothing to prefer
+  // The ray's parameter changes by `window` while crossing a slab 2 x coincidence_ thick
+  // around the plane hit.
+  const float rate = facing / glm::length(h.geometric_normal);
+  const float window = coincidence_ / rate;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.filter = front_only;
+  RTCRayHit rh;
+  rh.ray = single_ray(origin, dir, std::max(tnear, h.t - window), h.t + window, 0);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(as_scene(scene_), &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return;
+  h.t = rh.ray.tfar;
+  h.triangle = rh.hit.primID;
+  h.id = ids_[rh.hit.primID];
+  h.u = rh.hit.u;
+  h.v = rh.hit.v;
+  h.geometric_normal = glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
 }
 
 }  // namespace radiosity::detail

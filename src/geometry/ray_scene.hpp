@@ -38,10 +38,12 @@ class RayScene {
     glm::vec3 geometric_normal{0.0f};  ///< unnormalised, right-hand rule of the triangle
   };
 
-  /// `triangles` indexes `positions`; `ids` has one entry per triangle. Throws Error{internal}
+  /// `triangles` indexes `positions`; `ids` has one entry per triangle. `back_is_inside` (empty,
+  /// or one flag per triangle): 1 where the triangle's back is no surface (one-sided, opaque),
+  /// so that intersect() may take a coincident front instead of it. Throws Error{internal}
   /// if Embree cannot create a device.
   RayScene(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& triangles,
-           std::vector<std::uint32_t> ids);
+           std::vector<std::uint32_t> ids, std::vector<std::uint8_t> back_is_inside = {});
   RayScene(RayScene&& other) noexcept;
   RayScene& operator=(RayScene&& other) noexcept;
   RayScene(const RayScene&) = delete;
@@ -50,8 +52,13 @@ class RayScene {
 
   /// The scene's polygons, fan-triangulated; ids are polygon ids.
   static RayScene from_polygons(const Scene& scene);
-  /// The hierarchy's leaf elements (quads as two triangles); ids are element ids.
-  static RayScene from_leaves(const PatchHierarchy& hierarchy);
+  /// The hierarchy's leaf elements (quads as two triangles); ids are element ids. With
+  /// `back_is_inside` (per patch, from backs_inside()), intersect() prefers coincident fronts
+  /// as from_polygons()'s does; without, it returns the nearest hit as it is (point location).
+  static RayScene from_leaves(const PatchHierarchy& hierarchy, const std::vector<std::uint8_t>& back_is_inside = {});
+  /// Per patch of `hierarchy` (meshed from `scene`): 1 when its material's back is no surface
+  /// (one-sided, opaque, no BRDF of its own), for from_leaves().
+  static std::vector<std::uint8_t> backs_inside(const Scene& scene, const PatchHierarchy& hierarchy);
 
   /// True when something lies on the segment origin + t*dir, t in (tnear, tfar).
   bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
@@ -67,7 +74,8 @@ class RayScene {
   /// at a time for fewer.
   void occluded_incoherent(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
                            std::uint8_t* blocked) const;
-  /// The nearest hit on the ray within (tnear, tfar).
+  /// The nearest hit on the ray within (tnear, tfar); where a back and a front are one surface
+  /// (coincident within 2e-5 of the scene's diagonal, facing apart), the front.
   std::optional<Hit> intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar) const;
   /// intersect() for `count` rays as packets of Embree's widest native size: found[i] = 1 and
   /// hits[i] filled when ray i hits something, else found[i] = 0. Same answers as intersect().
@@ -83,9 +91,18 @@ class RayScene {
 
   void* device_ = nullptr;  // RTCDevice
   void* scene_ = nullptr;   // RTCScene
+  /// A hit on the back of a one-sided opaque triangle (back_is_inside_) with a front within
+  /// coincidence_ of it (a wall modelled as two coincident faces, one per room) becomes that
+  /// front's hit: from either side the ray meets the face toward it, as if the two were one
+  /// wall, instead of whichever rounding picks (a back, which absorbs everything). A two-sided
+  /// or transmitting back is a surface of its own and stays the hit.
+  void prefer_front(const glm::vec3& origin, const glm::vec3& dir, float tnear, Hit& h) const;
+
   int packet_width_ = 1;    // widest ray packet the CPU runs natively (16, 8, 4, or 1)
+  float coincidence_ = 0.0f;  // distance below which two surfaces are one (kOverlapRelativeTolerance x diagonal)
   std::vector<std::uint32_t> ids_;
   std::vector<std::uint32_t> indices_;
+  std::vector<std::uint8_t> back_is_inside_;  // per triangle, or empty
 };
 
 }  // namespace radiosity::detail

@@ -9,6 +9,9 @@
 //     SIGGRAPH 1991 (shared vertices, T-vertices and their interpolation).
 //   M. F. Cohen & J. R. Wallace, "Radiosity and Realistic Image Synthesis", Academic Press 1993,
 //     ch. 8 (quadtree element meshes, vertex radiosities by area-weighted averaging).
+//   (and the same paper's splitting of surfaces where other surfaces meet them, so that no
+//   element or interpolated vertex carries light across a wall standing on a floor: contact
+//   lines from scene/overlap.hpp, MeshOptions::split_at_contacts).
 //   R. E. Tarjan, "Efficiency of a good but not linear set union algorithm", J. ACM 22(2), 1975
 //     (union-find, here over polygon corners joined by smooth edges).
 #include <algorithm>
@@ -29,6 +32,7 @@
 
 #include "core/assert.hpp"
 #include "core/sampling.hpp"
+#include "scene/overlap.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -39,6 +43,11 @@ namespace {
 // the limit may round a few ulps above it; this slack keeps such a cell from being split again
 // (which would quadruple its element count for nothing).
 constexpr double kAreaSlack = 1e-6;
+
+// A polygon is cut along at most this many contact lines (the first in contact_lines()'s
+// order); beyond, the pieces would be slivers of little use, and their count grows as the
+// square of the lines.
+constexpr std::size_t kMaxContactLines = 64;
 
 // Refuse meshes whose estimated element count could not be indexed by 32-bit ids anyway,
 // before any memory is spent on them.
@@ -78,6 +87,78 @@ AreaCentroid cell_geometry(const std::vector<glm::vec3>& vertices, const std::ar
 std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
   const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
   return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+
+// A convex planar polygon cut along contact lines into convex pieces, in double: each line
+// splits every piece that has corners more than `tolerance` on both sides of it; corners within
+// `tolerance` of a line go to both sides. Corners of the input stay exact (they are converted
+// back to the same floats), so host vertices and polygon corners are still found bit for bit.
+// Pieces come out in a fixed order (the lines' order, positive side first), without repeated
+// or collinear corners.
+using Piece = std::vector<glm::dvec3>;
+
+void clean_piece(Piece& piece, double tolerance) {
+  // Repeated corners, then corners on the straight line between their neighbours.
+  Piece out;
+  for (const glm::dvec3& x : piece)
+    if (out.empty() || glm::length(x - out.back()) > tolerance) out.push_back(x);
+  while (out.size() > 1 && glm::length(out.front() - out.back()) <= tolerance) out.pop_back();
+  for (bool removed = true; removed && out.size() >= 3;) {
+    removed = false;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const glm::dvec3 &a = out[(i + out.size() - 1) % out.size()], &b = out[i], &c = out[(i + 1) % out.size()];
+      const glm::dvec3 ab = b - a, bc = c - b;
+      if (glm::length(glm::cross(ab, bc)) <= tolerance * glm::length(c - a)) {
+        out.erase(out.begin() + static_cast<std::ptrdiff_t>(i));
+        removed = true;
+        break;
+      }
+    }
+  }
+  piece = std::move(out);
+}
+
+std::vector<Piece> cut_polygon(const PolygonVertices& corners, const glm::vec3& normal,
+                               const detail::ContactLine* lines, std::size_t line_count, double tolerance) {
+  std::vector<Piece> pieces(1);
+  for (const glm::vec3& c : corners) pieces[0].emplace_back(c);
+  const glm::dvec3 n = glm::normalize(glm::dvec3(normal));
+  std::vector<Piece> next;
+  std::vector<double> d;
+  for (std::size_t l = 0; l < line_count; ++l) {
+    const glm::dvec3 across = glm::normalize(glm::cross(n, lines[l].direction));
+    next.clear();
+    for (Piece& piece : pieces) {
+      d.clear();
+      double lo = 0.0, hi = 0.0;
+      for (const glm::dvec3& x : piece) {
+        d.push_back(glm::dot(x - lines[l].point, across));
+        lo = std::min(lo, d.back());
+        hi = std::max(hi, d.back());
+      }
+      if (!(lo < -tolerance && hi > tolerance)) {
+        next.push_back(std::move(piece));
+        continue;
+      }
+      Piece positive, negative;
+      for (std::size_t i = 0, count = piece.size(); i < count; ++i) {
+        const std::size_t k = (i + 1) % count;
+        if (d[i] >= -tolerance) positive.push_back(piece[i]);
+        if (d[i] <= tolerance) negative.push_back(piece[i]);
+        if ((d[i] > tolerance && d[k] < -tolerance) || (d[i] < -tolerance && d[k] > tolerance)) {
+          const glm::dvec3 x = piece[i] + (piece[k] - piece[i]) * (d[i] / (d[i] - d[k]));
+          positive.push_back(x);
+          negative.push_back(x);
+        }
+      }
+      for (Piece* side : {&positive, &negative}) {
+        clean_piece(*side, 1e-3 * tolerance);
+        if (side->size() >= 3) next.push_back(std::move(*side));
+      }
+    }
+    std::swap(pieces, next);
+  }
+  return pieces;
 }
 
 // Checks one area option: 0 (derive) or a positive number; +inf is allowed and means "never split".
@@ -193,21 +274,23 @@ struct PatchHierarchy::Weld {
   std::uint32_t along_edges = 0;
 
   Weld() = default;
-  Weld(const std::vector<Polygon>& polygons, float crease_angle_deg);
+  /// `excluded` (empty, or one flag per polygon): polygons that share nothing.
+  Weld(const std::vector<Polygon>& polygons, float crease_angle_deg, const std::vector<bool>& excluded);
 
   bool welded(PolygonId polygon) const { return !first_corner.empty() && first_corner[polygon] != kNone; }
   /// Records the edges that ended up with more than one side in `edges`, as seams.
   void make_seams(Edges& edges) const;
 };
 
-PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_angle_deg) {
+PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_angle_deg,
+                           const std::vector<bool>& excluded) {
   // Number the corners of the triangles and quads; a fan polygon shares nothing (its triangles
-  // do not share vertices with each other either).
+  // do not share vertices with each other either), nor does a polygon cut at contact lines.
   first_corner.assign(polygons.size(), kNone);
   std::size_t corner_count = 0;
   for (std::size_t p = 0; p < polygons.size(); ++p) {
     const std::size_t n = polygons[p].vertices.size();
-    if (n != 3 && n != 4) continue;
+    if ((n != 3 && n != 4) || (!excluded.empty() && excluded[p])) continue;
     first_corner[p] = static_cast<std::uint32_t>(corner_count);
     corner_count += n;
     if (corner_count >= kNone)
@@ -396,11 +479,44 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
                     " elements would be created");
 
   const std::vector<Polygon>& polygons = scene.polygons();
-  Weld weld = options_.crease_angle_deg > 0.0f ? Weld(polygons, options_.crease_angle_deg) : Weld();
+  // Contact lines, by polygon: [first_line[p], first_line[p + 1]) in `lines`. A polygon that
+  // has any is cut along them and meshed piece by piece, and shares no vertices with its
+  // neighbours (welding would need its pieces' lattices to match theirs).
+  std::vector<detail::ContactLine> lines;
+  std::vector<std::uint32_t> first_line;
+  std::vector<bool> cut;
+  double tolerance = 0.0;
+  if (options_.split_at_contacts) {
+    lines = detail::contact_lines(scene);
+    tolerance = detail::touching_tolerance(scene);
+    first_line.assign(polygons.size() + 1, 0);
+    for (const detail::ContactLine& l : lines) ++first_line[l.polygon + 1];
+    std::partial_sum(first_line.begin(), first_line.end(), first_line.begin());
+    cut.assign(polygons.size(), false);
+    for (const detail::ContactLine& l : lines) cut[l.polygon] = true;
+  }
+  Weld weld = options_.crease_angle_deg > 0.0f ? Weld(polygons, options_.crease_angle_deg, cut) : Weld();
+  Polygon piece_polygon;
   for (PolygonId id = 0; id < polygons.size(); ++id) {
     const Polygon& polygon = polygons[id];
     const PolygonVertices& p = polygon.vertices;
-    if (p.size() == 4) {
+    if (!cut.empty() && cut[id]) {
+      const std::size_t count = std::min<std::size_t>(first_line[id + 1] - first_line[id], kMaxContactLines);
+      piece_polygon = polygon;
+      for (const Piece& piece : cut_polygon(p, polygon.normal, &lines[first_line[id]], count, tolerance)) {
+        std::vector<glm::vec3> corners;
+        for (const glm::dvec3& x : piece) corners.emplace_back(x);
+        // Quads where the piece allows (a rectangle cut by a line parallel to its sides gives
+        // rectangles), else quads and a triangle of a fan: mesh_quad() grids planar convex quads.
+        std::size_t i = 1;
+        for (; i + 2 < corners.size(); i += 2) {
+          const glm::vec3 quad[4] = {corners[0], corners[i], corners[i + 1], corners[i + 2]};
+          piece_polygon.vertices = PolygonVertices(quad, 4);
+          mesh_quad(id, piece_polygon, weld);
+        }
+        if (i + 1 < corners.size()) mesh_triangle(id, polygon, corners[0], corners[i], corners[i + 1], weld);
+      }
+    } else if (p.size() == 4) {
       mesh_quad(id, polygon, weld);
     } else if (p.size() == 3) {
       mesh_triangle(id, polygon, p[0], p[1], p[2], weld);

@@ -44,7 +44,8 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
 
   Camera camera_settings = options.camera ? *options.camera : scene.camera();
   const detail::PinholeCamera camera(camera_settings, options.width, options.height);
-  const detail::RayScene rays = detail::RayScene::from_leaves(hierarchy);
+  const detail::RayScene rays =
+      detail::RayScene::from_leaves(hierarchy, detail::RayScene::backs_inside(scene, hierarchy));
   const std::vector<Rgb> vertex_B = solution.vertex_radiosity(options.ambient);
   const std::vector<Rgb> vertex_back = solution.vertex_back_radiosity();  // empty: every back is black
   // A ray that hits nothing sees the sky, at its light group's weight in a relit solution.

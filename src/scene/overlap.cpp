@@ -1,4 +1,4 @@
-// Coincident and interpenetrating polygons.
+// Coincident and interpenetrating polygons, and the lines where polygons meet others' interiors.
 // Based on: T. Möller, "A fast triangle-triangle intersection test", Journal of Graphics Tools
 // 2(2), 1997 (signed distances to the other plane, the line where the planes meet and the
 // overlap of the two intervals on it), here for convex polygons with a tolerance; I. E.
@@ -15,6 +15,13 @@
 //   merely touches the other with an edge or a corner: a block standing on a floor, a
 //   T-junction) and the two chords cut from them by the line where the planes meet overlap by
 //   more than the tolerance (so the crossing is inside both).
+// The same broad phase finds contact lines (contact_lines()): where b stands on a or passes
+// through it along a segment that crosses a from border to border (a partition on a floor).
+// Meshes are cut along them so that no element or interpolated vertex straddles a line where
+// the light changes abruptly: D. R. Baum, S. Mann, K. P. Smith & J. M. Winget, "Making radiosity
+// usable: automatic preprocessing and meshing techniques for the generation of accurate
+// radiosity solutions", SIGGRAPH 1991 (surfaces split where others meet them, against light
+// and shadow leaks).
 #include "scene/overlap.hpp"
 
 #include <algorithm>
@@ -22,6 +29,7 @@
 #include <cstdio>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -48,8 +56,10 @@ struct Search {
   std::vector<Plane> planes;
   std::vector<glm::vec3> lower, upper;  ///< bounds grown by the tolerance
   double tolerance = 0.0;
+  bool contacts = false;  ///< looking for contact lines (contact_lines()) rather than overlaps
   std::mutex mutex;
   std::vector<PolygonOverlap> found;
+  std::vector<ContactLine> lines;
 };
 
 using Points2 = std::vector<glm::dvec2>;
@@ -183,6 +193,75 @@ bool test_pair(const Search& s, PolygonId ia, PolygonId ib, PolygonOverlap& out)
   return true;
 }
 
+// Where `b` divides `a` along a line: b stands on a (an edge of b lies in a's plane, the rest
+// of b on one side) or passes through it, along a segment that runs inside a (more than the
+// tolerance from its border: not a wall meeting a floor at the floor's edge, a T-junction)
+// from border to border. Coplanar pairs have no such line.
+bool contact_of(const Search& s, PolygonId ia, PolygonId ib, ContactLine& out) {
+  const Polygon& a = (*s.polygons)[ia];
+  const Polygon& b = (*s.polygons)[ib];
+  const Plane& pa = s.planes[ia];
+  thread_local std::vector<double> db;
+  const Side sb = distances(b, pa, db);
+  const double tb = s.tolerance + pa.flatness;
+  if (sb.lo >= -tb && sb.hi <= tb) return false;  // coplanar
+  if (sb.lo > tb || sb.hi < -tb) return false;    // b does not reach a's plane
+  glm::dvec3 axis = glm::cross(pa.normal, glm::normalize(glm::dvec3(b.normal)));
+  const double length = glm::length(axis);
+  if (!(length > 1e-6)) return false;
+  axis /= length;
+  // The segment of b in a's plane: its corners within the tolerance and its edges' crossings.
+  double lo = 1e300, hi = -1e300;
+  glm::dvec3 at{0.0};
+  auto take = [&](const glm::dvec3& x) {
+    const double t = glm::dot(x, axis);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+    at = x;
+  };
+  for (std::size_t i = 0, n = b.vertices.size(); i < n; ++i) {
+    const std::size_t k = (i + 1) % n;
+    if (std::fabs(db[i]) <= tb) take(glm::dvec3(b.vertices[i]));
+    if ((db[i] > tb && db[k] < -tb) || (db[i] < -tb && db[k] > tb)) {
+      const glm::dvec3 u(b.vertices[i]), v(b.vertices[k]);
+      take(u + (v - u) * (db[i] / (db[i] - db[k])));
+    }
+  }
+  if (!(hi - lo > s.tolerance)) return false;
+  // Project a point of the segment into a's plane; the line is origin + t axis there.
+  const glm::dvec3 origin = at - (glm::dot(pa.normal, at) - pa.offset) * pa.normal - glm::dot(at, axis) * axis;
+  // a's chord along the line, shrunk by the tolerance (a is convex, counter-clockwise around
+  // its normal: each edge's inward direction is normal x edge).
+  double chord_lo = -1e300, chord_hi = 1e300;
+  for (std::size_t i = 0, n = a.vertices.size(); i < n; ++i) {
+    const glm::dvec3 u(a.vertices[i]), v(a.vertices[(i + 1) % n]);
+    const glm::dvec3 edge = v - u;
+    const double edge_length = glm::length(edge);
+    if (!(edge_length > 0.0)) continue;
+    const glm::dvec3 inward = glm::cross(pa.normal, edge) / edge_length;
+    // dot(origin + t axis - u, inward) >= tolerance
+    const double c0 = glm::dot(origin - u, inward) - s.tolerance, c1 = glm::dot(axis, inward);
+    if (std::fabs(c1) < 1e-12) {
+      if (c0 < 0.0) return false;  // the line runs along a's border or outside it
+      continue;
+    }
+    const double t = -c0 / c1;
+    if (c1 > 0.0) chord_lo = std::max(chord_lo, t);
+    else chord_hi = std::min(chord_hi, t);
+  }
+  if (!(chord_hi - chord_lo > s.tolerance)) return false;
+  // b must cover the whole chord: it divides a in two. A block standing on a floor covers part
+  // of a chord only; rays already find what it hides (docs/ARCHITECTURE.md, "Contact"), and
+  // cutting along whole chords there would spread slivers over the floor.
+  if (lo > chord_lo + 2.0 * s.tolerance || hi < chord_hi - 2.0 * s.tolerance) return false;
+  lo = chord_lo;
+  hi = chord_hi;
+  out.polygon = ia;
+  out.point = origin + 0.5 * (lo + hi) * axis;
+  out.direction = axis;
+  return true;
+}
+
 void bounds_of(const RTCBoundsFunctionArguments* args) {
   const auto* s = static_cast<const Search*>(args->geometryUserPtr);
   const glm::vec3 &lo = s->lower[args->primID], &hi = s->upper[args->primID];
@@ -195,11 +274,68 @@ void on_collisions(void* user, RTCCollision* collisions, unsigned count) {
     PolygonId a = collisions[i].primID0, b = collisions[i].primID1;
     if (a == b) continue;
     if (a > b) std::swap(a, b);
+    if (s->contacts) {
+      for (const auto& [on, other] : {std::make_pair(a, b), std::make_pair(b, a)}) {
+        ContactLine line;
+        if (!contact_of(*s, on, other, line)) continue;
+        const std::lock_guard<std::mutex> lock(s->mutex);
+        s->lines.push_back(line);
+      }
+      continue;
+    }
     PolygonOverlap o;
     if (!test_pair(*s, a, b, o)) continue;
     const std::lock_guard<std::mutex> lock(s->mutex);
     s->found.push_back(o);
   }
+}
+
+// The tolerance, planes and grown bounds of every polygon, then Embree's collision query over
+// the bounds, which calls test_pair() or contact_of() for every nearby pair.
+void search_pairs(const Scene& scene, Search& s, const char* caller) {
+  const std::vector<Polygon>& polygons = scene.polygons();
+  s.polygons = &polygons;
+  s.tolerance = touching_tolerance(scene);
+  const auto grow = static_cast<float>(2.0 * s.tolerance);
+  s.planes.resize(polygons.size());
+  s.lower.resize(polygons.size());
+  s.upper.resize(polygons.size());
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    const Polygon& p = polygons[i];
+    Plane& plane = s.planes[i];
+    plane.normal = glm::normalize(glm::dvec3(p.normal));
+    for (const glm::vec3& v : p.vertices) plane.offset += glm::dot(plane.normal, glm::dvec3(v));
+    plane.offset /= static_cast<double>(p.vertices.size());
+    glm::vec3 lo = p.vertices[0], hi = p.vertices[0];
+    for (const glm::vec3& v : p.vertices) {
+      plane.flatness = std::max(plane.flatness, std::fabs(glm::dot(plane.normal, glm::dvec3(v)) - plane.offset));
+      lo = glm::min(lo, v);
+      hi = glm::max(hi, v);
+    }
+    s.lower[i] = lo - grow;
+    s.upper[i] = hi + grow;
+  }
+
+  RTCDevice device = rtcNewDevice(embree_device_config());
+  if (!device)
+    throw Error(ErrorCode::internal, std::string(caller) + ": Embree cannot create a device (error " +
+                                         std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
+  RTCScene boxes = rtcNewScene(device);
+  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(polygons.size()));
+  rtcSetGeometryUserData(geometry, &s);
+  rtcSetGeometryBoundsFunction(geometry, bounds_of, nullptr);
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(boxes, geometry);
+  rtcReleaseGeometry(geometry);
+  rtcCommitScene(boxes);
+  rtcCollide(boxes, boxes, on_collisions, &s);
+  const RTCError error = rtcGetDeviceError(device);
+  rtcReleaseScene(boxes);
+  rtcReleaseDevice(device);
+  if (error != RTC_ERROR_NONE)
+    throw Error(ErrorCode::internal, std::string(caller) + ": Embree's collision query failed (error " +
+                                         std::to_string(static_cast<int>(error)) + ")");
 }
 
 std::string point_text(const glm::vec3& p) {
@@ -233,6 +369,46 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene) {
   return out;
 }
 
+std::vector<ContactLine> contact_lines(const Scene& scene) {
+  if (scene.polygons().size() < 2) return {};
+  Search s;
+  s.contacts = true;
+  search_pairs(scene, s, "contact_lines");
+  // Sorted by polygon, then by line, and one line per polygon where several polygons meet it
+  // along the same line (a wall modelled as two coincident faces, collinear walls): the order
+  // of Embree's callbacks must not show.
+  std::vector<ContactLine> lines = std::move(s.lines);
+  auto key = [](const ContactLine& l) {
+    return std::make_tuple(l.polygon, l.direction.x, l.direction.y, l.direction.z, l.point.x, l.point.y, l.point.z);
+  };
+  std::sort(lines.begin(), lines.end(), [&](const ContactLine& x, const ContactLine& y) { return key(x) < key(y); });
+  std::vector<ContactLine> out;
+  for (const ContactLine& l : lines) {
+    bool same = false;
+    for (auto it = out.rbegin(); it != out.rend() && it->polygon == l.polygon; ++it) {
+      const double parallel = glm::length(glm::cross(it->direction, l.direction));
+      const glm::dvec3 d = l.point - it->point;
+      const double apart = glm::length(d - glm::dot(d, it->direction) * it->direction);
+      if (parallel < 1e-6 && apart <= s.tolerance) {
+        same = true;
+        break;
+      }
+    }
+    if (!same) out.push_back(l);
+  }
+  return out;
+}
+
+double touching_tolerance(const Scene& scene) {
+  // Float corners carry rounding of up to 6e-8 of their magnitude (half an ulp); far from the
+  // origin the tolerance stays above a few times that, so that shared edges of tilted polygons
+  // never look like crossings.
+  const Bounds box = scene.bounds();
+  const glm::vec3 extent = glm::max(glm::abs(box.lower), glm::abs(box.upper));
+  const double magnitude = std::max({extent.x, extent.y, extent.z});
+  return std::max(kOverlapRelativeTolerance * box.diagonal(), 2.5e-7 * magnitude);
+}
+
 }  // namespace radiosity::detail
 
 namespace radiosity {
@@ -242,54 +418,7 @@ std::vector<PolygonOverlap> find_overlaps(const Scene& scene) {
   const std::vector<Polygon>& polygons = scene.polygons();
   if (polygons.size() < 2) return {};
   detail::Search s;
-  s.polygons = &polygons;
-  // Float corners carry rounding of up to 6e-8 of their magnitude (half an ulp); far from the
-  // origin the tolerance stays above a few times that, so that shared edges of tilted polygons
-  // never look like crossings.
-  const Bounds box = scene.bounds();
-  const glm::vec3 extent = glm::max(glm::abs(box.lower), glm::abs(box.upper));
-  const double magnitude = std::max({extent.x, extent.y, extent.z});
-  s.tolerance = std::max(detail::kOverlapRelativeTolerance * box.diagonal(), 2.5e-7 * magnitude);
-  const auto grow = static_cast<float>(2.0 * s.tolerance);
-  s.planes.resize(polygons.size());
-  s.lower.resize(polygons.size());
-  s.upper.resize(polygons.size());
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    const Polygon& p = polygons[i];
-    detail::Plane& plane = s.planes[i];
-    plane.normal = glm::normalize(glm::dvec3(p.normal));
-    for (const glm::vec3& v : p.vertices) plane.offset += glm::dot(plane.normal, glm::dvec3(v));
-    plane.offset /= static_cast<double>(p.vertices.size());
-    glm::vec3 lo = p.vertices[0], hi = p.vertices[0];
-    for (const glm::vec3& v : p.vertices) {
-      plane.flatness = std::max(plane.flatness, std::fabs(glm::dot(plane.normal, glm::dvec3(v)) - plane.offset));
-      lo = glm::min(lo, v);
-      hi = glm::max(hi, v);
-    }
-    s.lower[i] = lo - grow;
-    s.upper[i] = hi + grow;
-  }
-
-  RTCDevice device = rtcNewDevice(detail::embree_device_config());
-  if (!device)
-    throw Error(ErrorCode::internal, "find_overlaps: Embree cannot create a device (error " +
-                                         std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
-  RTCScene boxes = rtcNewScene(device);
-  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(polygons.size()));
-  rtcSetGeometryUserData(geometry, &s);
-  rtcSetGeometryBoundsFunction(geometry, detail::bounds_of, nullptr);
-  rtcCommitGeometry(geometry);
-  rtcAttachGeometry(boxes, geometry);
-  rtcReleaseGeometry(geometry);
-  rtcCommitScene(boxes);
-  rtcCollide(boxes, boxes, detail::on_collisions, &s);
-  const RTCError error = rtcGetDeviceError(device);
-  rtcReleaseScene(boxes);
-  rtcReleaseDevice(device);
-  if (error != RTC_ERROR_NONE)
-    throw Error(ErrorCode::internal,
-                "find_overlaps: Embree's collision query failed (error " + std::to_string(static_cast<int>(error)) + ")");
+  detail::search_pairs(scene, s, "find_overlaps");
 
   // The query may report a pair twice and in any order; sorting makes the result deterministic.
   std::vector<PolygonOverlap> found = std::move(s.found);

@@ -4,8 +4,11 @@
 // the same way (z-fighting) are ambiguous. The public face is radiosity::find_overlaps().
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 namespace radiosity {
 inline namespace v1 {
@@ -25,5 +28,29 @@ inline constexpr double kOverlapRelativeTolerance = 2e-5;
 /// pairs there are. Coincident pairs facing each other (contact) and interpenetrating pairs
 /// are not warned about: they are lit correctly.
 std::vector<std::string> z_fighting_warnings(const Scene& scene);
+
+/// The distance below which two surfaces count as touching in `scene`:
+/// kOverlapRelativeTolerance of its bounding-box diagonal, and at least a few ulps of its
+/// largest coordinate.
+double touching_tolerance(const Scene& scene);
+
+/// A line in a polygon's plane along which another polygon meets its interior.
+struct ContactLine {
+  std::uint32_t polygon = 0;   ///< the polygon touched (a PolygonId)
+  glm::dvec3 point{0.0};       ///< a point of the line, in the polygon's plane, inside it
+  glm::dvec3 direction{0.0};   ///< unit, in the polygon's plane
+};
+
+/// Every line along which a polygon is divided by another that stands on it (an edge in its
+/// plane: a partition wall on a floor running from border to border) or passes through it,
+/// the contact running across the polygon from border to border; not lines along its border
+/// (walls meeting at corners, T-junctions), not contacts that end inside it (a block's sides
+/// on a floor: rays find what those hide) and nothing for coplanar pairs. Sorted by polygon,
+/// one entry per line (several polygons meeting a polygon along the same line give one).
+/// PatchHierarchy cuts the polygons along them (MeshOptions::split_at_contacts): the light on
+/// the two sides of such a line differs by everything the other polygon blocks, and an
+/// element or an interpolated vertex across it would carry light into the dark side (Baum et
+/// al. 1991). Cost: as find_overlaps(). Thread safety: concurrent calls are safe.
+std::vector<ContactLine> contact_lines(const Scene& scene);
 
 }  // namespace radiosity::detail

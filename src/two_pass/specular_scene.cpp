@@ -28,7 +28,7 @@ namespace {
 
 SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights)
     : hierarchy_(&hierarchy),
-      rays_(RayScene::from_leaves(hierarchy)),
+      rays_(RayScene::from_leaves(hierarchy, RayScene::backs_inside(scene, hierarchy))),
       lights_(scene.lights(), weights ? &weights->light : nullptr) {
   const auto& polygons = scene.polygons();
   for (const Patch& p : hierarchy.patches())

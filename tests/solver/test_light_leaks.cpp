@@ -1,0 +1,250 @@
+// Light leaks: scenes that production bakers get wrong, each with a lit room beside a dark one
+// that no light can reach (the reference path tracer renders it black):
+// - two rooms modelled as separate boxes that share a wall (two coincident, opposite-facing
+//   polygons at x = 2);
+// - one hall whose floor, ceiling and side walls run through a partition 1 cm thick (the
+//   partition's faces stand on them with a gap of 0);
+// - the same with a partition of no thickness (two coincident faces).
+// For every estimator that sees occlusion (ray_cast, hemicube, monte_carlo; analytic ignores
+// occlusion by definition) the dark room stays dark, the lit room keeps its light (a ray that
+// meets the coincident pair must take the face toward it, not the other's absorbing back), and
+// the display render of the dark room is black; hierarchical radiosity's leak stays within its
+// error bound. A block standing on a floor and a sunk sphere are test_contacts.cpp's.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <radiosity/radiosity.hpp>
+
+#include "support/build.hpp"
+
+namespace rad = radiosity;
+
+namespace {
+
+struct Materials {
+  rad::MaterialId wall, lamp;
+};
+
+Materials add_materials(rad::Scene& scene) {
+  rad::Material wall, lamp;
+  wall.name = "wall";
+  wall.reflectance = rad::Rgb(0.6f);
+  lamp.name = "lamp";
+  lamp.emission = rad::Rgb(25.0f);
+  lamp.reflectance = rad::Rgb(0.0f);
+  return {scene.add_material(wall), scene.add_material(lamp)};
+}
+
+// The six inward faces of the box [lo, hi], in `group`.
+void add_room(rad::Scene& scene, glm::vec3 lo, glm::vec3 hi, rad::MaterialId m, const std::string& group) {
+  const glm::vec3 d = hi - lo;
+  rad::add_quad(scene, lo, {0, 0, d.z}, {d.x, 0, 0}, m, group);                 // floor, +y
+  rad::add_quad(scene, {lo.x, hi.y, lo.z}, {d.x, 0, 0}, {0, 0, d.z}, m, group);  // ceiling, -y
+  rad::add_quad(scene, lo, {0, d.y, 0}, {0, 0, d.z}, m, group);                 // x0, +x
+  rad::add_quad(scene, {hi.x, lo.y, lo.z}, {0, 0, d.z}, {0, d.y, 0}, m, group);  // x1, -x
+  rad::add_quad(scene, lo, {d.x, 0, 0}, {0, d.y, 0}, m, group);                 // z0, +z
+  rad::add_quad(scene, {lo.x, lo.y, hi.z}, {0, d.y, 0}, {d.x, 0, 0}, m, group);  // z1, -z
+}
+
+// Two rooms [0,2]^3 ("lit", with a lamp) and [2,4]x[0,2]^2 ("dark") modelled as two boxes that
+// share the wall x = 2.
+rad::Scene shared_wall() {
+  rad::Scene scene;
+  const Materials m = add_materials(scene);
+  add_room(scene, {0, 0, 0}, {2, 2, 2}, m.wall, "lit");
+  add_room(scene, {2, 0, 0}, {4, 2, 2}, m.wall, "dark");
+  rad::add_quad(scene, {0.7f, 1.99f, 0.7f}, {0.6f, 0, 0}, {0, 0, 0.6f}, m.lamp, "lamp");
+  return scene;
+}
+
+// One hall [0,4]x[0,2]^2 (one polygon each for floor, ceiling, front and back) split at x = 2
+// by a solid partition `thickness` thick, or by two coincident faces when 0, that touches
+// floor, ceiling, front and back (gap 0). The lamp is in the x < 2 half.
+rad::Scene thin_wall(float thickness) {
+  rad::Scene scene;
+  const Materials m = add_materials(scene);
+  rad::add_quad(scene, {0, 0, 0}, {0, 0, 2}, {4, 0, 0}, m.wall, "floor");
+  rad::add_quad(scene, {0, 2, 0}, {4, 0, 0}, {0, 0, 2}, m.wall, "ceiling");
+  rad::add_quad(scene, {0, 0, 0}, {0, 2, 0}, {0, 0, 2}, m.wall, "lit");
+  rad::add_quad(scene, {4, 0, 0}, {0, 0, 2}, {0, 2, 0}, m.wall, "dark");
+  rad::add_quad(scene, {0, 0, 0}, {4, 0, 0}, {0, 2, 0}, m.wall, "front");
+  rad::add_quad(scene, {0, 0, 2}, {0, 2, 0}, {4, 0, 0}, m.wall, "back");
+  const float h = 0.5f * thickness;
+  if (thickness > 0.0f) {
+    rad::add_box(scene, {2 - h, 0, 0}, {2 + h, 2, 2}, m.wall, "partition");
+  } else {
+    rad::add_quad(scene, {2, 0, 0}, {0, 0, 2}, {0, 2, 0}, m.wall, "partition");  // facing -x
+    rad::add_quad(scene, {2, 0, 0}, {0, 2, 0}, {0, 0, 2}, m.wall, "partition");  // facing +x
+  }
+  rad::add_quad(scene, {0.7f, 1.99f, 0.7f}, {0.6f, 0, 0}, {0, 0, 0.6f}, m.lamp, "lamp");
+  return scene;
+}
+
+// Radiosity (red) of the leaves: area-weighted mean on the lit side (centre x < wall_x - 2 cm,
+// emitters left out), largest and mean on the dark side (x > wall_x + 2 cm).
+// A 2 x 2 x 2 room with a block standing on its floor, away from the walls.
+rad::Scene test_room_with_block() {
+  rad::Scene scene;
+  const Materials m = add_materials(scene);
+  add_room(scene, {0, 0, 0}, {2, 2, 2}, m.wall, "room");
+  rad::add_box(scene, {0.5f, 0, 0.5f}, {1.0f, 0.5f, 1.0f}, m.wall, "block");
+  return scene;
+}
+
+struct LeakFigures {
+  double lit_mean = 0, dark_max = 0, dark_mean = 0;
+};
+
+LeakFigures leak_figures(const rad::Solution& sol, const rad::Scene& scene, float wall_x) {
+  const rad::PatchHierarchy& h = sol.hierarchy();
+  LeakFigures f;
+  double lit_sum = 0, lit_area = 0, dark_sum = 0, dark_area = 0;
+  for (std::uint32_t leaf : h.leaves()) {
+    const rad::Element& e = h.element(leaf);
+    const rad::Polygon& poly = scene.polygons()[h.patches()[e.patch].polygon];
+    if (scene.materials()[poly.material].emission.x > 0) continue;
+    glm::vec3 c(0.0f);
+    for (int k = 0; k < e.corner_count(); ++k) c += h.vertices()[e.corners[static_cast<std::size_t>(k)]];
+    c /= static_cast<float>(e.corner_count());
+    const double b = sol.radiosity()[leaf].x;
+    if (c.x < wall_x - 0.02f) {
+      lit_sum += b * e.area;
+      lit_area += e.area;
+    } else if (c.x > wall_x + 0.02f) {
+      dark_sum += b * e.area;
+      dark_area += e.area;
+      f.dark_max = std::max(f.dark_max, b);
+    }
+  }
+  f.lit_mean = lit_sum / lit_area;
+  f.dark_mean = dark_sum / dark_area;
+  return f;
+}
+
+double image_mean(const rad::Image& image) {
+  double sum = 0.0;
+  for (const rad::Rgb& px : image.pixels) sum += px.x;
+  return sum / static_cast<double>(image.pixels.size());
+}
+
+struct LeakScene {
+  std::string name;
+  rad::Scene scene;
+};
+
+std::vector<LeakScene> leak_scenes() {
+  std::vector<LeakScene> out;
+  out.push_back({"two boxes sharing a wall", shared_wall()});
+  out.push_back({"a hall with a partition 1 cm thick", thin_wall(0.01f)});
+  out.push_back({"a hall with a partition of two coincident faces", thin_wall(0.0f)});
+  return out;
+}
+
+// Cameras at the far wall of each room, looking at the partition.
+const rad::Camera kDarkCamera{{3.9f, 1.0f, 1.0f}, {2.0f, 0.5f, 1.0f}, {0, 1, 0}, 90.0f};
+const rad::Camera kLitCamera{{0.1f, 1.0f, 1.0f}, {2.0f, 0.5f, 1.0f}, {0, 1, 0}, 90.0f};
+
+}  // namespace
+
+TEST_SUITE("solver") {
+  TEST_CASE("light leaks: a dark room beside a lit one stays dark for every estimator, the render and the path tracer") {
+    std::vector<rad::FormFactorMethod> methods{rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::hemicube,
+                                               rad::FormFactorMethod::monte_carlo};
+    // Under the sanitizers one estimator (the others' rays and hemicubes are the same code).
+    if (test::kSanitizerBuild) methods = {rad::FormFactorMethod::monte_carlo};
+    for (const LeakScene& c : leak_scenes()) {
+      CAPTURE(c.name);
+      // The reference: the path tracer sees nothing in the dark room, and the lit room's mean.
+      rad::PathTraceOptions po;
+      po.width = 24;
+      po.height = 24;
+      po.spp = test::kSanitizerBuild ? 4 : 16;
+      po.camera = kDarkCamera;
+      CHECK(image_mean(rad::render_path_traced(c.scene, po)) == 0.0);
+      po.spp = test::kSanitizerBuild ? 16 : 256;
+      po.camera = kLitCamera;
+      const double path_lit = image_mean(rad::render_path_traced(c.scene, po));
+      for (rad::FormFactorMethod method : methods) {
+        CAPTURE(static_cast<int>(method));
+        rad::SolveOptions o;
+        o.form_factors.method = method;
+        o.mesh.max_element_area = 0.04f;  // 20 cm elements
+        const rad::Solution sol = rad::solve(c.scene, o);
+        const LeakFigures f = leak_figures(sol, c.scene, 2.0f);
+        MESSAGE(c.name << ", estimator " << static_cast<int>(method) << ": lit mean " << f.lit_mean << ", dark max "
+                       << f.dark_max << ", dark mean " << f.dark_mean);
+        // Ray-cast estimates reach ~1e-4 of the lit mean next to a coincident wall (visibility
+        // rays that start within their lift-off distance of the wall); 1e-3 is far below what a
+        // display shows.
+        CHECK(f.dark_max < 1e-3 * f.lit_mean);
+        rad::RenderOptions ro;
+        ro.width = 24;
+        ro.height = 24;
+        ro.spp = 4;
+        ro.camera = kDarkCamera;
+        const double dark_view = image_mean(rad::render(c.scene, sol, ro));
+        ro.camera = kLitCamera;
+        const double lit_view = image_mean(rad::render(c.scene, sol, ro));
+        MESSAGE("  render: dark room " << dark_view << ", lit room " << lit_view << " (path tracer " << path_lit << ")");
+        CHECK(dark_view < 1e-3 * lit_view);
+        // The lit room keeps its light: a ray onto the coincident pair takes the face toward it.
+        // Before that rule Monte Carlo lost 12 % here. 4 % covers the path tracer's noise at
+        // 256 samples and the display's interpolation.
+        CHECK(lit_view == doctest::Approx(path_lit).epsilon(test::kSanitizerBuild ? 0.15 : 0.04));
+      }
+      // Hierarchical radiosity spreads what a cluster receives over its members, so a cluster
+      // that spans the partition passes a little light on to the dark side: bounded by the
+      // refinement's threshold (epsilon x the mean radiosity), not zero (docs/HIERARCHICAL.md).
+      rad::SolveOptions o;
+      o.method = rad::SolverMethod::hierarchical;
+      o.mesh.max_element_area = 0.04f;
+      const rad::Solution sol = rad::solve(c.scene, o);
+      const LeakFigures f = leak_figures(sol, c.scene, 2.0f);
+      MESSAGE(c.name << ", hierarchical: lit mean " << f.lit_mean << ", dark max " << f.dark_max << ", dark mean "
+                     << f.dark_mean);
+      CHECK(f.dark_max < o.hierarchical.epsilon * f.lit_mean);
+      CHECK(f.dark_mean < 0.1 * o.hierarchical.epsilon * f.lit_mean);
+    }
+  }
+
+  TEST_CASE("light leaks: a partition that divides a polygon cuts its mesh there, and only such contacts do") {
+    const rad::Scene hall = thin_wall(0.01f);
+    rad::MeshOptions mo;
+    mo.max_element_area = 0.04f;
+    const rad::PatchHierarchy cut(hall, mo);
+    // No leaf of the floor, ceiling, front or back spans the partition's faces at 1.995 and 2.005.
+    int spanning = 0;
+    for (std::uint32_t leaf : cut.leaves()) {
+      const rad::Element& e = cut.element(leaf);
+      float lo = 1e9f, hi = -1e9f;
+      for (int k = 0; k < e.corner_count(); ++k) {
+        lo = std::min(lo, cut.vertices()[e.corners[static_cast<std::size_t>(k)]].x);
+        hi = std::max(hi, cut.vertices()[e.corners[static_cast<std::size_t>(k)]].x);
+      }
+      for (float x : {1.995f, 2.005f})
+        if (lo < x - 1e-4f && hi > x + 1e-4f) ++spanning;
+    }
+    CHECK(spanning == 0);
+    // Area is kept, and meshing without the option spans the partition.
+    double area = 0.0;
+    for (const rad::Patch& p : cut.patches()) area += p.area;
+    CHECK(area == doctest::Approx(hall.total_area()).epsilon(1e-5));
+    mo.split_at_contacts = false;
+    const rad::PatchHierarchy whole(hall, mo);
+    CHECK(whole.patches().size() < cut.patches().size());
+    // A block standing on a floor (its sides end inside the floor) and the Cornell box's blocks
+    // cut nothing.
+    rad::Scene room = test_room_with_block();
+    mo.split_at_contacts = true;
+    rad::MeshOptions off = mo;
+    off.split_at_contacts = false;
+    CHECK(rad::PatchHierarchy(room, mo).patches().size() == rad::PatchHierarchy(room, off).patches().size());
+    const rad::Scene cornell = rad::cornell_box();
+    CHECK(rad::PatchHierarchy(cornell, rad::MeshOptions{}).patches().size() ==
+          rad::PatchHierarchy(cornell, rad::MeshOptions{0, 0, 30, false}).patches().size());
+  }
+}
