@@ -593,7 +593,7 @@ max_patch_area, max_element_area: meshing, scene units^2 (0 = derived from the s
 hemisphere_rays: Monte Carlo rays per element. adaptive: adaptive subdivision. epsilon: the
 hierarchical solver's link refinement threshold. memory_budget_bytes: 0 = 4 GiB.
 progress: optional callable(dict) with keys phase, fraction, iteration, residual, called on the
-calling thread at phase boundaries and at most every ~100 ms; return False to cancel (the
+calling thread at phase boundaries and at most every ~50 ms; return False to cancel (the
 Solution's status is then 'cancelled'). An exception it raises, and Ctrl-C, propagate.
 
 Raises radiosity.Error for bad options, a scene without polygons, overlapping polygons, or a

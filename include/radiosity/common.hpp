@@ -76,7 +76,7 @@ struct Progress {
 };
 
 /// Called on the thread that started the computation, one call at a time, at phase
-/// boundaries and at most about every 100 ms. Return false to cancel.
+/// boundaries and at most about every 50 ms. Return false to cancel.
 using ProgressFn = std::function<bool(const Progress&)>;
 
 /// Version of the library binary, e.g. "0.1.0". Compare with RADIOSITY_VERSION_STRING from

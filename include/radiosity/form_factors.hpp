@@ -279,8 +279,13 @@ struct ViewFactorOptions {
   /// GroupId order. Only the listed groups' elements are sources, but every polygon still
   /// occludes and receives.
   std::vector<std::string> groups;
+  /// The most bytes the factors may take while they are made, 0 = 4 GiB: the matrix's entries
+  /// (view_factor_matrix(): 8 bytes each while a block is made, 8 more in the result), or
+  /// ViewFactorMethod::hierarchical's links. A computation about to pass it stops with
+  /// Error{memory_budget}, naming the figure, before the allocation.
+  std::size_t memory_budget_bytes = 0;
   /// Called on the calling thread with Phase::form_factors at the start, at the end and at most
-  /// every ~100 ms in between; return false to cancel (the result then has `cancelled` set).
+  /// every ~50 ms in between; return false to cancel (the result then has `cancelled` set).
   /// Exceptions it throws propagate out of view_factors().
   ProgressFn on_progress;
 };

@@ -46,7 +46,7 @@ struct ImageOptions {
   /// (each pixel draws from its own random stream keyed by (seed, pixel)).
   std::uint64_t seed = 1;
   /// Called on the calling thread, one call at a time, after bands of rows (Phase::rendering,
-  /// fraction = rows done / height): at most about every 100 ms, and always after the last
+  /// fraction = rows done / height): at most about every 50 ms, and always after the last
   /// row (fraction 1). Return false to cancel: the rows not yet rendered stay black, and the
   /// renderer returns the image as it is.
   ProgressFn on_progress;

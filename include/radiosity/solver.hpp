@@ -77,7 +77,10 @@ struct SolveOptions {
   /// form_factors.threads is set (non-zero) itself.
   unsigned threads = 0;
   std::uint64_t seed = 1;        ///< overrides form_factors.seed
-  /// Largest form-factor matrix the matrix methods may allocate, in bytes; 0 = 4 GiB.
+  /// The most memory the form factors may take, in bytes; 0 = 4 GiB: the matrix methods' rows
+  /// (refused before they are computed, with the figure, or SolverMethod::automatic switches
+  /// to hierarchical), progressive's cache of columns (it keeps what fits), hierarchical's links
+  /// (refinement stops with Error{memory_budget} before a round that would pass it).
   std::size_t memory_budget_bytes = 0;
   /// Shadow rays per element side toward each sky light (Light::sky) where the sky is partly
   /// covered, >= 5: a first fifth decides (all clear or all blocked: no more rays), the rest

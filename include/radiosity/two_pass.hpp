@@ -43,6 +43,10 @@ struct PhotonOptions {
   /// Photons emitted from the emitters (chosen by power), >= 0; 0 turns caustics off. Only the
   /// photons whose first hit is specular cost more than one ray.
   std::size_t photons = 200000;
+  /// The most bytes the stored photons may take while they are shot and gathered, 0 = 4 GiB
+  /// (44 bytes a photon, held twice while the blocks are merged: about 48 million stored
+  /// photons): shooting that passes it stops with Error{memory_budget}, naming the figure.
+  std::size_t memory_budget_bytes = 0;
   /// Specular events a photon may go through, >= 1.
   int max_bounces = 8;
   /// Nearest photons per density estimate, >= 1 (more: smoother, blurrier caustics).

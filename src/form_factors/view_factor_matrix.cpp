@@ -23,6 +23,7 @@
 #include <string>
 
 #include "core/frame.hpp"
+#include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "core/rng.hpp"
@@ -41,9 +42,20 @@ inline namespace v1 {
 namespace {
 
 /// Source elements per chunk of rows (whole polygons are kept together, so a chunk may hold
-/// more): enough for the estimators' parallel loops, few enough for ~100 progress reports on
-/// large scenes.
-constexpr std::size_t kChunkElements = 4096;
+/// more): the first chunk's, then BlockSizer's choice (about 25 ms a chunk, so a cancel is
+/// seen soon) within these; an element's row does not depend on its chunk.
+constexpr std::size_t kFirstChunk = 256, kSmallestChunk = 16, kLargestChunk = 16384;
+/// Bytes of one entry of the matrix: its column and its value.
+constexpr double kEntryBytes = sizeof(std::uint32_t) + sizeof(float);
+
+/// Throws Error{memory_budget} when the matrix's `bytes` after `done` of `rows` rows pass `budget`.
+void check_matrix_memory(double bytes, std::size_t done, std::size_t rows, std::size_t budget) {
+  if (bytes <= static_cast<double>(budget)) return;
+  detail::refuse_memory("the view-factor matrix (after " + std::to_string(done) + " of " + std::to_string(rows) + " rows)",
+                        bytes, budget, "ViewFactorOptions::memory_budget_bytes",
+                        "; choose fewer rows (ViewFactorOptions::groups), a coarser level or mesh, or raise the budget");
+}
+
 /// The enclosure correction refuses a scene with a row farther than this from 1 (check_enclosure()).
 constexpr double kMaxClosureGap = 0.25;
 
@@ -111,10 +123,12 @@ bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
       escaped[k - element_begin] = static_cast<double>(open) / static_cast<double>(n);
     }
   };
-  for (std::size_t block = element_begin; block < element_end; block += kChunkElements) {
-    const std::size_t block_end = std::min<std::size_t>(element_end, block + kChunkElements);
+  detail::BlockSizer blocks(kFirstChunk, kSmallestChunk, kLargestChunk);
+  for (std::size_t block = element_begin, block_end = 0; block < element_end; block = block_end) {
+    block_end = std::min<std::size_t>(element_end, block + blocks.size());
     detail::parallel_for(ff.threads, block_end - block, 16,
                          [&](std::size_t begin, std::size_t end) { trace(block + begin, block + end); });
+    blocks.done(block_end - block);
     Progress p;
     p.phase = Phase::form_factors;
     p.fraction = done + (1.0 - done) * static_cast<double>(block_end - element_begin) /
@@ -205,18 +219,19 @@ void check_enclosure(const ViewFactorMatrix& m, const Scene& scene) {
 /// the same bits). Rows are integrated in parallel, a chunk at a time between progress reports;
 /// returns false when `gate` cancels (every row of the block is then left empty).
 bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const std::vector<double>& area,
-                std::size_t begin, std::size_t end, unsigned threads, detail::ProgressGate& gate, double share,
-                ViewFactorMatrix& out) {
+                std::size_t begin, std::size_t end, unsigned threads, std::size_t memory_budget,
+                detail::ProgressGate& gate, double share, ViewFactorMatrix& out) {
   const detail::ExactPolygonTransport transport(scene);
   const std::size_t n = ids.size(), rows = end - begin;
   std::vector<std::vector<std::uint32_t>> columns(rows);
   std::vector<std::vector<float>> transports(rows);
-  // Chunks of rows of about equal work (row r integrates n - r pairs in a whole matrix).
-  const std::size_t chunk_pairs = std::max<std::size_t>(n, 1) * 64;
+  // Chunks of rows of about equal work (row r integrates n - r pairs in a whole matrix), each
+  // of about as many pairs as BlockSizer asks for.
+  detail::BlockSizer chunk_pairs(std::max<std::size_t>(n, 1) * 4, 64, std::max<std::size_t>(n, 1) * 64);
   std::size_t row = begin;
   while (row < end) {
     std::size_t last = row, pairs = 0;
-    while (last < end && (last == row || pairs < chunk_pairs)) pairs += n - (last++ - begin);
+    while (last < end && (last == row || pairs < chunk_pairs.size())) pairs += n - (last++ - begin);
     detail::parallel_for(threads, last - row, 1, [&](std::size_t b, std::size_t e) {
       const auto w = transport.workspace();
       for (std::size_t r = row + b; r < row + e; ++r) {
@@ -231,7 +246,13 @@ bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const
         }
       }
     });
+    chunk_pairs.done(pairs);
     row = last;
+    // Each pair is held once now and twice in the result (both directions), 8 bytes per entry:
+    // refuse before the result is made, or the next chunk, if that passes the budget.
+    std::size_t pairs_held = 0;
+    for (std::size_t q = 0; q < row - begin; ++q) pairs_held += columns[q].size();
+    check_matrix_memory(3.0 * static_cast<double>(pairs_held) * kEntryBytes, row - begin, rows, memory_budget);
     Progress p;
     p.phase = Phase::form_factors;
     p.fraction = share * static_cast<double>(row - begin) / static_cast<double>(rows);
@@ -395,6 +416,7 @@ FormFactorOptions view_factor_estimator_options(const ViewFactorOptions& options
 
 struct ViewFactorRows::Impl {
   ViewFactorLevel level = ViewFactorLevel::polygon;
+  std::size_t memory_budget = detail::kDefaultMemoryBudget;  ///< ViewFactorOptions::memory_budget_bytes, resolved
   FormFactorOptions ff;
   /// Element level: the given scene's mesh (its leaves name the rows) and the scene whose
   /// polygons are its leaf elements, on which the rows are computed.
@@ -414,6 +436,7 @@ struct ViewFactorRows::Impl {
 ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.level = options.level;
+  m.memory_budget = detail::resolve_memory_budget(options.memory_budget_bytes);
   m.ff = view_factor_estimator_options(options);
   std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
   MeshOptions mesh = options.mesh;
@@ -498,7 +521,8 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
 
   if (m.ff.method == FormFactorMethod::ray_cast) {
     // The exact mode: polygon pairs integrated once, without rays (exact_view_factors.hpp).
-    out.cancelled = !exact_rows(*m.scene, m.ids, m.area, begin, end, m.ff.threads, gate, rows_share, out);
+    out.cancelled =
+        !exact_rows(*m.scene, m.ids, m.area, begin, end, m.ff.threads, m.memory_budget, gate, rows_share, out);
     if (!out.cancelled)
       out.cancelled = !row_sky(*m.scene, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
     return;
@@ -509,13 +533,15 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   std::vector<std::uint32_t> batch;
   std::vector<SparseFactors> element_rows;
   std::size_t row = begin;
+  detail::BlockSizer chunk(kFirstChunk, kSmallestChunk, kLargestChunk);
   while (row < end) {
-    // The chunk: whole rows until it holds kChunkElements elements.
+    // The chunk: whole rows until it holds the elements BlockSizer asks for.
     std::size_t last = row;
-    while (last < end && (last == row || first[last] - first[row] < kChunkElements)) ++last;
+    while (last < end && (last == row || first[last] - first[row] < chunk.size())) ++last;
     batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
                  sources.begin() + static_cast<std::ptrdiff_t>(first[last]));
     estimator->sparse_element_rows(batch, element_rows);
+    chunk.done(batch.size());
     for (std::size_t r = row; r < last; ++r) {
       touched.clear();
       for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
@@ -551,6 +577,9 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
       }
     }
     row = last;
+    check_matrix_memory(static_cast<double>(out.columns.capacity() * sizeof(std::uint32_t) +
+                                            out.values.capacity() * sizeof(float)),
+                        row - begin, rows, m.memory_budget);
     Progress p;
     p.phase = Phase::form_factors;
     p.fraction = rows_share * static_cast<double>(row - begin) / static_cast<double>(rows);

@@ -80,7 +80,7 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   // A_e F(e -> j) summed per (source group, receiver group) in element order, so the sums do not
   // depend on the thread count; chunks bound the memory to chunk x n floats.
   std::vector<double> sum(G * G, 0.0);
-  // Progress: at the start, at the end, and in between at most every 100 ms; a false return
+  // Progress: at the start, at the end, and in between at most every 50 ms; a false return
   // stops after the current chunk.
   detail::ProgressGate gate(options.on_progress);
   auto report = [&](double fraction, bool force) {
@@ -92,7 +92,8 @@ GroupViewFactors view_factors(const Scene& scene, const ViewFactorOptions& optio
   result.cancelled = !report(0.0, true);
   if (links && !result.cancelled) {
     detail::LinkGroupTransport t =
-        detail::link_group_transport(scene, hierarchy, slot, G, options.epsilon, ff.seed, ff.threads, gate);
+        detail::link_group_transport(scene, hierarchy, slot, G, options.epsilon, ff.seed, ff.threads,
+                                     options.memory_budget_bytes, gate);
     result.cancelled = t.cancelled;
     // Reciprocal by construction: each pair's transport A_i F_ij is the mean of the links' two
     // directions' estimates (each direction was refined and sampled on its own).

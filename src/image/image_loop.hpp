@@ -22,7 +22,7 @@ struct ImageBands {
 /// >= 0; the renderers validate() theirs first), band by band from the top, on up to
 /// options.threads threads (0 = all, 1 = the calling thread). After each band it reports
 /// Progress{Phase::rendering, rows done / height} through a ProgressGate (at most about every
-/// 100 ms, and always after the last band). When on_progress returns false no further band
+/// 50 ms, and always after the last band). When on_progress returns false no further band
 /// starts and for_each_pixel() returns false: the rows of the finished bands were visited, no
 /// pixel of a later band. Returns true when on_progress never cancelled. An exception from
 /// `pixel` or on_progress propagates after the workers have stopped.

@@ -46,8 +46,9 @@ namespace {
 
 /// Shadow rays to a point light stop this fraction of the segment short of it (lights.cpp).
 constexpr float kShadowEnd = 1.0f - 1e-4f;
-/// Elements per progress report and cancel check.
-constexpr std::size_t kBlock = 4096;
+/// Elements per progress report and cancel check: the first block's, then BlockSizer's choice
+/// (a sky costs SolveOptions::sky_rays rays per element, a point light one) within these.
+constexpr std::size_t kFirstBlock = 32, kSmallestBlock = 8, kLargestBlock = 16384;
 /// Spot integration: cells are split until they are this small (radians of angular diameter)
 /// where the falloff is smooth, or this deep where a cone's edge crosses them.
 constexpr double kSmoothDiameter = 0.02;
@@ -244,8 +245,9 @@ bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& 
   bool completed = true;
   if (!lights_.empty()) {
     std::vector<std::uint64_t> rays(todo.size(), 0);
-    for (std::size_t begin = 0; begin < todo.size(); begin += kBlock) {
-      const std::size_t end = std::min(todo.size(), begin + kBlock);
+    BlockSizer blocks(kFirstBlock, kSmallestBlock, kLargestBlock);
+    for (std::size_t begin = 0, end = 0; begin < todo.size(); begin = end) {
+      end = std::min(todo.size(), begin + blocks.size());
       parallel_for(threads_, end - begin, 8, [&](std::size_t lo, std::size_t hi) {
         for (std::size_t i = begin + lo; i < begin + hi; ++i) {
           const std::uint32_t e = todo[i];
@@ -254,6 +256,7 @@ bool LightShooter::shoot(const std::vector<std::uint32_t>& elements, LightShot& 
           shot.done[e] = 1;
         }
       });
+      blocks.done(end - begin);
       Progress p;
       p.phase = Phase::lights;
       p.fraction = static_cast<double>(end) / static_cast<double>(todo.size());

@@ -8,6 +8,7 @@
 
 #include "form_factors/estimators.hpp"
 #include "scene/emission.hpp"
+#include "core/memory_budget.hpp"
 #include "scene/overlap.hpp"
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
@@ -25,8 +26,6 @@ inline namespace v1 {
 namespace {
 
 using detail::seconds_since;
-
-constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
 
 /// Direct irradiance per front unknown, H_d(u) = sum over targets t of F(u -> t) E_t with E_t
 /// the target's mean emission, plus the lights' first shot H_light(u): the light that arrives
@@ -274,7 +273,7 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given, const detail::Com
         return true;
       };
   }
-  if (o.memory_budget_bytes == 0) o.memory_budget_bytes = kDefaultMemoryBudget;
+  o.memory_budget_bytes = detail::resolve_memory_budget(o.memory_budget_bytes);
   // Automatic starts as Gauss-Seidel; the first solve, which knows the rows' size, may switch.
   if (o.method == SolverMethod::automatic) {
     automatic_method = true;
@@ -535,8 +534,11 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     // Links refined against the emitted light, solved, refined again against the solution
     // (multigridding) until no link changes (docs/HIERARCHICAL.md).
     if (!links)
+    {
       links = std::make_unique<detail::LinkHierarchy>(scene, hierarchy, o.seed, o.threads,
                                                       light_shooter ? &light_shooter->occluders() : nullptr);
+      links->set_memory_budget(o.memory_budget_bytes, "SolveOptions::memory_budget_bytes");
+    }
     detail::SubdivisionLimits limits;
     if (o.adaptive.enabled) {
       limits.max_depth = static_cast<std::uint8_t>(std::min(250, initial_depth + o.adaptive.max_depth));

@@ -12,6 +12,7 @@
 #include "two_pass/photon_map.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -19,6 +20,7 @@
 #include <glm/gtc/constants.hpp>
 #include <nanoflann.hpp>
 
+#include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
 #include "core/color.hpp"
@@ -102,10 +104,21 @@ PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOption
   result.emitted = options.photons;
   const std::size_t blocks = (options.photons + kPhotonBlock - 1) / kPhotonBlock;
   std::vector<std::vector<Photon>> stored(blocks);
+  // The stored photons are held twice at the end (the blocks and the merged array): the count
+  // that fits the budget so, checked as each block grows.
+  const std::size_t budget = resolve_memory_budget(options.memory_budget_bytes);
+  const std::size_t most = budget / (2 * sizeof(Photon));
+  std::atomic<std::size_t> held{0};
   parallel_for(threads, blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const std::size_t last = std::min(options.photons, (b + 1) * kPhotonBlock);
       for (std::size_t k = b * kPhotonBlock; k < last; ++k) trace_photon(scene, options, pass1_depth, seed, k, stored[b]);
+      const std::size_t now = held.fetch_add(stored[b].size()) + stored[b].size();
+      if (now > most)
+        refuse_memory("the caustic photon map (" + std::to_string(now) + " photons stored after " +
+                          std::to_string(last) + " of " + std::to_string(options.photons) + " shot, more to come)",
+                      2.0 * static_cast<double>(now) * sizeof(Photon), budget, "PhotonOptions::memory_budget_bytes",
+                      "; shoot fewer photons or raise the budget");
     }
   });
   std::size_t total = 0;

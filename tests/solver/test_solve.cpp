@@ -188,12 +188,13 @@ TEST_SUITE("solver") {
     CHECK(within.report().method == rad::SolverMethod::gauss_seidel);
     CHECK(within.report().method_choice.find("within the memory budget") != std::string::npos);
     CHECK(within.report().link_count == 0);
-    // The same rows against a 1 MiB budget: the hierarchical solver, no error, the figure given.
-    o.memory_budget_bytes = 1u << 20;
+    // The same rows (6.4 MiB) against a 4 MiB budget: the hierarchical solver (its links, 1.3
+    // MiB, fit), no error, the figure given.
+    o.memory_budget_bytes = 4u << 20;
     const rad::Solution beyond = rad::solve(scene, o);
     CHECK(beyond.status() == rad::SolveStatus::converged);
     CHECK(beyond.report().method == rad::SolverMethod::hierarchical);
-    CHECK(beyond.report().method_choice.find("over the memory budget of 1 MiB") != std::string::npos);
+    CHECK(beyond.report().method_choice.find("over the memory budget of 4 MiB") != std::string::npos);
     CHECK(beyond.report().link_count > 0);
     // Both are the Cornell box: group means agree within the hierarchical solver's accuracy
     // (docs/HIERARCHICAL.md; element-to-patch rows here, so up to about 8 % on the floor).

@@ -20,6 +20,7 @@
 #include "core/assert.hpp"
 #include "core/constants.hpp"
 #include "core/growable_array.hpp"
+#include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
 #include "core/streams.hpp"
@@ -118,6 +119,9 @@ struct LinkHierarchy::Impl {
   const RayScene& occluders;
   std::uint64_t seed;
   unsigned threads;
+  /// Bytes the refinement's link arrays may reach (LinkHierarchy::set_memory_budget()).
+  std::size_t memory_budget = kDefaultMemoryBudget;
+  const char* memory_budget_field = "SolveOptions::memory_budget_bytes";
   float ray_epsilon;
   /// Per position of tree.order(): the area of the patches before it, for sampling a
   /// cluster's surface by area.
@@ -764,6 +768,20 @@ struct LinkHierarchy::Impl {
         next_count += b.next.size();
       }
       stats.links_added += link_count;
+      // The round's arrays are about to be made while the blocks still hold their parts: refuse
+      // here, with the figure, if the links so far and the round's would pass the budget.
+      {
+        std::size_t held = 0;
+        for (const std::vector<LinkRecord>& c : chunks) held += c.capacity() * sizeof(LinkRecord);
+        const double needed = static_cast<double>(held) + 2.0 * static_cast<double>(link_count * sizeof(LinkRecord)) +
+                              2.0 * static_cast<double>(next_count * sizeof(Pair));
+        if (needed > static_cast<double>(memory_budget))
+          refuse_memory("hierarchical radiosity's link refinement (" + std::to_string(held / sizeof(LinkRecord) + link_count) +
+                            " links and " + std::to_string(next_count) + " node pairs to examine after round " +
+                            std::to_string(chunks.size() + 1) + ")",
+                        needed, memory_budget, memory_budget_field,
+                        "; raise HierarchicalOptions::epsilon, coarsen the mesh or raise the budget");
+      }
       std::vector<LinkRecord>& links = chunks.emplace_back();
       links.reserve(link_count);
       frontier.reserve(next_count);
@@ -1114,6 +1132,11 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
 }
 
 std::size_t LinkHierarchy::link_count() const { return impl_->sources.size(); }
+
+void LinkHierarchy::set_memory_budget(std::size_t bytes, const char* field) {
+  impl_->memory_budget = resolve_memory_budget(bytes);
+  impl_->memory_budget_field = field;
+}
 
 std::size_t LinkHierarchy::bytes() const {
   const Impl& m = *impl_;

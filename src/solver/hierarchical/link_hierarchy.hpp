@@ -64,6 +64,10 @@ class LinkHierarchy {
   LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
                 const RayScene* occluders = nullptr);
   ~LinkHierarchy();
+  /// The most bytes refinement may hold in links and pairs (0: kDefaultMemoryBudget): a round
+  /// that would pass it throws Error{memory_budget} with the figure before its arrays are made,
+  /// naming `field` (a string literal: the option the user sets).
+  void set_memory_budget(std::size_t bytes, const char* field);
   LinkHierarchy(const LinkHierarchy&) = delete;
   LinkHierarchy& operator=(const LinkHierarchy&) = delete;
 

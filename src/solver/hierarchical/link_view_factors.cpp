@@ -14,11 +14,13 @@ namespace radiosity::detail {
 
 LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hierarchy,
                                         const std::vector<std::size_t>& slot, std::size_t groups, float epsilon,
-                                        std::uint64_t seed, unsigned threads, ProgressGate& gate) {
+                                        std::uint64_t seed, unsigned threads, std::size_t memory_budget,
+                                        ProgressGate& gate) {
   LinkGroupTransport out;
   out.transport.assign(groups * groups, 0.0);
   const RadiositySystem system(scene, hierarchy, false);
   LinkHierarchy links(scene, hierarchy, seed, threads);
+  links.set_memory_budget(memory_budget, "ViewFactorOptions::memory_budget_bytes");
   // Unit radiosity everywhere: the oracle judges the geometry alone, and its threshold (the
   // irradiance a link may get wrong) is then a view factor.
   const std::vector<Rgb> one(system.unknowns(), Rgb(1.0f));

@@ -28,6 +28,7 @@ struct LinkGroupTransport {
 /// seed at any thread count, as the links are.
 LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hierarchy,
                                         const std::vector<std::size_t>& slot, std::size_t groups, float epsilon,
-                                        std::uint64_t seed, unsigned threads, ProgressGate& gate);
+                                        std::uint64_t seed, unsigned threads, std::size_t memory_budget,
+                                        ProgressGate& gate);
 
 }  // namespace radiosity::detail

@@ -1,0 +1,194 @@
+// Cancel latency at every stage (issue #17), shared by tests/solver/test_cancel_latency.cpp
+// (a sanity bound on any machine) and benchmarks/bench_cancel.cpp (the 100 ms target on a quiet
+// one). For each stage (the lights' first shot, the form factors of each estimator,
+// progressive, hierarchical refinement, each renderer, the lightmap baker, the view-factor
+// matrix) a callback asks to cancel `after` seconds into the stage; the probe measures
+// - the latency: from the callback returning false to the call returning;
+// - the largest gap between two calls of the callback in the stage before that (how long a
+//   host's cancel request can wait to be seen).
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <radiosity/radiosity.hpp>
+
+namespace cancel {
+
+namespace rad = radiosity;
+using Clock = std::chrono::steady_clock;
+
+inline double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+/// Runs a call with a progress callback that cancels `after` seconds into `phase`.
+struct Probe {
+  rad::Phase phase;
+  double after = 0.15;
+  bool cancelled = false;
+  int calls_after_cancel = 0;
+  double largest_gap = 0.0;    ///< s between consecutive calls in the phase, before the cancel
+  double latency = -1.0;       ///< s from returning false to the call returning; -1: no cancel
+  double phase_seconds = 0.0;  ///< s the phase ran before the cancel (or in all)
+
+  void run(const std::function<void(const rad::ProgressFn&)>& call) {
+    bool seen = false;
+    Clock::time_point first{}, previous{}, cancel_at{};
+    call([&](const rad::Progress& p) {
+      if (cancelled) {
+        ++calls_after_cancel;
+        return false;
+      }
+      if (p.phase != phase) return true;
+      const Clock::time_point now = Clock::now();
+      if (!seen) {
+        seen = true;
+        first = previous = now;
+      }
+      largest_gap = std::max(largest_gap, seconds_between(previous, now));
+      previous = now;
+      phase_seconds = seconds_between(first, now);
+      if (phase_seconds < after) return true;
+      cancelled = true;
+      cancel_at = Clock::now();
+      return false;
+    });
+    if (cancelled) latency = seconds_between(cancel_at, Clock::now());
+  }
+};
+
+/// One stage: its call, the phase to cancel in, and whether the call's own result says it
+/// was cancelled (read after run()).
+struct Stage {
+  std::string name;
+  rad::Phase phase;
+  std::function<void(const rad::ProgressFn&)> call;
+  std::function<bool()> reports_cancel;
+};
+
+/// The Cornell box with a sky and a floor mesh with UV1, meshed at `element_area`
+/// (mm^2; 625 = 2.5 cm elements, about 26k), and the stages over it; `image` is the renders'
+/// width and height, `lightmap` the lightmap's. Keeps what the stages refer to.
+class Stages {
+ public:
+  Stages(float element_area, int image, int lightmap) {
+    scene_.add_light(light());
+    rad::Material grey;
+    grey.reflectance = rad::Rgb(0.5f);
+    rad::MeshDesc d;
+    d.positions = positions_.data();
+    d.vertex_count = positions_.size();
+    d.indices = indices_.data();
+    d.index_count = indices_.size();
+    d.material = scene_.add_material(grey);
+    d.group = "rug";
+    d.uv1 = uv1_.data();
+    floor_mesh_ = scene_.add_mesh(d);
+    rad::SolveOptions coarse;
+    coarse.mesh.max_element_area = 2500.0f;
+    solution_ = std::make_unique<rad::Solution>(rad::solve(scene_, coarse));
+
+    auto solve_stage = [this, element_area](rad::SolverMethod method, rad::FormFactorMethod estimator) {
+      return [this, element_area, method, estimator](const rad::ProgressFn& progress) {
+        rad::SolveOptions o;
+        o.method = method;
+        o.form_factors.method = estimator;
+        o.mesh.max_element_area = element_area;
+        o.threads = 2;
+        o.on_progress = progress;
+        solution_cancelled_ = rad::solve(scene_, o).status() == rad::SolveStatus::cancelled;
+      };
+    };
+    auto solved = [this] { return solution_cancelled_; };
+    auto always = [] { return true; };
+    const auto gs = rad::SolverMethod::gauss_seidel;
+    list_.push_back({"lights' first shot", rad::Phase::lights, solve_stage(gs, rad::FormFactorMethod::monte_carlo), solved});
+    list_.push_back({"form factors, ray_cast", rad::Phase::form_factors, solve_stage(gs, rad::FormFactorMethod::ray_cast), solved});
+    list_.push_back({"form factors, hemicube", rad::Phase::form_factors, solve_stage(gs, rad::FormFactorMethod::hemicube), solved});
+    list_.push_back({"form factors, monte_carlo", rad::Phase::form_factors,
+                     solve_stage(gs, rad::FormFactorMethod::monte_carlo), solved});
+    list_.push_back({"progressive", rad::Phase::solving,
+                     solve_stage(rad::SolverMethod::progressive, rad::FormFactorMethod::monte_carlo), solved});
+    list_.push_back({"hierarchical refinement", rad::Phase::form_factors,
+                     solve_stage(rad::SolverMethod::hierarchical, rad::FormFactorMethod::automatic), solved});
+    list_.push_back({"render", rad::Phase::rendering,
+                     [this, image](const rad::ProgressFn& progress) {
+                       rad::RenderOptions r;
+                       r.width = r.height = 2 * image;
+                       r.spp = 64;
+                       r.on_progress = progress;
+                       (void)rad::render(scene_, *solution_, r);
+                     },
+                     always});
+    list_.push_back({"path tracer", rad::Phase::rendering,
+                     [this, image](const rad::ProgressFn& progress) {
+                       rad::PathTraceOptions p;
+                       p.width = p.height = image;
+                       p.spp = 256;
+                       p.on_progress = progress;
+                       (void)rad::render_path_traced(scene_, p);
+                     },
+                     always});
+    list_.push_back({"two-pass", rad::Phase::rendering,
+                     [this, image](const rad::ProgressFn& progress) {
+                       rad::TwoPassOptions t;
+                       t.width = t.height = image;
+                       t.spp = 64;
+                       t.on_progress = progress;
+                       (void)rad::render_two_pass(scene_, *solution_, t);
+                     },
+                     always});
+    list_.push_back({"lightmap", rad::Phase::rendering,
+                     [this, lightmap](const rad::ProgressFn& progress) {
+                       rad::LightmapOptions l;
+                       l.width = l.height = lightmap;
+                       l.final_gather = true;  // rays per texel: a stage long enough to cancel
+                       l.on_progress = progress;
+                       lightmap_cancelled_ = rad::bake_lightmap(scene_, *solution_, floor_mesh_, l).cancelled;
+                     },
+                     [this] { return lightmap_cancelled_; }});
+    list_.push_back({"view-factor matrix", rad::Phase::form_factors,
+                     [this, element_area](const rad::ProgressFn& progress) {
+                       rad::ViewFactorOptions v;
+                       v.level = rad::ViewFactorLevel::element;
+                       v.mesh.max_element_area = element_area;
+                       v.form_factors.method = rad::FormFactorMethod::monte_carlo;
+                       v.on_progress = progress;
+                       factors_cancelled_ = rad::view_factor_matrix(scene_, v).cancelled;
+                     },
+                     [this] { return factors_cancelled_; }});
+  }
+  Stages(const Stages&) = delete;
+  Stages& operator=(const Stages&) = delete;
+
+  const std::vector<Stage>& list() const { return list_; }
+
+ private:
+  // A sky through the open front: its first shot casts SolveOptions::sky_rays per element,
+  // the longest of the lights'.
+  static rad::Light light() {
+    rad::Light l;
+    l.type = rad::LightType::sky;
+    l.intensity = 10.0f;
+    return l;
+  }
+
+  rad::Scene scene_ = rad::cornell_box();
+  std::vector<glm::vec3> positions_{{100, 1, 100}, {450, 1, 100}, {450, 1, 450}, {100, 1, 450}};
+  std::vector<std::uint32_t> indices_{0, 2, 1, 0, 3, 2};
+  std::vector<glm::vec2> uv1_{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  rad::MeshId floor_mesh_ = 0;
+  std::unique_ptr<rad::Solution> solution_;
+  bool solution_cancelled_ = false, lightmap_cancelled_ = false, factors_cancelled_ = false;
+  std::vector<Stage> list_;
+};
+
+}  // namespace cancel
