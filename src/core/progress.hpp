@@ -44,7 +44,7 @@ class ProgressGate {
   bool first_ = true;
 };
 
-/// Sizes the blocks of work between two progress reports so that each takes about 25 ms: the
+/// Sizes the blocks of work between two progress reports so that each takes about 15 ms: the
 /// next block's item count from the last block's items per second, at most twice its count,
 /// within [smallest, largest]. A loop whose items cost very different amounts in different scenes
 /// (elements of a sky's first shot, rows of a view-factor matrix) so reports, and sees a
@@ -59,6 +59,9 @@ class BlockSizer {
   /// Items in the next block.
   std::size_t size() const { return size_; }
 
+  /// Restarts the clock: the next done() times from here (when other work came between).
+  void start() { last_ = std::chrono::steady_clock::now(); }
+
   /// Call after each block of `items`: times it from the previous call (or construction).
   void done(std::size_t items) {
     const auto now = std::chrono::steady_clock::now();
@@ -72,7 +75,7 @@ class BlockSizer {
   }
 
  private:
-  static constexpr double kBlockSeconds = 0.025;
+  static constexpr double kBlockSeconds = 0.015;
   std::size_t size_, smallest_, largest_;
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };

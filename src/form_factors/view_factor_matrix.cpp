@@ -42,9 +42,9 @@ inline namespace v1 {
 namespace {
 
 /// Source elements per chunk of rows (whole polygons are kept together, so a chunk may hold
-/// more): the first chunk's, then BlockSizer's choice (about 25 ms a chunk, so a cancel is
+/// more): the first chunk's, then BlockSizer's choice (about 15 ms a chunk, so a cancel is
 /// seen soon) within these; an element's row does not depend on its chunk.
-constexpr std::size_t kFirstChunk = 256, kSmallestChunk = 16, kLargestChunk = 16384;
+constexpr std::size_t kFirstChunk = 32, kSmallestChunk = 8, kLargestChunk = 16384;
 /// Bytes of one entry of the matrix: its column and its value.
 constexpr double kEntryBytes = sizeof(std::uint32_t) + sizeof(float);
 

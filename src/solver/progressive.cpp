@@ -58,7 +58,10 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   FactorVector scratch;
   std::vector<std::uint32_t> batch, candidates;
   std::vector<SparseFactors> fetched;
-  const std::size_t prefetch = 8 * static_cast<std::size_t>(thread_count(ctx.options.threads));
+  // Sparse columns fetched per batch: up to 8 per thread, fewer where a batch would take more
+  // than about 15 ms (BlockSizer), so that progress and cancel are not held up by it.
+  const std::size_t threads = static_cast<std::size_t>(thread_count(ctx.options.threads));
+  BlockSizer prefetch(2 * threads, 1, 8 * threads);
 
   // Ambient radiosity: the unshot power spread over the whole scene area and multiplied by the
   // interreflection factor (Cohen et al. 1988, eqs. 5-6). For display only; it tends to 0.
@@ -134,12 +137,14 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
           candidates.clear();
           for (std::size_t c = 0; c < n; ++c)
             if (!cached[c] && c != shooter && power[c] > 0.0) candidates.push_back(static_cast<std::uint32_t>(c));
-          const std::size_t extra = std::min(candidates.size(), prefetch - 1);
+          const std::size_t extra = std::min(candidates.size(), prefetch.size() - 1);
           std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(extra), candidates.end(),
                            [&](std::uint32_t a, std::uint32_t b) { return power[a] > power[b] || (power[a] == power[b] && a < b); });
           batch.insert(batch.end(), candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(extra));
         }
+        prefetch.start();  // the time since the last batch was the shooting's
         ctx.estimator->sparse_patch_columns(batch, sys.leaves, fetched);
+        prefetch.done(batch.size());
         for (std::size_t k = 0; k < batch.size(); ++k) {
           FactorVector column;
           column.index = std::move(fetched[k].index);

@@ -36,6 +36,7 @@ struct Probe {
   bool cancelled = false;
   int calls_after_cancel = 0;
   double largest_gap = 0.0;    ///< s between consecutive calls in the phase, before the cancel
+  double largest_gap_end = 0.0;  ///< s into the phase when the largest gap ended
   double latency = -1.0;       ///< s from returning false to the call returning; -1: no cancel
   double phase_seconds = 0.0;  ///< s the phase ran before the cancel (or in all)
 
@@ -53,9 +54,12 @@ struct Probe {
         seen = true;
         first = previous = now;
       }
-      largest_gap = std::max(largest_gap, seconds_between(previous, now));
-      previous = now;
       phase_seconds = seconds_between(first, now);
+      if (seconds_between(previous, now) > largest_gap) {
+        largest_gap = seconds_between(previous, now);
+        largest_gap_end = phase_seconds;
+      }
+      previous = now;
       if (phase_seconds < after) return true;
       cancelled = true;
       cancel_at = Clock::now();

@@ -748,16 +748,31 @@ struct LinkHierarchy::Impl {
     bool subdivision_closed = limits.max_depth == 0;
     std::size_t done = 0;
     std::vector<BlockOutput> blocks;
+    const std::size_t workers = static_cast<std::size_t>(thread_count(threads));
+    BlockSizer slices(workers, workers, std::numeric_limits<std::size_t>::max());
     while (!frontier.empty()) {
       const RoundContext rc{hierarchy, values, threshold, limits, subdivision_closed};
       const std::size_t block_count = (frontier.size() + kBlock - 1) / kBlock;
       blocks.assign(block_count, BlockOutput{});
-      parallel_for(threads, block_count, 1, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t b = begin; b < end; ++b) {
-          const std::size_t first = b * kBlock, last = std::min(frontier.size(), first + kBlock);
-          for (std::size_t k = first; k < last; ++k) process(rc, frontier[k], blocks[b]);
-        }
-      });
+      // A round can hold millions of pairs: its blocks go in slices of about 15 ms with a
+      // progress report between them, so a cancel is seen within a round too (refine() then
+      // drops the pass's new links, as after a cancel between rounds); each block's output
+      // does not depend on the slices.
+      for (std::size_t slice = 0, slice_end = 0; slice < block_count; slice = slice_end) {
+        slice_end = std::min(block_count, slice + slices.size());
+        parallel_for(threads, slice_end - slice, 1, [&](std::size_t begin, std::size_t end) {
+          for (std::size_t b = slice + begin; b < slice + end; ++b) {
+            const std::size_t first = b * kBlock, last = std::min(frontier.size(), first + kBlock);
+            for (std::size_t k = first; k < last; ++k) process(rc, frontier[k], blocks[b]);
+          }
+        });
+        slices.done(slice_end - slice);
+        if (slice_end == block_count) break;
+        Progress p;
+        p.phase = Phase::form_factors;
+        p.fraction = static_cast<double>(done + slice_end * kBlock) / static_cast<double>(done + frontier.size());
+        if (!gate.report(p, false)) return false;
+      }
       done += frontier.size();
       frontier = {};  // read; its memory goes before the next round's is made
       // The round's links and next pairs, in block order, each array made at its final size
