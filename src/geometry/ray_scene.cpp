@@ -84,9 +84,7 @@ RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<st
       lo = glm::min(lo, p);
       hi = glm::max(hi, p);
     }
-    const glm::vec3 extent = glm::max(glm::abs(lo), glm::abs(hi));
-    coincidence_ = static_cast<float>(std::max(kOverlapRelativeTolerance * static_cast<double>(glm::length(hi - lo)),
-                                               2.5e-7 * static_cast<double>(std::max({extent.x, extent.y, extent.z}))));
+    coincidence_ = static_cast<float>(touching_tolerance(lo, hi));
   }
 
   if (!indices_.empty()) {

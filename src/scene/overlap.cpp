@@ -399,14 +399,18 @@ std::vector<ContactLine> contact_lines(const Scene& scene) {
   return out;
 }
 
-double touching_tolerance(const Scene& scene) {
+double touching_tolerance(const glm::vec3& lower, const glm::vec3& upper) {
   // Float corners carry rounding of up to 6e-8 of their magnitude (half an ulp); far from the
   // origin the tolerance stays above a few times that, so that shared edges of tilted polygons
   // never look like crossings.
-  const Bounds box = scene.bounds();
-  const glm::vec3 extent = glm::max(glm::abs(box.lower), glm::abs(box.upper));
+  const glm::vec3 extent = glm::max(glm::abs(lower), glm::abs(upper));
   const double magnitude = std::max({extent.x, extent.y, extent.z});
-  return std::max(kOverlapRelativeTolerance * box.diagonal(), 2.5e-7 * magnitude);
+  return std::max(kOverlapRelativeTolerance * static_cast<double>(glm::length(upper - lower)), 2.5e-7 * magnitude);
+}
+
+double touching_tolerance(const Scene& scene) {
+  const Bounds box = scene.bounds();
+  return touching_tolerance(box.lower, box.upper);
 }
 
 }  // namespace radiosity::detail

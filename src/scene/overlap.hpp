@@ -33,6 +33,8 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene);
 /// kOverlapRelativeTolerance of its bounding-box diagonal, and at least a few ulps of its
 /// largest coordinate.
 double touching_tolerance(const Scene& scene);
+/// The same for the box [lower, upper].
+double touching_tolerance(const glm::vec3& lower, const glm::vec3& upper);
 
 /// A line in a polygon's plane along which another polygon meets its interior.
 struct ContactLine {

@@ -265,7 +265,7 @@ TEST_CASE("glTF bake: a mesh placed by a mirroring node and by a plain one gets 
   CHECK(mean_colour("mirrored") == doctest::Approx(mean_colour("plain")).epsilon(0.05));
 }
 
-TEST_CASE("glTF bake: split vertices carry morph targets (with their bounds); material variants are dropped with the materials") {
+TEST_CASE("glTF bake: split vertices carry morph targets (with their bounds) - material variants are dropped with the materials") {
   test::GltfBuilder b;
   const int white = b.material({{"pbrMetallicRoughness", {{"metallicFactor", 0.0}}}, {"emissiveFactor", {1.0, 1.0, 1.0}}});
   nlohmann::json box = b.box({0, 0, 0}, {1, 1, 1}, white);
