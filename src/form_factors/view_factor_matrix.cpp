@@ -228,7 +228,7 @@ bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const
   // Chunks of rows of about equal work (row r integrates n - r pairs in a whole matrix), each
   // of about as many pairs as BlockSizer asks for.
   detail::BlockSizer chunk_pairs(std::max<std::size_t>(n, 1) * 4, 64, std::max<std::size_t>(n, 1) * 64);
-  std::size_t row = begin;
+  std::size_t row = begin, pairs_held = 0;
   while (row < end) {
     std::size_t last = row, pairs = 0;
     while (last < end && (last == row || pairs < chunk_pairs.size())) pairs += n - (last++ - begin);
@@ -247,11 +247,10 @@ bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const
       }
     });
     chunk_pairs.done(pairs);
-    row = last;
     // Each pair is held once now and twice in the result (both directions), 8 bytes per entry:
     // refuse before the result is made, or the next chunk, if that passes the budget.
-    std::size_t pairs_held = 0;
-    for (std::size_t q = 0; q < row - begin; ++q) pairs_held += columns[q].size();
+    for (std::size_t q = row; q < last; ++q) pairs_held += columns[q - begin].size();
+    row = last;
     check_matrix_memory(3.0 * static_cast<double>(pairs_held) * kEntryBytes, row - begin, rows, memory_budget);
     Progress p;
     p.phase = Phase::form_factors;
