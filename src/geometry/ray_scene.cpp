@@ -358,25 +358,39 @@ void RayScene::intersect(std::size_t count, const glm::vec3* origin, const glm::
     if (found[i]) prefer_front(origin[i], dir[i], tnear, hits[i]);
 }
 
-std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear,
-                                                 float tfar) const {
+namespace {
+
+/// The nearest hit within (tnear, tfar) of one ray, through `filter` when not null (a context
+/// filter: the scene has RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION).
+std::optional<RayScene::Hit> nearest_hit(RTCScene scene, const std::vector<std::uint32_t>& ids,
+                                         const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                                         RTCFilterFunctionN filter) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  context.filter = filter;
   RTCRayHit rh;
   rh.ray = single_ray(origin, dir, tnear, tfar, 0);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(as_scene(scene_), &context, &rh);
+  rtcIntersect1(scene, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
-  Hit h;
+  RayScene::Hit h;
   h.t = rh.ray.tfar;
   h.triangle = rh.hit.primID;
-  h.id = ids_[rh.hit.primID];
+  h.id = ids[rh.hit.primID];
   h.u = rh.hit.u;
   h.v = rh.hit.v;
   h.geometric_normal = glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-  prefer_front(origin, dir, tnear, h);
+  return h;
+}
+
+}  // namespace
+
+std::optional<RayScene::Hit> RayScene::intersect(const glm::vec3& origin, const glm::vec3& dir, float tnear,
+                                                 float tfar) const {
+  std::optional<Hit> h = nearest_hit(as_scene(scene_), ids_, origin, dir, tnear, tfar, nullptr);
+  if (h) prefer_front(origin, dir, tnear, *h);
   return h;
 }
 
@@ -388,22 +402,9 @@ void RayScene::prefer_front(const glm::vec3& origin, const glm::vec3& dir, float
   // around the plane hit.
   const float rate = facing / glm::length(h.geometric_normal);
   const float window = coincidence_ / rate;
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.filter = front_only;
-  RTCRayHit rh;
-  rh.ray = single_ray(origin, dir, std::max(tnear, h.t - window), h.t + window, 0);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(as_scene(scene_), &context, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return;
-  h.t = rh.ray.tfar;
-  h.triangle = rh.hit.primID;
-  h.id = ids_[rh.hit.primID];
-  h.u = rh.hit.u;
-  h.v = rh.hit.v;
-  h.geometric_normal = glm::vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+  const std::optional<Hit> front =
+      nearest_hit(as_scene(scene_), ids_, origin, dir, std::max(tnear, h.t - window), h.t + window, front_only);
+  if (front) h = *front;
 }
 
 }  // namespace radiosity::detail

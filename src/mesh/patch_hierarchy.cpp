@@ -89,16 +89,12 @@ std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
   return (static_cast<std::uint64_t>(lo) << 32) | hi;
 }
 
-// A convex planar polygon cut along contact lines into convex pieces, in double: each line
-// splits every piece that has corners more than `tolerance` on both sides of it; corners within
-// `tolerance` of a line go to both sides. Corners of the input stay exact (they are converted
-// back to the same floats), so host vertices and polygon corners are still found bit for bit.
-// Pieces come out in a fixed order (the lines' order, positive side first), without repeated
-// or collinear corners.
+// A convex piece of a polygon cut at contact lines, its corners counter-clockwise.
 using Piece = std::vector<glm::dvec3>;
 
+// Drops repeated corners (closer than `tolerance`), then corners on the straight line between
+// their neighbours.
 void clean_piece(Piece& piece, double tolerance) {
-  // Repeated corners, then corners on the straight line between their neighbours.
   Piece out;
   for (const glm::dvec3& x : piece)
     if (out.empty() || glm::length(x - out.back()) > tolerance) out.push_back(x);
@@ -118,6 +114,12 @@ void clean_piece(Piece& piece, double tolerance) {
   piece = std::move(out);
 }
 
+// A convex planar polygon cut along contact lines into convex pieces, in double: each line
+// splits every piece that has corners more than `tolerance` on both sides of it; corners within
+// `tolerance` of a line go to both sides. Corners of the input stay exact (they are converted
+// back to the same floats), so host vertices and polygon corners are still found bit for bit.
+// Pieces come out in a fixed order (the lines' order, positive side first), without repeated
+// or collinear corners.
 std::vector<Piece> cut_polygon(const PolygonVertices& corners, const glm::vec3& normal,
                                const detail::ContactLine* lines, std::size_t line_count, double tolerance) {
   std::vector<Piece> pieces(1);
