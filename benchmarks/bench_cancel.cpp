@@ -1,8 +1,8 @@
 // Cancel latency at every stage on a quiet machine (issue #17's target: under 100 ms), the
 // stages of tests/support/cancel_stages.hpp at a larger size: 1.5 cm elements (about 70k on the
-// Cornell box) and 512-pixel images.
+// Cornell box), 512-pixel images and a terrain of a million triangles to mesh.
 //
-// Usage: bench_cancel [ELEMENT_AREA_MM2] [IMAGE]   (defaults 225 and 512)
+// Usage: bench_cancel [ELEMENT_AREA_MM2] [IMAGE] [TERRAIN_TRIANGLES]   (defaults 225, 512, 1000000)
 // Prints, per stage, how long it ran before the cancel, the latency from the callback's false
 // to the call's return, and the largest gap between two calls of the callback before it (how
 // long a host's request can wait to be seen) with when in the stage it ended; then whether both
@@ -16,7 +16,8 @@
 int main(int argc, char** argv) {
   const float area = argc > 1 ? static_cast<float>(std::atof(argv[1])) : 225.0f;
   const int image = argc > 2 ? std::atoi(argv[2]) : 512;
-  const cancel::Stages stages(area, image, 1024);
+  const auto terrain = argc > 3 ? static_cast<std::size_t>(std::atoll(argv[3])) : std::size_t{1000000};
+  const cancel::Stages stages(area, image, 1024, terrain);
   std::printf("%-28s %8s %13s %17s %13s\n", "stage", "ran (s)", "latency (ms)", "largest gap (ms)", "gap ended (s)");
   double worst_latency = 0.0, worst_gap = 0.0;
   bool all_cancelled = true;

@@ -89,6 +89,10 @@ class RADIOSITY_API PatchHierarchy {
   /// negative or NaN, if max_element_area > max_patch_area, or if crease_angle_deg is outside
   /// [0, 180).
   PatchHierarchy(const Scene& scene, const MeshOptions& options);
+  /// The same, reporting Phase::meshing through `on_progress` (at the start, about every 50 ms
+  /// and at the end, on the calling thread). When the callback returns false meshing stops
+  /// within about that interval and the hierarchy is left empty (no patches).
+  PatchHierarchy(const Scene& scene, const MeshOptions& options, const ProgressFn& on_progress);
 
   const std::vector<Patch>& patches() const { return patches_; }
   /// Every node of every quadtree, inner nodes included; index = element id.
@@ -131,6 +135,8 @@ class RADIOSITY_API PatchHierarchy {
   void aggregate(std::vector<Rgb>& element_values) const;
 
  private:
+  /// Both constructors' work; false when `on_progress` (may be null) cancelled.
+  bool build(const Scene& scene, const MeshOptions& options, const ProgressFn* on_progress);
   std::uint32_t add_element(const Element& e);
   std::uint32_t add_vertex(const glm::vec3& position, std::uint32_t edge_a, std::uint32_t edge_b);
   std::uint32_t midpoint(std::uint32_t a, std::uint32_t b);

@@ -390,8 +390,9 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     out.cancelled = !gate.report(start, true);
     out.method = to_string(ff.method);
     if (!out.cancelled) {
-      const detail::ViewFactorRows rows(scene, options);
-      rows.compute(0, rows.rows(), gate, out);
+      const detail::ViewFactorRows rows(scene, options, &options.on_progress);
+      out.cancelled = rows.cancelled();
+      if (!out.cancelled) rows.compute(0, rows.rows(), gate, out);
     }
   }
   detail::finish_view_factor_matrix(scene, options, out);
@@ -430,10 +431,22 @@ struct ViewFactorRows::Impl {
   /// sources[first[r] .. first[r + 1]).
   std::vector<std::uint32_t> sources;
   std::vector<std::uint64_t> first;
+  bool cancelled = false;  ///< the meshing callback said stop
 };
 
-ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options) : impl_(std::make_unique<Impl>()) {
+ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options, const ProgressFn* meshing)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
+  ProgressFn progress;
+  if (meshing && *meshing)
+    progress = [&](const Progress& p) {
+      if ((*meshing)(p)) return true;
+      m.cancelled = true;
+      return false;
+    };
+  auto mesh_scene = [&](const Scene& s, const MeshOptions& o) {
+    return progress ? PatchHierarchy(s, o, progress) : PatchHierarchy(s, o);
+  };
   m.level = options.level;
   m.memory_budget = detail::resolve_memory_budget(options.memory_budget_bytes);
   m.ff = view_factor_estimator_options(options);
@@ -442,7 +455,8 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
   m.scene = &scene;
   if (options.level == ViewFactorLevel::element) {
     // Elements: the polygon level of a scene made of the leaf elements, meshed as they are.
-    const PatchHierarchy& hierarchy = m.element_mesh.emplace(scene, options.mesh);
+    const PatchHierarchy& hierarchy = m.element_mesh.emplace(mesh_scene(scene, options.mesh));
+    if (m.cancelled) return;
     m.scene = &m.elements.emplace(element_scene(scene, hierarchy));
     std::vector<std::uint32_t> element_row_of(m.elements->polygons().size(), kNone);
     for (std::size_t k = 0; k < hierarchy.leaves().size(); ++k)
@@ -461,7 +475,13 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
     if (row_of[p] != kNone) m.ids.push_back(static_cast<std::uint32_t>(p));
   const std::size_t rows = m.ids.size();
   m.area.assign(rows, 0.0);
-  m.hierarchy = PatchHierarchy(*m.scene, mesh);
+  m.hierarchy = mesh_scene(*m.scene, mesh);
+  if (m.cancelled) {
+    m.ids.clear();
+    m.area.clear();
+    m.first.assign(1, 0);
+    return;
+  }
   const PatchHierarchy& hierarchy = m.hierarchy;
   const std::vector<Patch>& patches = hierarchy.patches();
   m.column_of_patch.resize(patches.size());
@@ -486,6 +506,7 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
 ViewFactorRows::~ViewFactorRows() = default;
 
 std::size_t ViewFactorRows::rows() const { return impl_->ids.size(); }
+bool ViewFactorRows::cancelled() const { return impl_->cancelled; }
 
 const std::vector<std::uint64_t>& ViewFactorRows::source_offsets() const { return impl_->first; }
 

@@ -26,13 +26,17 @@ class ViewFactorRows {
  public:
   /// Selects the rows (options.groups), meshes the scene (options.mesh) and, for the element
   /// level, makes the scene whose polygons are the leaf elements. `options.level` must be
-  /// polygon or element. Throws as view_factor_matrix() does for a bad group name.
-  ViewFactorRows(const Scene& scene, const ViewFactorOptions& options);
+  /// polygon or element. Throws as view_factor_matrix() does for a bad group name. With
+  /// `meshing` (a callback, not empty) the meshing reports Phase::meshing through it and stops
+  /// when it returns false: then cancelled() and there are no rows.
+  ViewFactorRows(const Scene& scene, const ViewFactorOptions& options, const ProgressFn* meshing = nullptr);
   ~ViewFactorRows();
   ViewFactorRows(const ViewFactorRows&) = delete;
   ViewFactorRows& operator=(const ViewFactorRows&) = delete;
 
   std::size_t rows() const;
+  /// The meshing callback cancelled.
+  bool cancelled() const;
   /// rows() + 1 entries: source_offsets()[r] is the number of source elements of rows [0, r)
   /// (what a block balanced by elements, not rows, splits).
   const std::vector<std::uint64_t>& source_offsets() const;

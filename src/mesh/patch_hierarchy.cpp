@@ -31,6 +31,7 @@
 #include "radiosity/mesh.hpp"
 
 #include "core/assert.hpp"
+#include "core/progress.hpp"
 #include "core/sampling.hpp"
 #include "scene/overlap.hpp"
 
@@ -276,8 +277,10 @@ struct PatchHierarchy::Weld {
   std::uint32_t along_edges = 0;
 
   Weld() = default;
-  /// `excluded` (empty, or one flag per polygon): polygons that share nothing.
-  Weld(const std::vector<Polygon>& polygons, float crease_angle_deg, const std::vector<bool>& excluded);
+  /// `excluded` (empty, or one flag per polygon): polygons that share nothing. `keep_going` (may
+  /// be empty) is asked every so many items; when it says no, the weld stops unfinished.
+  Weld(const std::vector<Polygon>& polygons, float crease_angle_deg, const std::vector<bool>& excluded,
+       const detail::KeepGoing& keep_going);
 
   bool welded(PolygonId polygon) const { return !first_corner.empty() && first_corner[polygon] != kNone; }
   /// Records the edges that ended up with more than one side in `edges`, as seams.
@@ -285,7 +288,21 @@ struct PatchHierarchy::Weld {
 };
 
 PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_angle_deg,
-                           const std::vector<bool>& excluded) {
+                           const std::vector<bool>& excluded, const detail::KeepGoing& keep_going) {
+  // Every pass below is O(corners); a million triangles take about 0.5 s in all.
+  auto stop = [&](std::size_t i) { return i % 16384 == 0 && keep_going && !keep_going(); };
+  // `v` as n copies of `value`, made in steps with a check between: the first touch of tens of
+  // megabytes takes a noticeable time (page faults). False when stopped.
+  auto filled = [&](auto& v, std::size_t n, auto value) {
+    constexpr std::size_t kStep = std::size_t{1} << 20;
+    v.clear();
+    v.reserve(n);
+    for (std::size_t at = 0; at < n; at += kStep) {
+      if (stop(0)) return false;
+      v.insert(v.end(), std::min(kStep, n - at), value);
+    }
+    return true;
+  };
   // Number the corners of the triangles and quads; a fan polygon shares nothing (its triangles
   // do not share vertices with each other either), nor does a polygon cut at contact lines.
   first_corner.assign(polygons.size(), kNone);
@@ -301,7 +318,7 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   const auto count = static_cast<std::uint32_t>(corner_count);
   std::vector<std::uint32_t> polygon_of(count);
   for (std::size_t p = 0; p < polygons.size(); ++p)
-    if (first_corner[p] != kNone)
+    if (!stop(p) && first_corner[p] != kNone)
       for (std::size_t c = 0; c < polygons[p].vertices.size(); ++c)
         polygon_of[first_corner[p] + c] = static_cast<std::uint32_t>(p);
   auto next_corner = [&](std::uint32_t c) {
@@ -319,8 +336,10 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   {
     std::size_t size = 16;
     while (size < 2 * corner_count) size *= 2;
-    std::vector<std::uint32_t> table(size, kNone);  // a corner with that position
+    std::vector<std::uint32_t> table;  // a corner with that position
+    if (!filled(table, size, kNone)) return;
     for (std::uint32_t c = 0; c < count; ++c) {
+      if (stop(c)) return;
       const glm::vec3& q = position_of(c);
       std::size_t slot = static_cast<std::size_t>(position_hash(q)) & (size - 1);
       while (table[slot] != kNone && !same_bits(position_of(table[slot]), q)) slot = (slot + 1) & (size - 1);
@@ -337,16 +356,20 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   // end, keyed by (upper end, corner) so that sorting a bucket brings an edge's polygons
   // together in corner order (deterministic). O(corners) but for the sorts of buckets, which
   // hold a vertex's few edges.
+  if (stop(0)) return;
   std::vector<std::uint32_t> bucket_start(static_cast<std::size_t>(distinct) + 1, 0);
   for (std::uint32_t c = 0; c < count; ++c) {
+    if (stop(c)) return;
     const std::uint32_t a = position[c], b = position[next_corner(c)];
     if (a != b) ++bucket_start[std::min(a, b) + 1];
   }
   std::partial_sum(bucket_start.begin(), bucket_start.end(), bucket_start.begin());
-  std::vector<std::uint64_t> bucket(bucket_start.back());
+  std::vector<std::uint64_t> bucket;
+  if (!filled(bucket, bucket_start.back(), std::uint64_t{0})) return;
   {
     std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
     for (std::uint32_t c = 0; c < count; ++c) {
+      if (stop(c)) return;
       const std::uint32_t a = position[c], b = position[next_corner(c)];
       if (a != b) bucket[fill[std::min(a, b)]++] = (static_cast<std::uint64_t>(std::max(a, b)) << 32) | c;
     }
@@ -360,11 +383,11 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
     return p != q && a.material == b.material && a.group == b.group &&
            static_cast<double>(glm::dot(a.normal, b.normal)) >= cos_crease;
   };
-  root.resize(count);
+  if (!filled(root, count, 0u) || !filled(edge, count, kNone)) return;
   std::iota(root.begin(), root.end(), 0u);
-  edge.assign(count, kNone);
   std::vector<std::uint32_t> local, members, local_edge;
   for (std::uint32_t v = 0; v < distinct; ++v) {
+    if (stop(v)) return;
     const auto begin = bucket.begin() + bucket_start[v], end = bucket.begin() + bucket_start[v + 1];
     std::sort(begin, end);
     for (auto run = begin; run != end;) {
@@ -402,7 +425,10 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
       run = run_end;
     }
   }
-  for (std::uint32_t c = 0; c < count; ++c) root[c] = find_root(root, c);
+  for (std::uint32_t c = 0; c < count; ++c) {
+    if (stop(c)) return;
+    root[c] = find_root(root, c);
+  }
   vertex = std::move(position);  // reuse the memory
   std::fill(vertex.begin(), vertex.end(), kNone);
   first_side.assign(edge_count, kNone);
@@ -450,6 +476,37 @@ PatchHierarchy& PatchHierarchy::operator=(const PatchHierarchy& other) {
 }
 
 PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) : PatchHierarchy() {
+  build(scene, options, nullptr);
+}
+
+PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options, const ProgressFn& on_progress)
+    : PatchHierarchy() {
+  if (build(scene, options, on_progress ? &on_progress : nullptr)) return;
+  patches_ = {};
+  elements_ = {};
+  leaves_ = {};
+  leaf_slot_ = {};
+  vertices_ = {};
+  edges_ = std::make_unique<Edges>();
+}
+
+bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const ProgressFn* on_progress) {
+  static const ProgressFn kSilent;
+  detail::ProgressGate gate(on_progress ? *on_progress : kSilent);
+  // Phase::meshing's fraction: contact lines and welding first, then the polygons (half), then
+  // the subdivision of their patches. `due()` is a clock read: asked every kCheckEvery items.
+  constexpr std::size_t kCheckEvery = 64;
+  bool stopped = false;  // once the callback said no, it is not called again
+  auto report = [&](double fraction, bool force = false) {
+    if (stopped) return false;
+    Progress p;
+    p.phase = Phase::meshing;
+    p.fraction = fraction;
+    stopped = !gate.report(p, force);
+    return !stopped;
+  };
+  if (!report(0.0, true)) return false;
+  const detail::KeepGoing keep_going = [&] { return report(0.1); };
   check_area_option(options.max_patch_area, "max_patch_area");
   check_area_option(options.max_element_area, "max_element_area");
   check_crease_option(options.crease_angle_deg);
@@ -468,7 +525,7 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
   }
   if (options_.max_element_area == 0.0f) options_.max_element_area = options_.max_patch_area / 4.0f;
 
-  if (scene.polygons().empty()) return;
+  if (scene.polygons().empty()) return report(1.0, true);
   if (!(options_.max_element_area > 0.0f))
     throw Error(ErrorCode::invalid_argument,
                 "MeshOptions::max_element_area is 0 after derivation (the scene's polygons have no area)");
@@ -481,6 +538,14 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
                     " elements would be created");
 
   const std::vector<Polygon>& polygons = scene.polygons();
+  // Room for what the estimate says, so that the arrays do not grow by copying (a copy of a
+  // hundred megabytes is a tenth of a second without a cancel check); untouched until used.
+  const auto expected = static_cast<std::size_t>(std::min(estimate + static_cast<double>(polygons.size()), 6.7e7));
+  elements_.reserve(expected);
+  leaf_slot_.reserve(expected);
+  leaves_.reserve(expected);
+  vertices_.reserve(expected);
+  patches_.reserve(polygons.size());
   // Contact lines, by polygon: [first_line[p], first_line[p + 1]) in `lines`. A polygon that
   // has any is cut along them and meshed piece by piece, and shares no vertices with its
   // neighbours (welding would need its pieces' lattices to match theirs).
@@ -489,17 +554,25 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
   std::vector<bool> cut;
   double tolerance = 0.0;
   if (options_.split_at_contacts) {
-    lines = detail::contact_lines(scene);
+    lines = detail::contact_lines(scene, on_progress ? keep_going : detail::KeepGoing());
+    if (stopped) return false;
     tolerance = detail::touching_tolerance(scene);
     first_line.assign(polygons.size() + 1, 0);
     for (const detail::ContactLine& l : lines) ++first_line[l.polygon + 1];
     std::partial_sum(first_line.begin(), first_line.end(), first_line.begin());
     cut.assign(polygons.size(), false);
     for (const detail::ContactLine& l : lines) cut[l.polygon] = true;
+    if (!report(0.1)) return false;
   }
-  Weld weld = options_.crease_angle_deg > 0.0f ? Weld(polygons, options_.crease_angle_deg, cut) : Weld();
+  Weld weld = options_.crease_angle_deg > 0.0f
+                  ? Weld(polygons, options_.crease_angle_deg, cut, on_progress ? keep_going : detail::KeepGoing())
+                  : Weld();
+  if (stopped || !report(0.2)) return false;
   Polygon piece_polygon;
   for (PolygonId id = 0; id < polygons.size(); ++id) {
+    if (id % kCheckEvery == 0 && gate.due(Phase::meshing) &&
+        !report(0.2 + 0.5 * static_cast<double>(id) / static_cast<double>(polygons.size())))
+      return false;
     const Polygon& polygon = polygons[id];
     const PolygonVertices& p = polygon.vertices;
     if (!cut.empty() && cut[id]) {
@@ -533,10 +606,15 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
 
   // Split each patch's root until every leaf fits max_element_area. Roots are visited in order
   // and their subtrees depth-first, so element ids and leaves() do not depend on anything else.
+  // Subdivisions are counted for the cancel checks: one large polygon can make millions.
   std::vector<std::uint32_t> stack;
-  for (const Patch& patch : patches_) {
-    stack.push_back(patch.root);
+  std::size_t splits = 0;
+  for (std::size_t patch = 0; patch < patches_.size(); ++patch) {
+    stack.push_back(patches_[patch].root);
     while (!stack.empty()) {
+      if (++splits % kCheckEvery == 0 && gate.due(Phase::meshing) &&
+          !report(0.7 + 0.3 * static_cast<double>(patch) / static_cast<double>(patches_.size())))
+        return false;
       const std::uint32_t e = stack.back();
       stack.pop_back();
       if (fits(elements_[e].area, options_.max_element_area)) continue;
@@ -544,6 +622,7 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
       for (std::uint32_t k = 4; k-- > 0;) stack.push_back(first + k);
     }
   }
+  return report(1.0, true);
 }
 
 std::uint32_t PatchHierarchy::add_vertex(const glm::vec3& position, std::uint32_t edge_a, std::uint32_t edge_b) {

@@ -25,9 +25,14 @@
 #include "scene/overlap.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
+#include <limits>
 #include <mutex>
+#include <numeric>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -57,6 +62,7 @@ struct Search {
   std::vector<glm::vec3> lower, upper;  ///< bounds grown by the tolerance
   double tolerance = 0.0;
   bool contacts = false;  ///< looking for contact lines (contact_lines()) rather than overlaps
+  std::atomic<bool> stop{false};  ///< the caller's KeepGoing said no: pairs are skipped
   std::mutex mutex;
   std::vector<PolygonOverlap> found;
   std::vector<ContactLine> lines;
@@ -262,16 +268,36 @@ bool contact_of(const Search& s, PolygonId ia, PolygonId ib, ContactLine& out) {
   return true;
 }
 
+/// One piece of the broad phase: a BVH over some of the polygons (`ids`), for rtcCollide().
+struct Chunk {
+  const Search* search = nullptr;
+  std::vector<PolygonId> ids;
+  glm::vec3 lower{0.0f}, upper{0.0f};
+  RTCScene scene = nullptr;
+};
+
 void bounds_of(const RTCBoundsFunctionArguments* args) {
-  const auto* s = static_cast<const Search*>(args->geometryUserPtr);
-  const glm::vec3 &lo = s->lower[args->primID], &hi = s->upper[args->primID];
+  const auto* chunk = static_cast<const Chunk*>(args->geometryUserPtr);
+  const PolygonId id = chunk->ids[args->primID];
+  const glm::vec3 &lo = chunk->search->lower[id], &hi = chunk->search->upper[id];
   *args->bounds_o = RTCBounds{lo.x, lo.y, lo.z, 0.0f, hi.x, hi.y, hi.z, 0.0f};
 }
 
+/// What a collision query between two chunks hands its callback.
+struct ChunkPair {
+  Search* search;
+  const Chunk* first;
+  const Chunk* second;
+};
+
 void on_collisions(void* user, RTCCollision* collisions, unsigned count) {
-  auto* s = static_cast<Search*>(user);
+  const auto* pair = static_cast<const ChunkPair*>(user);
+  Search* s = pair->search;
+  // The pair tests are the search's cost (the BVH traversal is a fraction of it), so a stopped
+  // search ends within one traversal.
+  if (s->stop.load(std::memory_order_relaxed)) return;
   for (unsigned i = 0; i < count; ++i) {
-    PolygonId a = collisions[i].primID0, b = collisions[i].primID1;
+    PolygonId a = pair->first->ids[collisions[i].primID0], b = pair->second->ids[collisions[i].primID1];
     if (a == b) continue;
     if (a > b) std::swap(a, b);
     if (s->contacts) {
@@ -290,9 +316,53 @@ void on_collisions(void* user, RTCCollision* collisions, unsigned count) {
   }
 }
 
+/// Polygons per chunk of the broad phase. A BVH build cannot be interrupted, and Embree builds
+/// a million boxes in about 0.2 s; chunks of this size take a few milliseconds each, so a
+/// stopped search ends within that.
+constexpr std::size_t kChunkPolygons = 32768;
+
+/// Splits `ids` at the median of their boxes' centres along the longest axis of their extent
+/// until each part holds at most kChunkPolygons (a k-d tree's leaves: compact parts, so only
+/// neighbouring parts' boxes meet).
+void split_chunks(const Search& s, std::vector<PolygonId> ids, std::vector<Chunk>& out) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+  for (const PolygonId id : ids) {
+    lo = glm::min(lo, s.lower[id]);
+    hi = glm::max(hi, s.upper[id]);
+  }
+  if (ids.size() <= kChunkPolygons) {
+    Chunk c;
+    c.search = &s;
+    c.ids = std::move(ids);
+    c.lower = lo;
+    c.upper = hi;
+    out.push_back(std::move(c));
+    return;
+  }
+  const glm::vec3 extent = hi - lo;
+  const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
+  auto centre = [&](PolygonId id) { return s.lower[id][axis] + s.upper[id][axis]; };
+  const auto middle = ids.begin() + static_cast<std::ptrdiff_t>(ids.size() / 2);
+  // Ties by id: the parts, and so the order of the pairs found, do not depend on the sort.
+  std::nth_element(ids.begin(), middle, ids.end(), [&](PolygonId a, PolygonId b) {
+    const float ca = centre(a), cb = centre(b);
+    return ca < cb || (ca == cb && a < b);
+  });
+  std::vector<PolygonId> upper_half(middle, ids.end());
+  ids.erase(middle, ids.end());
+  split_chunks(s, std::move(ids), out);
+  split_chunks(s, std::move(upper_half), out);
+}
+
+bool boxes_meet(const Chunk& a, const Chunk& b) {
+  return a.lower.x <= b.upper.x && b.lower.x <= a.upper.x && a.lower.y <= b.upper.y && b.lower.y <= a.upper.y &&
+         a.lower.z <= b.upper.z && b.lower.z <= a.upper.z;
+}
+
 // The tolerance, planes and grown bounds of every polygon, then Embree's collision query over
-// the bounds, which calls test_pair() or contact_of() for every nearby pair.
-void search_pairs(const Scene& scene, Search& s, const char* caller) {
+// the bounds, which calls test_pair() or contact_of() for every nearby pair; every step ends
+// early once `s.stop` is set.
+void search_here(const Scene& scene, Search& s, const char* caller) {
   const std::vector<Polygon>& polygons = scene.polygons();
   s.polygons = &polygons;
   s.tolerance = touching_tolerance(scene);
@@ -301,6 +371,7 @@ void search_pairs(const Scene& scene, Search& s, const char* caller) {
   s.lower.resize(polygons.size());
   s.upper.resize(polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i) {
+    if (i % 4096 == 0 && s.stop.load(std::memory_order_relaxed)) return;
     const Polygon& p = polygons[i];
     Plane& plane = s.planes[i];
     plane.normal = glm::normalize(glm::dvec3(p.normal));
@@ -316,26 +387,72 @@ void search_pairs(const Scene& scene, Search& s, const char* caller) {
     s.upper[i] = hi + grow;
   }
 
+  std::vector<PolygonId> all(polygons.size());
+  std::iota(all.begin(), all.end(), PolygonId{0});
+  std::vector<Chunk> chunks;
+  split_chunks(s, std::move(all), chunks);
+
   RTCDevice device = rtcNewDevice(embree_device_config());
   if (!device)
     throw Error(ErrorCode::internal, std::string(caller) + ": Embree cannot create a device (error " +
                                          std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))) + ")");
-  RTCScene boxes = rtcNewScene(device);
-  RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(polygons.size()));
-  rtcSetGeometryUserData(geometry, &s);
-  rtcSetGeometryBoundsFunction(geometry, bounds_of, nullptr);
-  rtcCommitGeometry(geometry);
-  rtcAttachGeometry(boxes, geometry);
-  rtcReleaseGeometry(geometry);
-  rtcCommitScene(boxes);
-  rtcCollide(boxes, boxes, on_collisions, &s);
+  for (Chunk& c : chunks) {
+    if (s.stop.load()) break;
+    c.scene = rtcNewScene(device);
+    // The Morton builder: the pairs do not depend on the tree, and it builds several times faster.
+    rtcSetSceneBuildQuality(c.scene, RTC_BUILD_QUALITY_LOW);
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_LOW);
+    rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(c.ids.size()));
+    rtcSetGeometryUserData(geometry, &c);
+    rtcSetGeometryBoundsFunction(geometry, bounds_of, nullptr);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(c.scene, geometry);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(c.scene);
+  }
+  // Each pair of chunks whose boxes meet, a chunk with itself included.
+  for (std::size_t i = 0; i < chunks.size() && !s.stop.load(); ++i)
+    for (std::size_t j = i; j < chunks.size() && !s.stop.load(); ++j) {
+      if (!boxes_meet(chunks[i], chunks[j])) continue;
+      ChunkPair pair{&s, &chunks[i], &chunks[j]};
+      rtcCollide(chunks[i].scene, chunks[j].scene, on_collisions, &pair);
+    }
   const RTCError error = rtcGetDeviceError(device);
-  rtcReleaseScene(boxes);
+  for (Chunk& c : chunks)
+    if (c.scene) rtcReleaseScene(c.scene);
   rtcReleaseDevice(device);
   if (error != RTC_ERROR_NONE)
     throw Error(ErrorCode::internal, std::string(caller) + ": Embree's collision query failed (error " +
                                          std::to_string(static_cast<int>(error)) + ")");
+}
+
+// search_here() on this thread, or with `keep_going` on a worker while this thread polls it
+// (it must be called on the caller's thread, and Embree's build and query cannot be
+// interrupted: a stop is seen between them and by each batch of pairs).
+void search_pairs(const Scene& scene, Search& s, const char* caller, const KeepGoing& keep_going) {
+  if (!keep_going) return search_here(scene, s, caller);
+  std::future<void> done = std::async(std::launch::async, [&] { search_here(scene, s, caller); });
+  while (done.wait_for(std::chrono::milliseconds(10)) != std::future_status::ready)
+    if (!s.stop.load() && !keep_going()) s.stop.store(true);
+  done.get();
+}
+
+// find_overlaps(), polled by `keep_going`.
+std::vector<PolygonOverlap> overlaps(const Scene& scene, const KeepGoing& keep_going) {
+  const std::vector<Polygon>& polygons = scene.polygons();
+  if (polygons.size() < 2) return {};
+  Search s;
+  search_pairs(scene, s, "find_overlaps", keep_going);
+
+  // The query may report a pair twice and in any order; sorting makes the result deterministic.
+  std::vector<PolygonOverlap> found = std::move(s.found);
+  auto key = [](const PolygonOverlap& o) { return std::make_pair(o.first, o.second); };
+  std::sort(found.begin(), found.end(), [&](const PolygonOverlap& x, const PolygonOverlap& y) { return key(x) < key(y); });
+  found.erase(std::unique(found.begin(), found.end(),
+                          [&](const PolygonOverlap& x, const PolygonOverlap& y) { return key(x) == key(y); }),
+              found.end());
+  return found;
 }
 
 std::string point_text(const glm::vec3& p) {
@@ -347,10 +464,10 @@ std::string point_text(const glm::vec3& p) {
 
 }  // namespace
 
-std::vector<std::string> z_fighting_warnings(const Scene& scene) {
+std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing& keep_going) {
   std::vector<std::string> out;
   std::vector<const PolygonOverlap*> same_facing;
-  const std::vector<PolygonOverlap> found = find_overlaps(scene);
+  const std::vector<PolygonOverlap> found = overlaps(scene, keep_going);
   for (const PolygonOverlap& o : found)
     if (o.kind == OverlapKind::coincident &&
         glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) > 0.0f)
@@ -369,11 +486,11 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene) {
   return out;
 }
 
-std::vector<ContactLine> contact_lines(const Scene& scene) {
+std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep_going) {
   if (scene.polygons().size() < 2) return {};
   Search s;
   s.contacts = true;
-  search_pairs(scene, s, "contact_lines");
+  search_pairs(scene, s, "contact_lines", keep_going);
   // Sorted by polygon, then by line, and one line per polygon where several polygons meet it
   // along the same line (a wall modelled as two coincident faces, collinear walls): the order
   // of Embree's callbacks must not show.
@@ -418,21 +535,7 @@ double touching_tolerance(const Scene& scene) {
 namespace radiosity {
 inline namespace v1 {
 
-std::vector<PolygonOverlap> find_overlaps(const Scene& scene) {
-  const std::vector<Polygon>& polygons = scene.polygons();
-  if (polygons.size() < 2) return {};
-  detail::Search s;
-  detail::search_pairs(scene, s, "find_overlaps");
-
-  // The query may report a pair twice and in any order; sorting makes the result deterministic.
-  std::vector<PolygonOverlap> found = std::move(s.found);
-  auto key = [](const PolygonOverlap& o) { return std::make_pair(o.first, o.second); };
-  std::sort(found.begin(), found.end(), [&](const PolygonOverlap& x, const PolygonOverlap& y) { return key(x) < key(y); });
-  found.erase(std::unique(found.begin(), found.end(),
-                          [&](const PolygonOverlap& x, const PolygonOverlap& y) { return key(x) == key(y); }),
-              found.end());
-  return found;
-}
+std::vector<PolygonOverlap> find_overlaps(const Scene& scene) { return detail::overlaps(scene, {}); }
 
 }  // namespace v1
 }  // namespace radiosity

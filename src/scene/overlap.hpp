@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,11 +24,16 @@ namespace radiosity::detail {
 /// diagonal), so a surface closer than that to another cannot be told apart from it by rays.
 inline constexpr double kOverlapRelativeTolerance = 2e-5;
 
+/// Polled by the searches below on the calling thread, about every 10 ms while Embree's
+/// collision query runs on a worker: false stops the search, which then returns what it found
+/// so far (a caller that cancels discards it). Empty: not polled, the query runs on the caller.
+using KeepGoing = std::function<bool()>;
+
 /// One warning (or none) for the coincident pairs of find_overlaps(scene) whose normals point
 /// the same way: it names the first pair by index and group, where they meet, and how many
 /// pairs there are. Coincident pairs facing each other (contact) and interpenetrating pairs
 /// are not warned about: they are lit correctly.
-std::vector<std::string> z_fighting_warnings(const Scene& scene);
+std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing& keep_going = {});
 
 /// The distance below which two surfaces count as touching in `scene`:
 /// kOverlapRelativeTolerance of its bounding-box diagonal, and at least a few ulps of its
@@ -53,6 +59,6 @@ struct ContactLine {
 /// the two sides of such a line differs by everything the other polygon blocks, and an
 /// element or an interpolated vertex across it would carry light into the dark side (Baum et
 /// al. 1991). Cost: as find_overlaps(). Thread safety: concurrent calls are safe.
-std::vector<ContactLine> contact_lines(const Scene& scene);
+std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep_going = {});
 
 }  // namespace radiosity::detail

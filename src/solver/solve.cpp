@@ -142,6 +142,8 @@ struct Problem::Impl {
   std::vector<std::string> warnings;  ///< the scene's and the z-fighting check's, for every report
   double seconds_meshing = 0.0;       ///< reported by the first solve only
   bool meshed_reported = false;
+  /// The callback cancelled the meshing (in the constructor): every solve returns cancelled.
+  bool meshing_cancelled = false;
   /// Adaptive subdivision's limits stay those of the initial mesh however often it refines.
   std::uint8_t initial_depth = 0;
   std::size_t initial_leaves = 0;
@@ -289,13 +291,27 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given, const detail::Com
   // The estimator inherits the solve's thread count unless it was given one of its own.
   if (o.form_factors.threads == 0) o.form_factors.threads = o.threads;
 
-  warnings = scene.warnings();
-  // Contact and interpenetration are lit correctly; only same-facing coincident surfaces are
-  // ambiguous.
-  for (std::string& w : detail::z_fighting_warnings(scene)) warnings.push_back(std::move(w));
-
+  // Meshing, and the z-fighting check before it, report Phase::meshing and can be cancelled
+  // (then every solve returns cancelled).
+  ProgressFn meshing_progress;
+  if (o.on_progress)
+    meshing_progress = [this](const Progress& p) {
+      if (options.on_progress(p)) return true;
+      meshing_cancelled = true;
+      return false;
+    };
+  detail::ProgressGate gate(meshing_progress);
   auto t0 = std::chrono::steady_clock::now();
-  hierarchy = PatchHierarchy(scene, o.mesh);
+  warnings = scene.warnings();
+  if (gate.report(Progress{Phase::meshing, 0.0}, true)) {
+    // Contact and interpenetration are lit correctly; only same-facing coincident surfaces are
+    // ambiguous.
+    const detail::KeepGoing poll = [&] { return gate.report(Progress{Phase::meshing, 0.0}); };
+    for (std::string& w : detail::z_fighting_warnings(scene, meshing_progress ? poll : detail::KeepGoing()))
+      warnings.push_back(std::move(w));
+  }
+  if (!meshing_cancelled)
+    hierarchy = meshing_progress ? PatchHierarchy(scene, o.mesh, meshing_progress) : PatchHierarchy(scene, o.mesh);
   seconds_meshing = seconds_since(t0);
   o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
   if (o.max_iterations == 0)
@@ -322,7 +338,9 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
   const bool groups = options.separate_light_groups;
   Solution solution = solve_once(emission, last && !groups);
   if (groups && solution.status() != SolveStatus::cancelled) solution.set_light_groups(solve_light_groups(emission));
-  solution.set_meshes(solved_meshes(scene));
+  // Cancelled while meshing, the solution has no elements, and nothing to align with the
+  // meshes (whose copy would take a host's million triangles some 0.1 s after the cancel).
+  if (!meshing_cancelled) solution.set_meshes(solved_meshes(scene));
   return solution;
 }
 
@@ -391,10 +409,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   std::vector<Rgb> B_back(translucency ? hierarchy.elements().size() : 0, Rgb(0.0f));
   std::vector<std::string> groups = scene.groups();
 
-  // The meshing phase ends (in the constructor) before the first solve reports it.
-  const bool meshing_reported = meshed_reported;
+  // The meshing phase was reported by the constructor.
   meshed_reported = true;
-  if (!meshing_reported && !gate.report(Progress{Phase::meshing, 1.0, 0, 1.0}, true)) {
+  if (meshing_cancelled) {
     std::vector<Rgb> no_irradiance(hierarchy.elements().size(), Rgb(0.0f));
     return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), SolveStatus::cancelled,
                     std::move(report), Rgb(0.0f), {}, std::move(B_back), std::move(no_irradiance));

@@ -1,5 +1,5 @@
 // Tests for PatchHierarchy: area bookkeeping, option handling, shared vertices, crack-free vertex
-// values, aggregation and area-uniform sampling.
+// values, aggregation, area-uniform sampling and progress and cancel while meshing.
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -12,6 +12,7 @@
 
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
+#include "radiosity/solver.hpp"
 
 #include "support/fields.hpp"
 
@@ -382,3 +383,38 @@ TEST_CASE("the default Cornell box meshes into a few hundred patches and a few t
 }
 
 }  // TEST_SUITE("mesh")
+
+TEST_CASE("meshing with a progress callback: the same mesh, reported from 0 to 1; a cancel leaves it empty") {
+  const Scene scene = mixed_scene();
+  MeshOptions o;
+  o.max_element_area = 0.01f;
+  const PatchHierarchy plain(scene, o);
+  std::vector<double> fractions;
+  const PatchHierarchy reported(scene, o, [&](const Progress& p) {
+    CHECK(p.phase == Phase::meshing);
+    fractions.push_back(p.fraction);
+    return true;
+  });
+  CHECK(reported.leaves() == plain.leaves());
+  CHECK(reported.vertices().size() == plain.vertices().size());
+  REQUIRE(fractions.size() >= 2);
+  CHECK(fractions.front() == 0.0);
+  CHECK(fractions.back() == 1.0);
+  for (std::size_t k = 1; k < fractions.size(); ++k) CHECK(fractions[k] >= fractions[k - 1]);
+
+  int calls = 0;
+  const PatchHierarchy cancelled(scene, o, [&](const Progress&) { return ++calls < 1; });
+  CHECK(calls == 1);  // not called again after the cancel
+  CHECK(cancelled.patches().empty());
+  CHECK(cancelled.leaves().empty());
+  CHECK(cancelled.elements().empty());
+
+  // Cancelled while meshing, solve() returns cancelled with no elements (and without copying
+  // the scene's meshes).
+  SolveOptions so;
+  so.mesh = o;
+  so.on_progress = [](const Progress& p) { return p.phase != Phase::meshing; };
+  const Solution s = solve(scene, so);
+  CHECK(s.status() == SolveStatus::cancelled);
+  CHECK(s.hierarchy().leaves().empty());
+}

@@ -276,4 +276,20 @@ TEST_SUITE("scene") {
         warned = true;
     CHECK(warned);
   }
+  TEST_CASE("a large scene searched in parts finds the pairs across the parts' border") {
+    // 40 000 unit squares (the broad phase splits more than 32 768 polygons into parts by
+    // position; here at x = 100) and a blade through four of them, two on each side.
+    Builder b(kMotions[0]);
+    for (int i = 0; i < 200; ++i)
+      for (int j = 0; j < 200; ++j) b.add(square(static_cast<float>(i), static_cast<float>(j), 1.0f), "ground");
+    b.add({{98.2f, 50.5f, -0.5f}, {101.8f, 50.5f, -0.5f}, {101.8f, 50.5f, 0.5f}, {98.2f, 50.5f, 0.5f}}, "blade");
+    const std::vector<rad::PolygonOverlap> o = rad::find_overlaps(b.scene);
+    REQUIRE(o.size() == 4);
+    for (std::size_t k = 0; k < 4; ++k) {
+      CAPTURE(k);
+      CHECK(o[k].kind == rad::OverlapKind::interpenetrating);
+      CHECK(o[k].first == static_cast<rad::PolygonId>((98 + k) * 200 + 50));
+      CHECK(o[k].second == 40000u);
+    }
+  }
 }

@@ -12,9 +12,9 @@
 TEST_SUITE("solver") {
   TEST_CASE("cancel: every stage stops soon after the callback asks, and calls it no more") {
     const double bound = test::kSanitizerBuild ? 5.0 : 1.0;
-    // 2.5 cm elements and 256-pixel images: every stage runs well past the 0.15 s at which the
-    // probe cancels.
-    const cancel::Stages stages(625.0f, 256, 512);
+    // 2.5 cm elements, 256-pixel images and a terrain of 600k triangles: every stage runs well
+    // past the 0.15 s at which the probe cancels.
+    const cancel::Stages stages(625.0f, 256, 512, 600000);
     for (const cancel::Stage& stage : stages.list()) {
       CAPTURE(stage.name);
       cancel::Probe probe{stage.phase};

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -80,10 +81,12 @@ struct Stage {
 
 /// The Cornell box with a sky and a floor mesh with UV1, meshed at `element_area`
 /// (mm^2; 625 = 2.5 cm elements, about 26k), and the stages over it; `image` is the renders'
-/// width and height, `lightmap` the lightmap's. Keeps what the stages refer to.
+/// width and height, `lightmap` the lightmap's. Meshing is measured on a scene of its own: a
+/// height field of `terrain_triangles` triangles (one indexed mesh, as a host hands it over)
+/// under a sky. Keeps what the stages refer to.
 class Stages {
  public:
-  Stages(float element_area, int image, int lightmap) {
+  Stages(float element_area, int image, int lightmap, std::size_t terrain_triangles) {
     scene_.add_light(light());
     rad::Material grey;
     grey.reflectance = rad::Rgb(0.5f);
@@ -114,6 +117,28 @@ class Stages {
     auto solved = [this] { return solution_cancelled_; };
     auto always = [] { return true; };
     const auto gs = rad::SolverMethod::gauss_seidel;
+    make_terrain(terrain_triangles);
+    // Meshing: in solve() the z-fighting check comes first, then PatchHierarchy's contact
+    // lines, then the polygons' elements (the last two alone, without the search, next).
+    list_.push_back({"meshing, solve()", rad::Phase::meshing,
+                     [this](const rad::ProgressFn& progress) {
+                       rad::SolveOptions o;
+                       o.threads = 2;
+                       o.on_progress = progress;
+                       solution_cancelled_ = rad::solve(terrain_, o).status() == rad::SolveStatus::cancelled;
+                     },
+                     solved});
+    auto mesh_stage = [this](bool contacts) {
+      return [this, contacts](const rad::ProgressFn& progress) {
+        rad::MeshOptions m;
+        m.split_at_contacts = contacts;
+        if (!contacts) m.max_element_area = 1e-4f;  // 1 cm elements: a million of them
+        mesh_cancelled_ = rad::PatchHierarchy(terrain_, m, progress).patches().empty();
+      };
+    };
+    auto mesh_cancelled = [this] { return mesh_cancelled_; };
+    list_.push_back({"meshing, contact lines", rad::Phase::meshing, mesh_stage(true), mesh_cancelled});
+    list_.push_back({"meshing, elements", rad::Phase::meshing, mesh_stage(false), mesh_cancelled});
     list_.push_back({"lights' first shot", rad::Phase::lights, solve_stage(gs, rad::FormFactorMethod::monte_carlo), solved});
     list_.push_back({"form factors, ray_cast", rad::Phase::form_factors, solve_stage(gs, rad::FormFactorMethod::ray_cast), solved});
     list_.push_back({"form factors, hemicube", rad::Phase::form_factors, solve_stage(gs, rad::FormFactorMethod::hemicube), solved});
@@ -185,13 +210,45 @@ class Stages {
     return l;
   }
 
+  /// A gently rolling n x n grid of quads, two triangles each, 10 m across.
+  void make_terrain(std::size_t triangles) {
+    const auto n = static_cast<std::uint32_t>(std::max(1.0, std::ceil(std::sqrt(static_cast<double>(triangles) / 2.0))));
+    std::vector<glm::vec3> positions;
+    std::vector<std::uint32_t> indices;
+    positions.reserve(static_cast<std::size_t>(n + 1) * (n + 1));
+    indices.reserve(static_cast<std::size_t>(n) * n * 6);
+    const float step = 10.0f / static_cast<float>(n);
+    for (std::uint32_t j = 0; j <= n; ++j)
+      for (std::uint32_t i = 0; i <= n; ++i) {
+        const float x = step * static_cast<float>(i), y = step * static_cast<float>(j);
+        positions.emplace_back(x, y, 0.2f * std::sin(0.7f * x) * std::cos(0.9f * y));
+      }
+    for (std::uint32_t j = 0; j < n; ++j)
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const std::uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+        indices.insert(indices.end(), {a, b, c, a, c, d});
+      }
+    rad::Material ground;
+    ground.reflectance = rad::Rgb(0.3f);
+    rad::MeshDesc d;
+    d.positions = positions.data();
+    d.vertex_count = positions.size();
+    d.indices = indices.data();
+    d.index_count = indices.size();
+    d.material = terrain_.add_material(ground);
+    d.group = "terrain";
+    terrain_.add_mesh(d);
+    terrain_.add_light(light());
+  }
+
   rad::Scene scene_ = rad::cornell_box();
+  rad::Scene terrain_;
   std::vector<glm::vec3> positions_{{100, 1, 100}, {450, 1, 100}, {450, 1, 450}, {100, 1, 450}};
   std::vector<std::uint32_t> indices_{0, 2, 1, 0, 3, 2};
   std::vector<glm::vec2> uv1_{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   rad::MeshId floor_mesh_ = 0;
   std::unique_ptr<rad::Solution> solution_;
-  bool solution_cancelled_ = false, lightmap_cancelled_ = false, factors_cancelled_ = false;
+  bool solution_cancelled_ = false, mesh_cancelled_ = false, lightmap_cancelled_ = false, factors_cancelled_ = false;
   std::vector<Stage> list_;
 };
 
