@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -200,6 +201,15 @@ std::unique_ptr<Brdf> load_measured(const std::filesystem::path& merl_binary) {
                                             ", expected 90 x 90 x 180 (theta_half, theta_diff, phi_diff)");
   }
 
+  // A file too short for the table is refused before the table's 30 MB are allocated.
+  const std::size_t expected = 3 * kEntries * sizeof(double);
+  std::error_code size_error;
+  const std::uintmax_t file_size = std::filesystem::file_size(merl_binary, size_error);
+  if (!size_error && file_size < sizeof(header) + expected)
+    throw Error(ErrorCode::parse_error, name + ": truncated, expected " + std::to_string(expected) +
+                                            " bytes of BRDF data after the header, found " +
+                                            std::to_string(file_size - sizeof(header)));
+
   // Read one channel at a time (all R, then all G, then all B) and interleave.
   std::vector<float> rgb(3 * kEntries);
   std::vector<unsigned char> buffer(kEntries * sizeof(double));
@@ -207,7 +217,6 @@ std::unique_ptr<Brdf> load_measured(const std::filesystem::path& merl_binary) {
     in.read(reinterpret_cast<char*>(buffer.data()), static_cast<std::streamsize>(buffer.size()));
     const auto got = static_cast<std::size_t>(in.gcount());
     if (got != buffer.size()) {
-      const std::size_t expected = 3 * buffer.size();
       const std::size_t found = c * buffer.size() + got;
       throw Error(ErrorCode::parse_error, name + ": truncated, expected " + std::to_string(expected) +
                                               " bytes of BRDF data after the header, found " +

@@ -11,8 +11,9 @@
 // a positive area, since a reader that lets NaN through gives a silently wrong answer later.
 //
 // Formats: obj (an OBJ, then optionally a line "#%%MTL%%" and the text of the MTL library that
-// `mtllib fuzz.mtl` names), json, gltf, glb, vs3, ply and stl (Assimp's readers behind
-// load_scene()), exr (read_exr()), merl (load_measured()). Seeds and the runs: run_fuzzers.sh.
+// `mtllib fuzz.mtl` names), json, gltf, glb, vs3, ply, stl, dae, fbx and 3ds (Assimp's readers
+// behind load_scene()), exr (read_exr()), merl (load_measured()). Seeds and the runs:
+// run_fuzzers.sh.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -29,7 +30,7 @@
 #include "radiosity/scene.hpp"
 
 #ifndef RADIOSITY_FUZZ_FORMAT
-#error "RADIOSITY_FUZZ_FORMAT must name the format (obj, json, gltf, glb, vs3, ply, stl, exr, merl)"
+#error "RADIOSITY_FUZZ_FORMAT must name the format (obj, json, gltf, glb, vs3, ply, stl, dae, fbx, 3ds, exr, merl)"
 #endif
 
 namespace {

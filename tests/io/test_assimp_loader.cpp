@@ -5,7 +5,7 @@
 // one skipped, attenuation and cone angles warned about); and broken files: a PLY header cut
 // short (Assimp 5.2 would loop forever on it), the empty faces of a truncated PLY (its
 // Triangulate step would abort), NaN coordinates, every truncation of each file an Error or a
-// scene, never a crash or a hang.
+// scene, never a crash or a hang; a room exported by Assimp as COLLADA, FBX and 3DS.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -389,6 +389,36 @@ TEST_CASE("Assimp broken COLLADA: a stray character in an index list - an array 
       }
     CHECK(refused > 0);
   }
+}
+
+TEST_CASE("Assimp: a room exported as COLLADA - ASCII FBX and 3DS reads as its OBJ does - the lamp emitting") {
+  // tests/data/assimp: tests/data/messy/exported_room.obj written by Assimp 5.2's exporters
+  // (the fuzz targets' seeds too). Assimp triangulates, so the OBJ's 14 polygons are 28 triangles
+  // (less one degenerate, skipped with a warning, as the OBJ reader drops its degenerate face).
+  const fs::path data = fs::path(RADIOSITY_TEST_DATA);
+  const radiosity::Scene obj = load(data / "messy" / "exported_room.obj");
+  auto emitting_area = [](const radiosity::Scene& s) {
+    double area = 0.0;
+    for (const radiosity::Polygon& p : s.polygons())
+      if (s.material(p.material).emission.x > 0.0f) area += p.area;
+    return area;
+  };
+  REQUIRE(emitting_area(obj) > 0.0);
+  for (const char* name : {"room.dae", "room.fbx", "room.3ds"}) {
+    CAPTURE(name);
+    const radiosity::Scene s = load(data / "assimp" / name);
+    CHECK(s.polygons().size() == 28);
+    CHECK(s.total_area() == doctest::Approx(obj.total_area()).epsilon(1e-5));
+    // The lamp's Ke 10 (a radiance: E = pi x 10); in the FBX only as the computed "Emissive".
+    CHECK(emitting_area(s) == doctest::Approx(emitting_area(obj)).epsilon(1e-5));
+    for (const radiosity::Polygon& p : s.polygons())
+      if (s.material(p.material).emission.x > 0.0f) CHECK(s.material(p.material).emission.x == doctest::Approx(10.0f * kPi));
+  }
+  // Assimp 5.2's binary FBX exporter writes block offsets its own reader refuses: an Error
+  // naming the file, not a crash.
+  const Error e = load_error(data / "assimp" / "room_binary_assimp52.fbx");
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "room_binary_assimp52.fbx"));
 }
 
 TEST_CASE("an unsupported extension lists the formats load_scene reads") {

@@ -110,7 +110,7 @@ TEST_CASE("read_exr reads HALF channels and an offset data window - and missing 
   }
 }
 
-TEST_CASE("read_exr errors name the path: missing file - not an EXR - no RGB channels") {
+TEST_CASE("read_exr errors name the path: missing file - not an EXR - truncated - an attribute past the end - no RGB channels") {
   Error missing = error_of([] { radiosity::read_exr(kTmp / "no_such.exr"); });
   CHECK(missing.code() == ErrorCode::file_not_found);
   CHECK(contains(missing.what(), "no_such.exr"));
@@ -129,6 +129,18 @@ TEST_CASE("read_exr errors name the path: missing file - not an EXR - no RGB cha
   Error truncated = error_of([] { radiosity::read_exr(kTmp / "truncated.exr"); });
   CHECK(truncated.code() == ErrorCode::parse_error);
   CHECK(contains(truncated.what(), "truncated.exr"));
+
+  // An attribute whose declared size runs past the end of the file (OpenEXR would allocate
+  // it first): refused by that figure. The first attribute's size follows "channels\0chlist\0".
+  const std::size_t size_at = bytes.find(std::string("chlist") + '\0') + 7;
+  REQUIRE(size_at < bytes.size());
+  std::string huge = bytes;
+  huge.replace(size_at, 4, std::string("\x00\x00\x00\x40", 4));  // 2^30, little-endian
+  std::ofstream(kTmp / "huge_attribute.exr", std::ios::binary) << huge;
+  Error attribute = error_of([] { radiosity::read_exr(kTmp / "huge_attribute.exr"); });
+  CHECK(attribute.code() == ErrorCode::parse_error);
+  CHECK(contains(attribute.what(), "huge_attribute.exr"));
+  CHECK(contains(attribute.what(), "attribute 'channels' (chlist) declares 1073741824 bytes, but "));
 
   Error no_rgb = error_of([] { radiosity::read_exr(kData / "no_rgb.exr"); });
   CHECK(no_rgb.code() == ErrorCode::parse_error);

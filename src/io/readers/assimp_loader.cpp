@@ -83,8 +83,12 @@ std::size_t ply_type_size(const std::string& type) {
 ///   characters per property in an ASCII one, but the last), and a file too short for its header is refused
 ///   with both figures.
 void check_ply_header(const fs::path& path) {
+  // The header is within the first megabyte (or the file is refused); no more is read, and no
+  // more than the file holds is allocated.
+  std::error_code size_error;
+  const std::uintmax_t size = fs::file_size(path, size_error);
   std::ifstream in(path, std::ios::binary);
-  std::string head(std::size_t{1} << 20, '\0');
+  std::string head(size_error ? std::size_t{1} << 20 : static_cast<std::size_t>(std::min<std::uintmax_t>(size, 1u << 20)), '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
   std::size_t body = std::string::npos;  // offset of the first byte after the header
@@ -100,10 +104,8 @@ void check_ply_header(const fs::path& path) {
   if (body == std::string::npos)
     throw Error(ErrorCode::parse_error, path.string() + ": the PLY header has no end_header line (a truncated file?)");
 
-  std::error_code ec;
-  const std::uintmax_t file_size = fs::file_size(path, ec);
-  if (ec) return;  // Assimp will say what is wrong
-  const double available = static_cast<double>(file_size) - static_cast<double>(std::min<std::uintmax_t>(body, file_size));
+  if (size_error) return;  // Assimp will say what is wrong
+  const double available = static_cast<double>(size) - static_cast<double>(std::min<std::uintmax_t>(body, size));
   std::istringstream lines(head.substr(0, body));
   std::string line;
   bool binary = false;
@@ -536,7 +538,11 @@ class AssimpReader {
                        "a diffuse reflectance (1 or more would create energy)", "in [0, 1)");
 
     // Emission: a radiance, as glTF's and MTL's (E = pi L).
-    Rgb emissive = colour(AI_MATKEY_COLOR_EMISSIVE).value_or(Rgb(0.0f));
+    // An FBX material may hold only the computed "Emissive" (EmissiveColor x EmissiveFactor),
+    // as Assimp's own FBX exporter writes it; Assimp's importer keeps that as a raw property.
+    std::optional<Rgb> emitted = colour(AI_MATKEY_COLOR_EMISSIVE);
+    if (!emitted) emitted = colour("$raw.Emissive", 0, 0);
+    Rgb emissive = emitted.value_or(Rgb(0.0f));
     emissive *= number(AI_MATKEY_EMISSIVE_INTENSITY).value_or(1.0f);
     if (!std::isfinite(emissive.x) || !std::isfinite(emissive.y) || !std::isfinite(emissive.z))
       fail(ErrorCode::parse_error, place, "emissive colour is NaN or infinite");

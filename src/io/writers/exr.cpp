@@ -10,7 +10,9 @@
 #include <ImfStringAttribute.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <exception>
+#include <fstream>
 #include <set>
 #include <string>
 #include <system_error>
@@ -53,6 +55,52 @@ void check_image(const Image& image, const std::filesystem::path& path) {
   }
 }
 
+/// OpenEXR 3.1 allocates each header attribute at the size the file declares before reading
+/// it, so a few corrupt bytes can make it ask for gigabytes (found by the fuzz target: most of
+/// its time went to such allocations). This walks the header (or a multi-part file's headers):
+/// per attribute a name, a type name, a 32-bit little-endian size and the value; a size beyond
+/// the end of the file is refused here, naming the attribute and both figures. Anything else
+/// that is wrong is left for OpenEXR to report.
+void check_exr_header(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  std::ifstream in(path, std::ios::binary);
+  unsigned char start[8];
+  if (ec || !in.read(reinterpret_cast<char*>(start), 8)) return;
+  if (!(start[0] == 0x76 && start[1] == 0x2f && start[2] == 0x31 && start[3] == 0x01)) return;
+  const bool multipart = (start[5] & 0x10) != 0;  // version flags, bit 12
+  // A name or type name: at most 255 characters and a NUL. False when the file ends first.
+  auto read_name = [&](std::string& out) {
+    out.clear();
+    for (char c; in.get(c);) {
+      if (c == '\0') return true;
+      if (out.size() == 255) return false;
+      out += c;
+    }
+    return false;
+  };
+  std::string name, type;
+  for (;;) {
+    bool any = false;
+    while (read_name(name) && !name.empty()) {
+      any = true;
+      unsigned char bytes[4];
+      if (!read_name(type) || !in.read(reinterpret_cast<char*>(bytes), 4)) return;
+      const std::int64_t declared = static_cast<std::int32_t>(static_cast<std::uint32_t>(bytes[0]) |
+                                                              static_cast<std::uint32_t>(bytes[1]) << 8 |
+                                                              static_cast<std::uint32_t>(bytes[2]) << 16 |
+                                                              static_cast<std::uint32_t>(bytes[3]) << 24);
+      const std::int64_t left = static_cast<std::int64_t>(size) - static_cast<std::int64_t>(in.tellg());
+      if (declared < 0 || declared > left)
+        throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': header attribute '" + name + "' (" +
+                                                type + ") declares " + std::to_string(declared) + " bytes, but " +
+                                                std::to_string(left) + " remain in the file");
+      in.seekg(declared, std::ios::cur);
+    }
+    if (!in || !multipart || !any) return;
+  }
+}
+
 }  // namespace
 
 void write_exr(const Image& image, const std::filesystem::path& path) {
@@ -81,6 +129,7 @@ Image read_exr(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw Error(ErrorCode::file_not_found, "read_exr: cannot open '" + path.string() + "': no such file");
+  check_exr_header(path);
   try {
     Imf::InputFile file(path.string().c_str());
     const Imf::Header& header = file.header();
