@@ -1,8 +1,9 @@
 // Cancel latency at every stage (issue #17), shared by tests/solver/test_cancel_latency.cpp
 // (a sanity bound on any machine) and benchmarks/bench_cancel.cpp (the 100 ms target on a quiet
-// one). For each stage (the lights' first shot, the form factors of each estimator,
-// progressive, hierarchical refinement, each renderer, the lightmap baker, the view-factor
-// matrix) a callback asks to cancel `after` seconds into the stage; the probe measures
+// one). For each stage (meshing: solve()'s z-fighting check, contact lines and elements; the
+// lights' first shot, the form factors of each estimator, progressive, hierarchical refinement,
+// each renderer, the lightmap baker, the view-factor matrix) a callback asks to cancel `after`
+// seconds into the stage; the probe measures
 // - the latency: from the callback returning false to the call returning;
 // - the largest gap between two calls of the callback in the stage before that (how long a
 //   host's cancel request can wait to be seen).
