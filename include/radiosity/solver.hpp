@@ -398,7 +398,8 @@ class RADIOSITY_API Problem {
 /// factors are set up, so a scene that emits nothing returns B = 0 without the check; a scene with
 /// lights (Scene::lights()) is solved even when no polygon emits: the lights are the first shot,
 /// docs/LIGHTS.md). A cancelled solve returns the last
-/// consistent estimate with status cancelled.
+/// consistent estimate with status cancelled (cancelled while meshing, which reports
+/// Phase::meshing: a Solution without elements or meshes).
 /// Light that leaves the scene is diagnosed in SolveReport::warnings: emitters that face away
 /// from every surface (find_emitters_facing_away()), and, for a converged solve, a scene that
 /// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses

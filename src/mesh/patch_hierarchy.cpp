@@ -317,10 +317,12 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   }
   const auto count = static_cast<std::uint32_t>(corner_count);
   std::vector<std::uint32_t> polygon_of(count);
-  for (std::size_t p = 0; p < polygons.size(); ++p)
-    if (!stop(p) && first_corner[p] != kNone)
+  for (std::size_t p = 0; p < polygons.size(); ++p) {
+    if (stop(p)) return;
+    if (first_corner[p] != kNone)
       for (std::size_t c = 0; c < polygons[p].vertices.size(); ++c)
         polygon_of[first_corner[p] + c] = static_cast<std::uint32_t>(p);
+  }
   auto next_corner = [&](std::uint32_t c) {
     const std::uint32_t p = polygon_of[c];
     return c + 1 < first_corner[p] + polygons[p].vertices.size() ? c + 1 : first_corner[p];

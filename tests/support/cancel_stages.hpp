@@ -22,6 +22,8 @@
 #include <glm/vec3.hpp>
 #include <radiosity/radiosity.hpp>
 
+#include "support/scenes.hpp"
+
 namespace cancel {
 
 namespace rad = radiosity;
@@ -91,15 +93,7 @@ class Stages {
     scene_.add_light(light());
     rad::Material grey;
     grey.reflectance = rad::Rgb(0.5f);
-    rad::MeshDesc d;
-    d.positions = positions_.data();
-    d.vertex_count = positions_.size();
-    d.indices = indices_.data();
-    d.index_count = indices_.size();
-    d.material = scene_.add_material(grey);
-    d.group = "rug";
-    d.uv1 = uv1_.data();
-    floor_mesh_ = scene_.add_mesh(d);
+    floor_mesh_ = scene_.add_mesh(test::mesh_desc(positions_, indices_, scene_.add_material(grey), "rug", uv1_));
     rad::SolveOptions coarse;
     coarse.mesh.max_element_area = 2500.0f;
     solution_ = std::make_unique<rad::Solution>(rad::solve(scene_, coarse));
@@ -231,14 +225,7 @@ class Stages {
       }
     rad::Material ground;
     ground.reflectance = rad::Rgb(0.3f);
-    rad::MeshDesc d;
-    d.positions = positions.data();
-    d.vertex_count = positions.size();
-    d.indices = indices.data();
-    d.index_count = indices.size();
-    d.material = terrain_.add_material(ground);
-    d.group = "terrain";
-    terrain_.add_mesh(d);
+    terrain_.add_mesh(test::mesh_desc(positions, indices, terrain_.add_material(ground), "terrain"));
     terrain_.add_light(light());
   }
 
