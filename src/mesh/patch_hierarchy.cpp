@@ -508,7 +508,9 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
     return !stopped;
   };
   if (!report(0.0, true)) return false;
-  const detail::KeepGoing keep_going = [&] { return report(0.1); };
+  // Polled by the overlap search and the weld; empty without a callback (nothing to poll).
+  detail::KeepGoing keep_going;
+  if (on_progress) keep_going = [&] { return report(0.1); };
   check_area_option(options.max_patch_area, "max_patch_area");
   check_area_option(options.max_element_area, "max_element_area");
   check_crease_option(options.crease_angle_deg);
@@ -556,7 +558,7 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
   std::vector<bool> cut;
   double tolerance = 0.0;
   if (options_.split_at_contacts) {
-    lines = detail::contact_lines(scene, on_progress ? keep_going : detail::KeepGoing());
+    lines = detail::contact_lines(scene, keep_going);
     if (stopped) return false;
     tolerance = detail::touching_tolerance(scene);
     first_line.assign(polygons.size() + 1, 0);
@@ -567,7 +569,7 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
     if (!report(0.1)) return false;
   }
   Weld weld = options_.crease_angle_deg > 0.0f
-                  ? Weld(polygons, options_.crease_angle_deg, cut, on_progress ? keep_going : detail::KeepGoing())
+                  ? Weld(polygons, options_.crease_angle_deg, cut, keep_going)
                   : Weld();
   if (stopped || !report(0.2)) return false;
   Polygon piece_polygon;
