@@ -41,14 +41,15 @@ void check_row_memory(std::size_t rows, std::size_t unknowns, std::size_t patche
 bool end_sweep(const SolverContext& ctx, SolverResult& result, int it, double change, double seconds) {
   result.iterations = it;
   result.residual = change / ctx.system.emitted;
-  // A sweep that passes on more light than it received diverges (hierarchical links in a
-  // closed scene of reflectance near 1 can): say so rather than return infinite radiosity.
+  // A sweep that passes on more light than it received diverges: say so rather than return
+  // infinite radiosity. (Hierarchical links can gain energy; LinkHierarchy::solve() holds its
+  // sweeps to the maximum principle when they grow, so they should not reach this.)
   if (!std::isfinite(result.residual))
     throw Error(ErrorCode::internal,
                 "the solve diverged after " + std::to_string(it) +
-                    " sweeps (its radiosity grew without bound); with SolverMethod::hierarchical the links of a "
-                    "closed scene of reflectance near 1 can pass on more light than they receive: use "
-                    "SolverMethod::gauss_seidel, a smaller hierarchical.epsilon or lower reflectances");
+                    " sweeps (its radiosity grew without bound): the form factors of a closed scene of "
+                    "reflectance near 1 pass on more light than they receive; try another solver or form-factor "
+                    "method, or lower reflectances");
   result.residual_history.push_back(result.residual);
   result.time_history.push_back(seconds);
   const bool done = result.residual < ctx.options.tolerance;

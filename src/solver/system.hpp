@@ -89,6 +89,9 @@ struct SolverResult {
   std::vector<double> residual_history, time_history;
   std::size_t form_factor_bytes = 0;
   double seconds_form_factors = 0.0;
+  /// Hierarchical: the sweeps grew, and were run again with the irradiance held to the maximum
+  /// principle (LinkHierarchy::solve()).
+  bool held = false;
 };
 
 struct SolverContext {

@@ -350,19 +350,61 @@ TEST_SUITE("solver") {
     CHECK_THROWS_AS(rad::solve(scene, o), rad::Error);
   }
 
-  TEST_CASE("hierarchical: an exported room made two-sided either solves to finite radiosity or says it diverged") {
-    // Outward winding, Kd 1 (clamped to 0.99), a degenerate face, a box resting on the floor:
-    // made two-sided, a closed room of reflectance 0.99 whose links pass on slightly more light
-    // than they receive. Measured: the sweeps diverge after 619 of them (not fixed yet: issue #15's
-    // note); the solve must then throw radiosity::Error, never return infinite or NaN radiosity.
+  TEST_CASE("hierarchical: links that gain energy are held to the maximum principle and converge, with a warning") {
+    // Outward winding, Kd 1 (clamped to 0.99), a degenerate face, a box resting on the floor (its
+    // bottom face on the floor: coincident surfaces, which a receiver inside the box sees twice):
+    // made two-sided, a closed room of reflectance 0.99 whose links pass on more light than they
+    // receive. Before the hold the sweeps diverged after 619 of them (radiosity::Error). Now they
+    // converge, the report says why they were held, and the room's inside agrees with
+    // Gauss-Seidel: measured 18.243 against 18.277 (0.19 %); the inside of the box is lit only
+    // through the coincident floor (Gauss-Seidel 10.2, hierarchical 30.4: the model's ambiguity,
+    // which the z-fighting warning names), and every radiosity stays below the bound max E /
+    // (1 - rho_max) = 3142.
     rad::Scene scene = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/exported_room.obj");
     scene.make_two_sided();
-    try {
-      const rad::Solution sol = rad::solve(scene, hierarchical(0.05f));
-      for (const rad::Rgb& b : sol.radiosity()) CHECK(std::isfinite(b.x + b.y + b.z));
-      for (const rad::Rgb& b : sol.back_radiosity()) CHECK(std::isfinite(b.x + b.y + b.z));
-    } catch (const rad::Error& e) {
-      CHECK(std::string(e.what()).find("diverged") != std::string::npos);
+    const rad::Solution sol = rad::solve(scene, hierarchical(0.05f));
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    bool warned = false;
+    for (const std::string& w : sol.report().warnings) warned = warned || w.find("maximum principle") != std::string::npos;
+    CHECK(warned);
+    const float bound = 31.416f / (1.0f - 0.99f) * 1.001f;
+    for (const rad::Rgb& b : sol.radiosity()) CHECK(std::max({b.x, b.y, b.z}) < bound);
+    for (const rad::Rgb& b : sol.back_radiosity()) CHECK(std::max({b.x, b.y, b.z}) < bound);
+    rad::SolveOptions gs;
+    gs.method = rad::SolverMethod::gauss_seidel;
+    gs.tolerance = 1e-6;
+    const rad::Solution ref = rad::solve(scene, gs);
+    const double inside = sol.group_back_radiosity("room").y, expected = ref.group_back_radiosity("room").y;
+    MESSAGE("inside of the room: hierarchical " << inside << ", gauss-seidel " << expected);
+    CHECK(relative(inside, expected) < 0.02);
+  }
+
+  TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to at most E / (1 - rho)") {
+    // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
+    // The links gain about 1 % here (absorbed / emitted 1.013 at rho 0.8), so the sweeps grow and
+    // are held: measured mean 94.6, largest 99.9987 (before the hold: mean 159 after one pass
+    // held and the next not, or divergence).
+    rad::Material m;
+    m.name = "furnace";
+    m.emission = rad::Rgb(1.0f);
+    m.reflectance = rad::Rgb(0.99f);
+    const rad::Scene scene = test::closed_box(m);
+    rad::SolveOptions o = hierarchical(0.05f);
+    o.tolerance = 1e-5;  // about 1150 sweeps at rho 0.99
+    o.max_iterations = 4000;
+    o.mesh.max_patch_area = 0.26f;
+    o.mesh.max_element_area = 0.07f / 4;
+    const rad::Solution sol = rad::solve(scene, o);
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    double mean = 0.0, largest = 0.0;
+    for (std::uint32_t e : sol.hierarchy().leaves()) {
+      mean += sol.radiosity()[e].y;
+      largest = std::max(largest, static_cast<double>(sol.radiosity()[e].y));
     }
+    mean /= static_cast<double>(sol.hierarchy().leaves().size());
+    MESSAGE("furnace at rho 0.99: mean " << mean << ", largest " << largest << " (exact 100), held "
+                                         << sol.report().warnings.size());
+    CHECK(largest < 100.0 * 1.0001);
+    CHECK(mean > 90.0);
   }
 }

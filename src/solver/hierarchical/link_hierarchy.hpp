@@ -83,8 +83,10 @@ class LinkHierarchy {
 
   /// Jacobi sweeps (gather, push, B = E + rho H + tau H', pull) from `B0` (per unknown) until
   /// the residual is below the tolerance or the iteration cap (SolveOptions), with progress and
-  /// cancel. H in the result is the irradiance from surfaces only.
-  SolverResult solve(const SolverContext& context, const std::vector<Rgb>& B0) const;
+  /// cancel. H in the result is the irradiance from surfaces only. Sweeps that keep growing
+  /// (links that gain energy) start again with each irradiance held to the maximum principle
+  /// (SolverResult::held); `hold` holds from the start (a later pass of a solve that needed it).
+  SolverResult solve(const SolverContext& context, const std::vector<Rgb>& B0, bool hold = false) const;
 
   /// The irradiance per unknown that radiosity `B` (per unknown) sends along the links: one
   /// gather and push. With B = the emission it is the direct irradiance from the emitters.
