@@ -77,7 +77,9 @@ struct Lightmap {
   bool cancelled = false;         ///< on_progress returned false: covered texels so far only
 };
 
-/// Bakes `quantity` of `solution` (solved from `scene`) into the UV1 space of mesh `mesh`. Each
+/// Bakes `quantity` of `solution` (solved from `scene`) into the UV1 space of mesh `mesh`, on
+/// the front side of its triangles (the side their normals face; a two-sided surface's back is
+/// not baked, and solve() warns about two-sided groups lit mainly on their backs). Each
 /// texel that a triangle touches (conservative rasterisation: a thin triangle still gets the
 /// texels it crosses) takes the value at the point of the triangle nearest to the texel centre,
 /// so a texel on a chart border reads the chart's edge; then `dilation` rings of gutter are

@@ -151,6 +151,39 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
   return warnings;
 }
 
+std::vector<std::string> back_lit_warnings(const Scene& scene, const PatchHierarchy& hierarchy,
+                                           const std::vector<Rgb>& front, const std::vector<Rgb>& back) {
+  std::vector<std::string> warnings;
+  if (back.empty()) return warnings;
+  // Power per group from the fronts and the backs of its two-sided opaque elements.
+  std::vector<double> front_power(scene.groups().size(), 0.0), back_power(scene.groups().size(), 0.0);
+  for (const std::uint32_t e : hierarchy.leaves()) {
+    const Polygon& polygon = scene.polygons()[hierarchy.patches()[hierarchy.element(e).patch].polygon];
+    const Material& m = scene.material(polygon.material);
+    if (!m.two_sided || m.diffuse_transmittance != Rgb(0.0f)) continue;
+    const double area = hierarchy.element(e).area;
+    front_power[polygon.group] += area * (front[e].x + front[e].y + front[e].z);
+    back_power[polygon.group] += area * (back[e].x + back[e].y + back[e].z);
+  }
+  std::vector<GroupId> lit;
+  for (GroupId g = 0; g < scene.groups().size(); ++g)
+    if (back_power[g] > 0.0 && back_power[g] > 4.0 * front_power[g]) lit.push_back(g);
+  if (lit.empty()) return warnings;
+  constexpr std::size_t kGroupsShown = 4;
+  std::string who;
+  for (std::size_t k = 0; k < lit.size() && k < kGroupsShown; ++k) {
+    if (k > 0) who += k + 1 == lit.size() ? " and " : ", ";
+    who += "'" + scene.groups()[lit[k]] + "'";
+  }
+  if (lit.size() > kGroupsShown) who += " and " + std::to_string(lit.size() - kGroupsShown) + " more";
+  const bool many = lit.size() > 1;
+  warnings.push_back(std::string(many ? "groups " : "group ") + who + (many ? " are" : " is") +
+                     " lit mainly on the back of " + std::string(many ? "their" : "its") + " two-sided polygons (their normals face away from the light, "
+                     "as in a room modelled with outward normals): solved and rendered right, but lightmaps and "
+                     "per-vertex values hold the front side, which is dark; reverse those polygons' winding");
+  return warnings;
+}
+
 }  // namespace radiosity::detail
 
 namespace radiosity {

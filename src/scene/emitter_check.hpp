@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "radiosity/common.hpp"
+#include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
@@ -47,5 +48,16 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads = 0
 std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& emitted, const Rgb& escaped,
                                                 bool balanced, unsigned threads = 0,
                                                 const std::vector<Rgb>* emission = nullptr);
+
+/// The warning of solve() about two-sided groups lit mainly on their backs: the groups whose
+/// two-sided opaque polygons (Material::two_sided, no diffuse transmission) send, over their
+/// leaf elements, more than four times as much power from their backs as from their fronts
+/// (`front` and `back`: radiosity per element id of `hierarchy`, W/m^2; `back` empty: none).
+/// Such a group's normals face away from its light (a room modelled as a box with outward
+/// normals, made two-sided): solved and rendered right, but whatever reads one side per surface
+/// (lightmaps, per-vertex values) shows its dark front. Empty when there is none; else one
+/// warning naming the groups.
+std::vector<std::string> back_lit_warnings(const Scene& scene, const PatchHierarchy& hierarchy,
+                                           const std::vector<Rgb>& front, const std::vector<Rgb>& back);
 
 }  // namespace radiosity::detail

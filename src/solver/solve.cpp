@@ -768,6 +768,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
                                                        balance_diagnoses, o.threads, emission))
     report.warnings.push_back(std::move(w));
+  if (status == SolveStatus::converged)
+    for (std::string& w : detail::back_lit_warnings(scene, hierarchy, B_elements, B_back))
+      report.warnings.push_back(std::move(w));
   return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
                   r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements),
                   std::move(H_direct));

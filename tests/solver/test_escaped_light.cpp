@@ -103,6 +103,32 @@ TEST_SUITE("solver") {
     CHECK(rad::find_emitters_facing_away(scene).empty());
   }
 
+  TEST_CASE("escaped power: the same room made two-sided keeps its light, and is said to be lit on its back") {
+    // What a user does on the warning above (--two-sided): the light stays, but the room's lit
+    // side is the back of its polygons, which lightmaps and per-vertex values do not hold.
+    rad::Scene scene;
+    rad::Material wall;
+    wall.two_sided = true;
+    const rad::MaterialId white = scene.add_material(wall);
+    const rad::MaterialId light = scene.add_material(lamp());
+    rad::add_box(scene, {0, 0, 0}, {2, 2, 2}, white, "room");
+    rad::add_quad(scene, {0.75f, 1.9f, 0.75f}, {0.5f, 0, 0}, {0, 0, 0.5f}, light, "light");  // faces down
+    const rad::Solution sol = rad::solve(scene, coarse());
+    const rad::SolveReport& r = sol.report();
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    CHECK(std::abs(share(r.escaped_power, r.emitted_power)) < 0.05);  // the light's own back only
+    CHECK(sol.group_back_radiosity("room").x > 10.0f * sol.group_radiosity("room").x);
+    CHECK(has_warning(r, "group 'room' is lit mainly on the back of its two-sided polygons"));
+    CHECK(!has_warning(r, "looks closed"));
+
+    // Wound inwards, two-sided: lit on the front, no warning.
+    rad::Scene inward = test::closed_box(wall, glm::vec3(2.0f));
+    const rad::MaterialId inward_light = inward.add_material(lamp());
+    rad::add_quad(inward, {0.75f, 1.9f, 0.75f}, {0.5f, 0, 0}, {0, 0, 0.5f}, inward_light, "light");
+    const rad::Solution ok = rad::solve(inward, coarse());
+    CHECK(!has_warning(ok.report(), "lit mainly on the back"));
+  }
+
   TEST_CASE("escaped power: an emitter facing away from an open floor is found and named") {
     const rad::Scene scene = floor_and_light(false);
     const std::vector<rad::PolygonId> away = rad::find_emitters_facing_away(scene);
