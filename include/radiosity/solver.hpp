@@ -84,10 +84,12 @@ struct SolveOptions {
   std::size_t memory_budget_bytes = 0;
   /// Shadow rays per element side toward each sky light (Light::sky) where the sky is partly
   /// covered, >= 5: a first fifth decides (all clear or all blocked: no more rays), the rest
-  /// estimate the visible part. Its standard error is about 0.5 / sqrt(sky_rays) where half the
-  /// sky is covered (1.4 % at the default); an occluder covering less than about 5 / sky_rays
-  /// of the cosine-weighted sky can go unseen by the first fifth. Read at a Problem's first solve.
-  std::uint32_t sky_rays = 1280;
+  /// estimate the visible part. Points and directions come from one randomised 4D Halton set,
+  /// whose error falls nearly as 1 / sky_rays (a stratified set's as 1 / sqrt(sky_rays)): on
+  /// issue #15's 22k city the default's element error equals that of 1280 stratified rays
+  /// (docs/LIGHTS.md). An occluder covering less than about 5 / sky_rays of the cosine-weighted
+  /// sky can go unseen by the first fifth. Read at a Problem's first solve.
+  std::uint32_t sky_rays = 640;
   /// With SolverMethod::hierarchical, refinement stays within the meshed elements
   /// (MeshOptions) unless adaptive.enabled, which lets it split elements adaptive.max_depth
   /// levels further (up to adaptive.max_elements leaves); adaptive.threshold is not used there.

@@ -2,6 +2,8 @@
 // Based on:
 //   J. Wallace, K. Elmquist & E. Haines, "A ray tracing algorithm for progressive radiosity",
 //     SIGGRAPH 1989 (direct light onto elements by shadow rays from sample points).
+//   J. H. Halton, Numerische Mathematik 2, 1960, randomised by R. Cranley & T. Patterson, SIAM
+//     J. Numer. Anal. 13(6), 1976 (the sky's points and directions; core/halton.hpp).
 //   M. Cohen & J. Wallace, "Radiosity and Realistic Image Synthesis" (1993), sec. 4.10 (the
 //     unoccluded factor times a visible fraction; here exact unoccluded irradiance, so an
 //     element that sees all of a light gets it without noise).
@@ -15,10 +17,11 @@
 //   I Omega_e / A_e for a point light (the integral of I cos / r^2 over the element is I times
 //   the solid angle it subtends), the spot's falloff integrated over that solid angle, E cos for
 //   a directional light, the closed-form sky irradiance of a plane for a sky (scene/lights.cpp).
-// - V, the visible part, is a weighted fraction of shadow rays from stratified points of the
-//   element: to the light (point, spot), along -direction (directional) or in a
-//   cosine-weighted direction paired with the point by a random permutation of strata (sky;
-//   the padding of visibility.hpp's shuffled pairing). Each ray weighs what its point would
+// - V, the visible part, is a weighted fraction of shadow rays from points of the element: from
+//   stratified points to the light (point, spot) or along -direction (directional); for a sky,
+//   points and cosine-weighted directions from one randomised 4D Halton set (core/halton.hpp:
+//   half the rays of a stratified point set shuffled against a stratified direction set, for
+//   the same error; docs/LIGHTS.md). Each ray weighs what its point would
 //   receive unoccluded (I t cos / r^2; the sky's radiance in its direction), so V is the
 //   irradiance-weighted visible fraction. A first pass whose rays all agree gives V = 1 or 0;
 //   otherwise a second, larger pass is cast and both make the estimate (visibility.hpp's idea).
@@ -28,12 +31,14 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <glm/geometric.hpp>
 
 #include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/frame.hpp"
+#include "core/halton.hpp"
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
 #include "core/sampling.hpp"
@@ -164,19 +169,23 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
     // Generates and traces one pass of `points` rays; returns how many were traced and how many
     // of those were clear, adding their weights to the sums.
     double weight_sum = 0.0, visible_sum = 0.0;
-    std::uint32_t traced_total = 0, clear_total = 0;
+    std::uint32_t traced_total = 0, clear_total = 0, drawn = 0;
+    // A sky's rays: points and directions from one randomised Halton set in four dimensions,
+    // the second pass continuing the first's points (core/halton.hpp).
+    const std::optional<ShiftedHalton4> halton = sky ? std::optional<ShiftedHalton4>(rng) : std::nullopt;
     auto pass = [&](std::uint32_t points, std::uint32_t& traced, std::uint32_t& clear) {
       r.point_uv.resize(points);
       r.origin.resize(points);
       r.direction.resize(points);
       r.weight.resize(points);
       r.blocked.resize(points);
-      stratified(points, rng, true, r.point_uv.data());
       if (sky) {
         r.direction_uv.resize(points);
-        stratified(points, rng, true, r.direction_uv.data());
-        shuffle(r.direction_uv.data(), points, rng);
+        for (std::uint32_t k = 0; k < points; ++k) halton->point(drawn + k, r.direction_uv[k], r.point_uv[k]);
+      } else {
+        stratified(points, rng, true, r.point_uv.data());
       }
+      drawn += points;
       traced = 0;
       for (std::uint32_t k = 0; k < points; ++k) {
         const glm::vec3 x = sampler(r.point_uv[k]);
