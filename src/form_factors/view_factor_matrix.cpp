@@ -23,6 +23,7 @@
 #include <string>
 
 #include "core/frame.hpp"
+#include "core/halton.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -108,9 +109,10 @@ bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
       glm::vec3 t, b;
       detail::tangent_frame(normal, t, b);
       detail::Rng rng(ff.seed, e, detail::stream_key(detail::Stream::view_factor_sky));
-      detail::stratified(n, rng, true, points.data());
-      detail::stratified(n, rng, true, directions.data());
-      detail::shuffle(directions.data(), n, rng);
+      // Points and directions from one randomised 4D Halton set (core/halton.hpp), as the
+      // Monte Carlo rows and the lights' first shot draw theirs.
+      const detail::ShiftedHalton4 halton(rng);
+      for (std::uint32_t i = 0; i < n; ++i) halton.point(i, directions[i], points[i]);
       for (std::uint32_t i = 0; i < n; ++i) {
         const glm::vec3 w = detail::cosine_hemisphere(directions[i]);
         origin[i] = hierarchy.sample_point(e, points[i]) + epsilon * normal;
