@@ -18,9 +18,9 @@ namespace radiosity::detail {
 /// Rays per (element side, light): a first pass, and a larger second one only when the first
 /// pass's rays disagree (the element straddles a shadow edge, or sees the sky in part), the
 /// two-pass idea of visibility.hpp. Delta lights need few rays (one ray decides a point); sky
-/// visibility is a hemisphere's: occluders that cover less than about 1/256 of the cosine-weighted
-/// sky can be missed by the first pass (a bias of at most that), and a half-covered sky has a
-/// standard error of about 1 % with 1280 rays.
+/// visibility is a hemisphere's: occluders that cover less than about 5 / sky_rays of the
+/// cosine-weighted sky can be missed by the first pass (a bias of at most that); the default 640
+/// Halton rays give the element error 1280 independent-stratified rays did (docs/LIGHTS.md).
 struct LightRayBudget {
   std::uint32_t first = 16;
   std::uint32_t penumbra = 256;
