@@ -178,9 +178,10 @@ std::vector<std::string> back_lit_warnings(const Scene& scene, const PatchHierar
   if (lit.size() > kGroupsShown) who += " and " + std::to_string(lit.size() - kGroupsShown) + " more";
   const bool many = lit.size() > 1;
   warnings.push_back(std::string(many ? "groups " : "group ") + who + (many ? " are" : " is") +
-                     " lit mainly on the back of " + std::string(many ? "their" : "its") + " two-sided polygons (their normals face away from the light, "
-                     "as in a room modelled with outward normals): solved and rendered right, but lightmaps and "
-                     "per-vertex values hold the front side, which is dark; reverse those polygons' winding");
+                     " lit mainly on the back of " + (many ? "their" : "its") +
+                     " two-sided polygons (their normals face away from the light, as in a room modelled with "
+                     "outward normals): solved and rendered right, but lightmaps and per-vertex values hold the "
+                     "front side, which is dark; reverse those polygons' winding");
   return warnings;
 }
 

@@ -1062,8 +1062,9 @@ struct LinkHierarchy::Impl {
   /// the whole: in a closed room of reflectance 0.99 a net gain of 1 % made the sweeps diverge
   /// (an exported room made two-sided, after 619 sweeps). Capped so, each sweep's power is at
   /// most the emitted power plus rho_max times the last sweep's: bounded for any rho < 1. In an
-  /// open scene, or where the links lose light, nothing changes. Applied with gather()'s hold
-  /// (the same bias when not needed).
+  /// open scene, or where the links lose light, nothing changes. Applied only together with
+  /// gather()'s hold: where the links do not gain energy overall, capping the sweeps that happen
+  /// to would bias them low for nothing.
   static void cap_delivered_power(const RadiositySystem& sys, const std::vector<Rgb>& B, std::vector<Rgb>& H) {
     glm::dvec3 sent(0.0), delivered(0.0);
     for (std::size_t u = 0; u < sys.unknowns(); ++u) {
