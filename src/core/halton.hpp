@@ -57,7 +57,7 @@ inline const std::vector<std::array<float, 4>>& halton_table() {
 /// Thread safety: a value.
 class ShiftedHalton4 {
  public:
-  explicit ShiftedHalton4(Rng& rng) {
+  explicit ShiftedHalton4(Rng& rng) : table_(halton_table().data()) {
     const glm::vec2 a = rng.uniform2(), b = rng.uniform2();
     shift_ = {a.x, a.y, b.x, b.y};
   }
@@ -66,7 +66,7 @@ class ShiftedHalton4 {
   void point(std::uint32_t k, glm::vec2& first, glm::vec2& second) const {
     std::array<float, 4> h;
     if (k < kHaltonTable) {
-      h = halton_table()[k];
+      h = table_[k];
     } else {
       h = {static_cast<float>(radical_inverse(k + 1, 2)), static_cast<float>(radical_inverse(k + 1, 3)),
            static_cast<float>(radical_inverse(k + 1, 5)), static_cast<float>(radical_inverse(k + 1, 7))};
@@ -81,6 +81,8 @@ class ShiftedHalton4 {
     const float w = x >= 1.0f ? x - 1.0f : x;
     return w < 1.0f ? w : 0x1.fffffep-1f;
   }
+  // The table, looked up once: point() runs per ray, and halton_table()'s static needs a guard check.
+  const std::array<float, 4>* table_;
   std::array<float, 4> shift_{};
 };
 

@@ -562,7 +562,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       limits.max_leaves = o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * initial_leaves;
     }
     std::vector<Rgb> B_now = system->source;
-    bool solved = false, held_warning = false;
+    // held: an earlier pass's sweeps grew and were held (the maximum principle); later passes
+    // start held, and the warning below is given once.
+    bool solved = false, held = false;
     for (int pass = 1; pass <= o.hierarchical.max_passes; ++pass) {
       // The oracle's scale: the scene's mean radiosity estimate, power emitted (lights
       // included) per area times the mean interreflection factor.
@@ -598,9 +600,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       if (solved && split.empty() && stats.links_replaced == 0) break;  // nothing changed
       report.refinement_passes = pass;
       detail::SolverContext context{scene, hierarchy, *system, nullptr, o, gate, nullptr};
-      r = links->solve(context, solved ? current_B() : std::vector<Rgb>{}, held_warning);
-      if (r.held && !held_warning) {
-        held_warning = true;
+      r = links->solve(context, solved ? current_B() : std::vector<Rgb>{}, held);
+      if (r.held && !held) {
+        held = true;
         report.warnings.push_back(
             "hierarchical: the links passed on more light than they received (a closed region of reflectance near 1, "
             "or coincident surfaces seen twice), so the sweeps grew; they were run again with each irradiance held "

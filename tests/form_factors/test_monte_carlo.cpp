@@ -13,6 +13,7 @@
 
 #include "form_factors/ff_support.hpp"
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 using namespace fftest;
 
@@ -349,7 +350,8 @@ rad::Scene mirror_room(float mirror) {
 }  // namespace
 
 TEST_SUITE("form_factors") {
-  TEST_CASE("mirror form factors: a tile above a mirror floor gets rho r F(tile -> mirrored light) E plus its own image") {
+  TEST_CASE("mirror form factors: a tile above a mirror floor gets rho r F(tile -> mirrored light) E plus its own image"
+            * test::release_only) {
     // The reference: the factor to the light's mirror image, by the analytic estimator.
     rad::Scene image;
     const rad::MaterialId m = image.add_material(rad::Material{});

@@ -16,6 +16,7 @@
 
 #include "form_factors/ff_support.hpp"
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 using namespace fftest;
 
@@ -105,7 +106,8 @@ TEST_SUITE("form_factors") {
   }
 
   TEST_CASE(
-      "closed box around a floating cube: rows still sum to 1 and A_i F_ij = A_j F_ji (ray_cast 1% - hemicube 2%)") {
+      "closed box around a floating cube: rows still sum to 1 and A_i F_ij = A_j F_ji (ray_cast 1% - hemicube 2%)"
+      * test::release_only) {
     // The room's walls see each other only in part; what the cube hides, it receives.
     std::vector<Poly> polys;
     const glm::dvec3 lo(0.35, 0.3, 0.4), hi(0.65, 0.6, 0.7);

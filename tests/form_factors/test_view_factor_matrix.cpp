@@ -15,6 +15,7 @@
 #include "../../tools/radiosity/npz_format.hpp"
 #include "form_factors/view_factor_rows.hpp"
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 namespace {
 
@@ -129,7 +130,8 @@ std::pair<std::string, std::string> parse_npy(const std::string& npy) {
 
 TEST_SUITE("form_factors") {
   TEST_CASE("view_factor_matrix per facet: the faceted 1x2x3 box against Howell C-11 and C-14, facet to facet and "
-            "face to face - the exact mode within 1e-4 - monte_carlo within its stated standard error") {
+            "face to face - the exact mode within 1e-4 - monte_carlo within its stated standard error"
+            * test::release_only) {
     const rad::Scene s = faceted_box(1, 2, 3, 0.5f);  // 2x4 + 2x6 + 4x6 facets per face pair: 88 polygons
     rad::ViewFactorOptions o;
     o.level = rad::ViewFactorLevel::polygon;

@@ -60,18 +60,13 @@ seeds() {
   if [ -d "$root/tests/data/fuzz/$format" ]; then cp "$root/tests/data/fuzz/$format"/* "$dir/" 2>/dev/null || true; fi
 }
 
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
-export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/lsan.supp}"
+source "$root/tests/fuzz/fuzz_env.sh"
 
 # fuzz_one FORMAT: one target's run; prints its figures, returns 1 on a finding.
 fuzz_one() {
-  local format="$1" exe="$build/bin/radiosity_fuzz_$1" log="$work/$1.log" leaks=1
+  local format="$1" exe="$build/bin/radiosity_fuzz_$1" log="$work/$1.log" leaks
+  leaks="$(fuzz_detect_leaks "$format")"
   mkdir -p "$work/corpus/$format" "$work/artifacts/$format"
-  # Assimp leaks on most broken files (suppressed: tests/lsan.supp), and libFuzzer then scans
-  # the heap after every such input: the FBX target ran 13 times slower. For Assimp's formats
-  # leaks are checked once, when the target exits (AddressSanitizer's own check).
-  case "$format" in ply | stl | dae | fbx | 3ds) leaks=0 ;; esac
   # -seed fixed: the same mutations each run on the same corpus.
   if "$exe" -seed=1 -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 -detect_leaks="$leaks" \
       -artifact_prefix="$work/artifacts/$format/" "$work/corpus/$format" "$work/seeds/$format" > "$log" 2>&1; then

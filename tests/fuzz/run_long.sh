@@ -20,11 +20,8 @@ format="$2"
 millions="$3"
 first="${4:-1}"
 root="$(cd "$(dirname "$0")/../.." && pwd)"
-export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/tests/lsan.supp}"
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
-export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-leaks=1
-case "$format" in ply | stl | dae | fbx | 3ds) leaks=0 ;; esac
+source "$root/tests/fuzz/fuzz_env.sh"
+leaks="$(fuzz_detect_leaks "$format")"
 work="$build/fuzz"
 mkdir -p "$work/long" "$work/artifacts/$format" "$work/corpus/$format"
 for ((k = first; k < first + millions; ++k)); do

@@ -136,7 +136,7 @@ TEST_SUITE("path_tracer") {
     CHECK(std::fabs(ratio - 1.0) < 0.015);
   }
 
-  TEST_CASE("each MTL illum mode path-traces within noise of the same material built in code") {
+  TEST_CASE("each MTL illum mode path-traces within noise of the same material built in code" * test::release_only) {
     {
       rad::Material m;  // illum 2: Phong from Ks and Ns
       m.reflectance = Rgb(0.3f, 0.4f, 0.5f);

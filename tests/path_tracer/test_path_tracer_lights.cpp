@@ -12,6 +12,7 @@
 #include "image/camera.hpp"
 #include "support/pixel_groups.hpp"
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
@@ -31,7 +32,8 @@ rad::Light sun() {
 }  // namespace
 
 TEST_SUITE("path_tracer") {
-  TEST_CASE("lights: sunlight through a window into a room matches the radiosity display group by group") {
+  TEST_CASE("lights: sunlight through a window into a room matches the radiosity display group by group"
+            * test::release_only) {
     // A directional light (10 W/m^2 travelling along (0.2, -1, 0.3)) through a hole in the
     // ceiling of a closed room: the sun patch on the floor lights the walls.
     rad::Scene scene = test::window_room();

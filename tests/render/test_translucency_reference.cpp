@@ -10,6 +10,7 @@
 #include <radiosity/radiosity.hpp>
 
 #include "support/images.hpp"
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
@@ -36,7 +37,7 @@ rad::Image blocks(const rad::Image& image, int b) {
 }  // namespace
 
 TEST_SUITE("render") {
-  TEST_CASE("the Cornell box with a translucent diffuser matches its path-traced reference") {
+  TEST_CASE("the Cornell box with a translucent diffuser matches its path-traced reference" * test::release_only) {
     const rad::Scene scene = rad::load_scene(kScene);
     const rad::Image P = rad::read_exr(kReference);
     REQUIRE(P.width == 64);

@@ -45,7 +45,8 @@ rad::Scene props_on_floor() {
 }  // namespace
 
 TEST_SUITE("solver") {
-  TEST_CASE("a box resting on the floor and a sphere sunk into it are lit as the path tracer lights them") {
+  TEST_CASE("a box resting on the floor and a sphere sunk into it are lit as the path tracer lights them"
+            * test::release_only) {
     const rad::Scene scene = props_on_floor();
     // The geometry really touches: the box's bottom lies on the floor, the ball crosses it.
     bool coincident = false, crossing = false;
@@ -57,18 +58,14 @@ TEST_SUITE("solver") {
     CHECK(crossing);
 
     const double pi = 3.14159265358979323846;
-    std::vector<rad::FormFactorMethod> methods{rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::hemicube,
-                                               rad::FormFactorMethod::monte_carlo};
-    // Under the sanitizers one estimator (the others' contact handling is the same rays', or
-    // the hemicube's, which test_occlusion.cpp covers there too).
-    if (test::kSanitizerBuild) methods.resize(1);
+    const std::vector<rad::FormFactorMethod> methods{rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::hemicube,
+                                                     rad::FormFactorMethod::monte_carlo};
     for (rad::FormFactorMethod method : methods) {
       CAPTURE(static_cast<int>(method));
       rad::SolveOptions o;
       o.form_factors.method = method;
       // 64 rather than 128: the same figures (display RMSE 0.049 against the path tracer, the
-      // box's bottom at 3e-4 of the floor) at 60 % of the time, which under the sanitizers is
-      // this suite's longest test.
+      // box's bottom at 3e-4 of the floor) at 60 % of the time.
       o.form_factors.hemicube_resolution = 64;
       o.mesh.max_element_area = 0.01f;  // 10 cm elements
       o.tolerance = 1e-4;
@@ -100,10 +97,6 @@ TEST_SUITE("solver") {
         return c.x > 0.15f && c.x < 0.27f && c.z > 1.14f && c.z < 1.26f;
       });
       MESSAGE("strip beside the box: radiosity " << strip);
-      // The renders against the path tracer below take most of this test's time under the
-      // sanitizers, where the renderers' code paths are covered by their own tests.
-      if (test::kSanitizerBuild) continue;
-
       // The view a user would look at: radiosity's display against the path tracer, looking
       // down at both props from above the room's middle.
       rad::RenderOptions ro;

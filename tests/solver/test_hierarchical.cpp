@@ -10,6 +10,7 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "support/build.hpp"
 #include "support/scenes.hpp"
 
 namespace rad = radiosity;
@@ -375,6 +376,9 @@ TEST_SUITE("solver") {
     const float bound = 31.416f / (1.0f - 0.99f) * 1.001f;
     for (const rad::Rgb& b : sol.radiosity()) CHECK(std::max({b.x, b.y, b.z}) < bound);
     for (const rad::Rgb& b : sol.back_radiosity()) CHECK(std::max({b.x, b.y, b.z}) < bound);
+    // The sanitizer builds check the hold's code paths; the comparison's Gauss-Seidel solve at
+    // reflectance 0.99 would double their time, and is the Release build's.
+    if (test::kSanitizerBuild) return;
     rad::SolveOptions gs;
     gs.method = rad::SolverMethod::gauss_seidel;
     gs.tolerance = 1e-6;

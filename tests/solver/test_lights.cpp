@@ -10,6 +10,7 @@
 #include <radiosity/radiosity.hpp>
 
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
@@ -247,7 +248,8 @@ TEST_SUITE("solver") {
     CHECK_THROWS_AS(rad::solve(scene, bad), rad::Error);
   }
 
-  TEST_CASE("lights: in a closed box lit by a point light every solver and estimator gives B = rho H and absorbs 4 pi I") {
+  TEST_CASE("lights: in a closed box lit by a point light every solver and estimator gives B = rho H and absorbs 4 pi I"
+            * test::release_only) {
     // Every ray of the light meets a wall: the walls receive 4 pi I (the solid angles of the
     // elements add up to the sphere's, exactly), and a closed box absorbs all of it.
     rad::Material m;

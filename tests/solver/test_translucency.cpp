@@ -10,6 +10,7 @@
 #include <radiosity/radiosity.hpp>
 
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
@@ -166,7 +167,8 @@ TEST_SUITE("solver") {
     }
   }
 
-  TEST_CASE("translucent partition in a closed box: absorbed power equals emitted and the solvers agree") {
+  TEST_CASE("translucent partition in a closed box: absorbed power equals emitted and the solvers agree"
+            * test::release_only) {
     // A closed grey box with an emitting ceiling, split by a one-sided translucent partition.
     // In a closed enclosure every ray lands on a side that keeps a radiosity, so all the power
     // is absorbed: by the walls (1 - rho) H and by the partition's sides (1 - rho - tau) H.
@@ -227,7 +229,7 @@ TEST_SUITE("solver") {
     }
   }
 
-  TEST_CASE("adaptive subdivision keeps both sides of translucent elements") {
+  TEST_CASE("adaptive subdivision keeps both sides of translucent elements" * test::release_only) {
     // The partitioned box refined where radiosity varies fast: the matrix methods compute front
     // and back rows for the new elements, progressive gathers both sides for them. Every leaf of
     // the paper ends with a back radiosity, and the two agree.

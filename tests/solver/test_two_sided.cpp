@@ -11,6 +11,7 @@
 #include <radiosity/radiosity.hpp>
 
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
@@ -186,7 +187,7 @@ TEST_SUITE("solver") {
     }
   }
 
-  TEST_CASE("two-sided sheets in a room match the reference path tracer on both sides") {
+  TEST_CASE("two-sided sheets in a room match the reference path tracer on both sides" * test::release_only) {
     // A closed room (inward) lit by a ceiling lamp, with a two-sided table top (one quad) in
     // the middle: its top is lit directly, its underside only by the floor's light. The path
     // tracer renders two-sided materials with the same rule (reflect and emit on both sides).

@@ -12,11 +12,13 @@
 
 #include "support/pixel_groups.hpp"
 #include "support/scenes.hpp"
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
 TEST_SUITE("two_pass") {
-  TEST_CASE("lights: the two-pass view and the path tracer agree with the radiosity display under a point light and a sky") {
+  TEST_CASE("lights: the two-pass view and the path tracer agree with the radiosity display under a point light and a sky"
+            * test::release_only) {
     rad::Scene scene = test::window_room();
     rad::Light lamp, sky;
     lamp.intensity = 0.3f;
