@@ -285,7 +285,8 @@ TEST_SUITE("form_factors") {
     }
   }
 
-  TEST_CASE("monte_carlo Cornell box: group radiosities within 1% of the ray_cast solution for every method") {
+  TEST_CASE("monte_carlo Cornell box: group radiosities within 1% of the ray_cast solution for every method"
+            * test::not_under_thread_sanitizer) {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;
     o.mesh.max_patch_area = 12000.0f;

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <radiosity/radiosity.hpp>
+#include "support/build.hpp"
 
 namespace rad = radiosity;
 
@@ -38,7 +39,8 @@ std::vector<double> lu_solve(std::vector<double> A, std::vector<double> b, std::
 }  // namespace
 
 TEST_SUITE("solver") {
-  TEST_CASE("every method agrees with a dense LU solve of the same discrete system within 0.1%") {
+  TEST_CASE("every method agrees with a dense LU solve of the same discrete system within 0.1%"
+            * test::not_under_thread_sanitizer) {
     const rad::Scene scene = rad::cornell_box();
     rad::SolveOptions o;
     o.mesh.max_patch_area = 20000.0f;

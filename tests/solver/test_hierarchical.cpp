@@ -196,7 +196,8 @@ TEST_SUITE("solver") {
     }
   }
 
-  TEST_CASE("hierarchical: the Cornell box agrees with Gauss-Seidel over element-to-element factors") {
+  TEST_CASE("hierarchical: the Cornell box agrees with Gauss-Seidel over element-to-element factors"
+            * test::not_under_thread_sanitizer) {
     // The reference's targets are the elements themselves (patches = elements), as the links'
     // finest ends are: with element-to-patch factors a patch half hidden under a block sends its
     // mean radiosity from its visible half too, an error of the reference of up to 40 % on the
