@@ -32,9 +32,9 @@ phase "build (clang: ASan + UBSan, fuzz targets)"
 # report leaks that are not ours; the split code's single-process parts are tested there anyway.
 # -g1 (line tables): the sanitizers' reports keep file and line, and the build takes about a
 # quarter less time than with full debug information. clang, because libFuzzer is clang's; the
-# library is compiled with coverage feedback for the fuzzers (RADIOSITY_FUZZ). The tests, the
-# command and the fuzz targets at -O0 (RADIOSITY_NON_LIBRARY_FLAGS): half the compile time, and
-# the library they exercise keeps -O2.
+# library is compiled with coverage feedback for the fuzzers (RADIOSITY_FUZZ). The command and
+# the fuzz targets at -O0 (RADIOSITY_NON_LIBRARY_FLAGS): half their compile time; the library
+# keeps -O2.
 sanitizer_flags=(-DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DRADIOSITY_WERROR=ON
   -DRADIOSITY_BUILD_EXAMPLES=OFF -DRADIOSITY_BUILD_BENCHMARKS=OFF -DRADIOSITY_PYTHON=OFF -DRADIOSITY_MPI=OFF

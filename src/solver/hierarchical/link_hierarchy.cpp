@@ -539,8 +539,10 @@ struct LinkHierarchy::Impl {
         weight.push_back(glm::dot(nx, d) * -glm::dot(ny, d) / (d2 * std::max(d2, weight_floor2_)));
       }
       blocked.resize(origin.size());
-      m_.occluders.occluded_incoherent(origin.size(), origin.data(), direction.data(), 0.0f, 1.0f - 1e-4f,
-                                       blocked.data());
+      // As coherent packets: a link's rays join two nodes, a bundle. The same answers as one
+      // ray at a time; the 246k city's links 17.7 s -> 16.6-17.2 s (Embree's traversal is a
+      // quarter of their time; drawing the points is most of the rest).
+      m_.occluders.occluded(origin.size(), origin.data(), direction.data(), 0.0f, 1.0f - 1e-4f, blocked.data());
       rays += origin.size();
       Result out;
       out.cast = static_cast<int>(origin.size());
