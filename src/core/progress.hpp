@@ -13,6 +13,11 @@
 
 namespace radiosity::detail {
 
+/// Wall-clock seconds since t0, for the timings in the reports.
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 /// Rate-limited progress reporting on the calling thread. report() returns false when the
 /// callback asked to cancel. Holds a reference to the callback, which must outlive it.
 class ProgressGate {

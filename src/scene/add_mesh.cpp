@@ -21,7 +21,7 @@ inline namespace v1 {
 
 namespace {
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+using detail::finite;
 bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
 /// "5, 17 and 230" or "5, 17, 230, ... and 12 more".

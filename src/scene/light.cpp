@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "radiosity/scene.hpp"
+#include "scene/polygon_math.hpp"
 
 namespace radiosity {
 inline namespace v1 {
@@ -23,7 +24,6 @@ const char* type_name(LightType type) {
   return "unknown";
 }
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 std::string text(const glm::vec3& v) {
   std::ostringstream s;
@@ -48,8 +48,8 @@ LightId Scene::add_light(const Light& given) {
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(given.color[c]) || given.color[c] < 0.0f)
       fail("color", text(given.color) + " must be finite and >= 0 per channel");
-  if (!finite(given.position)) fail("position", text(given.position) + " must be finite");
-  if (!finite(given.direction)) fail("direction", text(given.direction) + " must be finite");
+  if (!detail::finite(given.position)) fail("position", text(given.position) + " must be finite");
+  if (!detail::finite(given.direction)) fail("direction", text(given.direction) + " must be finite");
   if (!std::isfinite(given.inner_cone_deg) || !std::isfinite(given.outer_cone_deg) || given.inner_cone_deg < 0.0f ||
       given.inner_cone_deg > given.outer_cone_deg || given.outer_cone_deg > 90.0f)
     fail("inner_cone_deg/outer_cone_deg",

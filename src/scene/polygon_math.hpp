@@ -20,6 +20,9 @@ inline constexpr float kDegenerateAreaRatio = 1e-7f;
 /// is 1000 km in millimetres, where float's spacing is already 64 units.
 inline constexpr float kMaxCoordinate = 1e9f;
 
+/// Whether every coordinate of `v` is finite.
+inline bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
 /// Whether `v` is a position a scene can hold: finite, every coordinate within kMaxCoordinate.
 inline bool usable_position(const glm::vec3& v) {
   return std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate && std::fabs(v.z) <= kMaxCoordinate;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/assert.hpp"
+#include "core/color.hpp"
 #include "core/parallel.hpp"
 #include "solver/system.hpp"
 
@@ -17,7 +18,6 @@ namespace radiosity::detail {
 
 namespace {
 
-double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z); }
 
 }  // namespace
 
@@ -206,7 +206,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       });
       if (split) split->all_gather(result.H, blocks);
       for (std::size_t i = 0; i < m; ++i) next[i] = radiosity(i, result.H[i]);
-      for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * l1(next[i] - result.B[i]);
+      for (std::size_t i = 0; i < m; ++i) change += sys.area[i] * channel_l1(next[i] - result.B[i]);
       result.B.swap(next);
     } else {
       // Gauss-Seidel: each side sees the patch means already updated by earlier sides. A new
@@ -215,7 +215,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       auto set = [&](std::size_t i) {
         const Rgb b = radiosity(i, result.H[i]);
         const Rgb d = b - result.B[i];
-        change += sys.area[i] * l1(d);
+        change += sys.area[i] * channel_l1(d);
         patch_B[sys.patch[i]] += (sys.area[i] / sys.patch_area[sys.patch[i]]) * d;
         result.B[i] = b;
       };

@@ -16,11 +16,6 @@
 
 namespace radiosity::detail {
 
-/// Wall-clock seconds since t0, for the timings in SolveReport.
-inline double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 /// B_e = E_e + rho_e sum_j F_ej B_j over the leaves e and patches j, B_j the area-weighted
 /// mean of patch j's leaves.
 ///

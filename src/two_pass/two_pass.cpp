@@ -27,6 +27,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "core/parallel.hpp"
+#include "core/progress.hpp"
 #include "core/rng.hpp"
 #include "core/sampling.hpp"
 #include "core/color.hpp"
@@ -58,9 +59,7 @@ const char* const kLayerNames[kLayers] = {"direct", "indirect", "specular", "cau
   throw Error(ErrorCode::invalid_argument, "TwoPassOptions::" + what);
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using detail::seconds_since;
 
 /// The scene as pass 2 traces it, its emitters and lights at the weights of pass 1's light
 /// groups (all 1 unless pass 1 was relit).

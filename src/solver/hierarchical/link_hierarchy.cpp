@@ -18,6 +18,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/assert.hpp"
+#include "core/color.hpp"
 #include "core/constants.hpp"
 #include "core/growable_array.hpp"
 #include "core/memory_budget.hpp"
@@ -88,7 +89,6 @@ int receiver_grid(float d, float R) { return d >= 6.0f * R ? 1 : d >= 3.0f * R ?
 constexpr int kCorrectionLevels = 3;
 
 float mean(const Rgb& c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
-double l1(const Rgb& c) { return std::fabs(c.x) + std::fabs(c.y) + std::fabs(c.z); }
 
 struct Pair {
   NodeHandle receiver, source;
@@ -1213,7 +1213,7 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
       Rgb b = sys.source[u] + sys.reflectance[u] * result.H[u];
       if (sys.twin[u] != kNone) b += sys.transmittance[u] * result.H[sys.twin[u]];
       next[u] = b;
-      change += sys.area[u] * l1(b - result.B[u]);
+      change += sys.area[u] * channel_l1(b - result.B[u]);
     }
     growing = change > last_change ? growing + 1 : 0;
     last_change = change;
