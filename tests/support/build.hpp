@@ -21,8 +21,9 @@ inline constexpr bool kThreadSanitizerBuild = RADIOSITY_TEST_THREAD_SANITIZER_BU
 /// only repeat them with more samples, at ten times the cost. A skipped case is not listed, so
 /// ctest does not register it in those builds.
 inline const doctest::skip release_only{kSanitizerBuild};
-/// `TEST_CASE("..." * test::not_under_thread_sanitizer)`: a serial check (meshing, geometry) in a
-/// module the ThreadSanitizer build covers; the Release and AddressSanitizer builds run it.
+/// `TEST_CASE("..." * test::not_under_thread_sanitizer)`: a check in a module the
+/// ThreadSanitizer build covers whose parallel loops other tests there run too (serial meshing,
+/// the estimators' closed-form accuracy); the Release and AddressSanitizer builds run it.
 inline const doctest::skip not_under_thread_sanitizer{kThreadSanitizerBuild};
 
 }  // namespace test
