@@ -87,6 +87,13 @@ int receiver_grid(float d, float R) { return d >= 6.0f * R ? 1 : d >= 3.0f * R ?
 /// Three levels rather than two: walls' mean on the 22k city -0.87 % -> -0.78 % against the
 /// reference, at no measurable cost.
 constexpr int kCorrectionLevels = 3;
+/// The centroid rule underestimates a convex kernel at every level, by about the square of the
+/// nodes' size for their distance; one level down a cluster (two children) halves the area of
+/// flat parts, so the error about halves, and T3 + (T3 - T2) (Richardson's extrapolation of
+/// the last two levels) removes most of what is left. Measured on the 22k city against its
+/// reference: mean -0.17 % -> -0.12 %, walls -0.37 % -> -0.29 %, element RMS 1.72 % -> 1.71 %
+/// (half the step: -0.15 %, walls -0.33 %).
+constexpr float kExtrapolate = 1.0f;
 
 float mean(const Rgb& c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 
@@ -820,7 +827,10 @@ struct LinkHierarchy::Impl {
         if (refined_transport(h, r, s, kCorrectionLevels) > 0.0f) refine();
         return;
       }
-      coefficient *= std::clamp(refined_transport(h, r, s, kCorrectionLevels) / coarse, 0.25f, 4.0f);
+      // Extrapolated from the last two levels (kExtrapolate).
+      const float fine = refined_transport(h, r, s, kCorrectionLevels);
+      const float extrapolated = fine + kExtrapolate * (fine - refined_transport(h, r, s, kCorrectionLevels - 1));
+      coefficient *= std::clamp(extrapolated / coarse, 0.25f, 4.0f);
     }
     if (!(coefficient > 0.0f)) return;
     // Visibility: a pilot pass decides, fresh rays estimate. A partly hidden pilot (a shadow
