@@ -36,6 +36,7 @@ enum class Stream : std::uint64_t {
   two_pass_sky = 0xd1ec7001ull,          ///< per element: sky rays of the direct part of pass 1
   // Hierarchical radiosity (key_a: the link's receiver and source handles, 32 bits each).
   hierarchical_link = 0xe0000000000ull,  ///< a link's visibility rays
+  hierarchical_enclosure = 0xe1000000000ull,  ///< key_a 2 x element + back: a side's enclosure rays
   // View factors (key_a: the element).
   view_factor_sky = 0xf0000000000ull,    ///< an element's rays for its sky view factor
 };
@@ -63,7 +64,7 @@ constexpr Range kRanges[] = {
     {stream_key(Stream::lightmap_gather), 1},               {stream_key(Stream::lightmap_light), 1ull << 31},
     {stream_key(Stream::light_front), 1ull << 31},          {stream_key(Stream::light_back), 1ull << 31},
     {stream_key(Stream::two_pass_sky), 1},                  {stream_key(Stream::hierarchical_link), 1},
-    {stream_key(Stream::view_factor_sky), 1},
+    {stream_key(Stream::view_factor_sky), 1},               {stream_key(Stream::hierarchical_enclosure), 1},
 };
 
 constexpr bool disjoint() {

@@ -2,6 +2,7 @@
 // the form factors, and solve for the materials' emission or any other.
 #include <chrono>
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -770,6 +771,23 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   for (std::string& w : detail::escaped_light_warnings(scene, report.emitted_power, report.escaped_power,
                                                        balance_diagnoses, o.threads, emission))
     report.warnings.push_back(std::move(w));
+  // The links lose or gain a few per cent of what they carry (docs/HIERARCHICAL.md, "A room as
+  // an exporter writes it"), which in a closed scene of reflectance near 1 becomes many per cent
+  // of the radiosity; there no light can leave, so the balance's "escaped" measures it. Gains
+  // are held (the warning above); losses are said here, once they pass 1 % of the emitted power.
+  if (hierarchical && status == SolveStatus::converged && r.B.size() == system->unknowns()) {
+    const double sent = (emitted.x + emitted.y + emitted.z) / 3.0;
+    const double lost = (emitted.x + emitted.y + emitted.z - absorbed.x - absorbed.y - absorbed.z) / 3.0;
+    if (sent > 0.0 && lost > 0.01 * sent && links->enclosed_power_share(hierarchy, *system, r.B) > 0.99) {
+      char share[32];
+      std::snprintf(share, sizeof share, "%.1f", 100.0 * lost / sent);
+      report.warnings.push_back(
+          std::string("hierarchical: ") + share +
+          " % of the emitted power is unaccounted for, though the surfaces that send the light are enclosed (no light "
+          "can leave): the links lost it, and every bounce compounds the loss (near reflectance 1 the radiosity comes "
+          "out many times that per cent low); SolverMethod::gauss_seidel (where its rows fit) or a smaller hierarchical.epsilon is more accurate");
+    }
+  }
   if (status == SolveStatus::converged)
     for (std::string& w : detail::back_lit_warnings(scene, hierarchy, B_elements, B_back))
       report.warnings.push_back(std::move(w));

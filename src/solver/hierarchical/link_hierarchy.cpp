@@ -20,6 +20,9 @@
 #include "core/assert.hpp"
 #include "core/color.hpp"
 #include "core/constants.hpp"
+#include "core/frame.hpp"
+#include "core/halton.hpp"
+#include "core/sampling.hpp"
 #include "core/growable_array.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
@@ -87,6 +90,14 @@ int receiver_grid(float d, float R) { return d >= 6.0f * R ? 1 : d >= 3.0f * R ?
 /// Three levels rather than two: walls' mean on the 22k city -0.87 % -> -0.78 % against the
 /// reference, at no measurable cost.
 constexpr int kCorrectionLevels = 3;
+/// Rays per element side that decide whether it is enclosed (enclosed_power_share()), cast
+/// kEnclosureBatch at a time until one escapes. A side open over a fraction O of its
+/// (cosine-weighted) hemisphere passes for enclosed with probability (1 - O)^32: 19 % at O =
+/// 0.05, 3e-4 at O = 0.22.
+constexpr std::uint32_t kEnclosureRays = 32;
+constexpr std::uint32_t kEnclosureBatch = 8;
+/// Sides enclosed_power_share() tests at most, drawn by the power they send.
+constexpr std::size_t kEnclosureSamples = 1024;
 /// The centroid rule underestimates a convex kernel at every level, by about the square of the
 /// nodes' size for their distance; one level down a cluster (two children) halves the area of
 /// flat parts, so the error about halves, and T3 + (T3 - T2) (Richardson's extrapolation of
@@ -1058,6 +1069,71 @@ struct LinkHierarchy::Impl {
     linked = true;
   }
 
+  // ---- Enclosure ----------------------------------------------------------------------------
+
+  /// Casts an element side's kEnclosureRays cosine-distributed rays (points and directions from
+  /// one randomised Halton set, the side's own stream), kEnclosureBatch at a time, calling
+  /// `visit(found, hit, front)` for each until it returns false; returns whether all were visited.
+  template <typename Visit>
+  bool enclosure_rays(const PatchHierarchy& h, std::uint32_t e, bool back, Visit&& visit) const {
+    const glm::vec3 n = back ? -h.normal(e) : h.normal(e);
+    glm::vec3 t, b;
+    tangent_frame(n, t, b);
+    Rng rng(seed, 2ull * e + (back ? 1u : 0u), stream_key(Stream::hierarchical_enclosure));
+    const ShiftedHalton4 halton(rng);
+    std::array<glm::vec3, kEnclosureBatch> origin, direction;
+    std::array<RayScene::Hit, kEnclosureBatch> hits;
+    std::array<std::uint8_t, kEnclosureBatch> found{};
+    for (std::uint32_t first = 0; first < kEnclosureRays; first += kEnclosureBatch) {
+      for (std::uint32_t k = 0; k < kEnclosureBatch; ++k) {
+        glm::vec2 dir2, point2;
+        halton.point(first + k, dir2, point2);
+        const glm::vec3 w = cosine_hemisphere(dir2);
+        origin[k] = h.sample_point(e, point2) + ray_epsilon * n;
+        direction[k] = w.x * t + w.y * b + w.z * n;
+      }
+      occluders.intersect(kEnclosureBatch, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
+                          hits.data(), found.data());
+      for (std::uint32_t k = 0; k < kEnclosureBatch; ++k)
+        if (!visit(found[k] != 0, hits[k], glm::dot(direction[k], hits[k].geometric_normal) < 0.0f)) return false;
+    }
+    return true;
+  }
+
+
+  /// The share of the power `B` sends (A B per side, channel means) that leaves sides in
+  /// enclosed places, estimated from up to kEnclosureSamples sides drawn by that power (at
+  /// stratified, fixed points of its cumulative sum): a side is enclosed when all its rays meet
+  /// a surface that receives light there, a polygon's front or the back of one that has backs
+  /// (a one-sided back absorbs, so light that meets one is rightly lost), not an
+  /// obstruction-only polygon.
+  double enclosed_power_share(const PatchHierarchy& h, const RadiositySystem& sys, const std::vector<Rgb>& B) const {
+    std::vector<std::uint8_t> receives(2 * scene.polygons().size(), 0);
+    for (std::size_t u = 0; u < sys.unknowns(); ++u)
+      receives[2 * std::size_t{h.patches()[h.element(sys.element(u)).patch].polygon} + (u >= sys.fronts() ? 1 : 0)] = 1;
+    std::vector<double> cumulative(sys.unknowns() + 1, 0.0);
+    for (std::size_t u = 0; u < sys.unknowns(); ++u)
+      cumulative[u + 1] = cumulative[u] + std::max(0.0, static_cast<double>(sys.area[u]) * channel_mean(B[u]));
+    const double total = cumulative.back();
+    if (!(total > 0.0)) return 0.0;
+    const std::size_t samples = std::min(kEnclosureSamples, sys.unknowns());
+    std::vector<std::uint8_t> enclosed(samples, 0);
+    parallel_for(threads, samples, 16, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const double target = (static_cast<double>(k) + 0.5) / static_cast<double>(samples) * total;
+        const auto u = static_cast<std::size_t>(std::upper_bound(cumulative.begin() + 1, cumulative.end(), target) -
+                                                (cumulative.begin() + 1));
+        if (u >= sys.unknowns()) continue;
+        enclosed[k] = enclosure_rays(h, sys.element(u), u >= sys.fronts(), [&](bool found, const RayScene::Hit& hit, bool front) {
+          return found && !scene.polygons()[hit.id].obstruction_only && receives[2 * std::size_t{hit.id} + (front ? 0 : 1)];
+        });
+      }
+    });
+    std::size_t count = 0;
+    for (const std::uint8_t e : enclosed) count += e;
+    return static_cast<double>(count) / static_cast<double>(samples);
+  }
+
   // ---- Sweeps -------------------------------------------------------------------------------
 
   /// Gather and push: the irradiance per unknown from the links with node values `v`.
@@ -1348,6 +1424,11 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
   impl_->node_values(hierarchy, system, B, values);
   impl_->gather(hierarchy, system, values, H);
   return H;
+}
+
+double LinkHierarchy::enclosed_power_share(const PatchHierarchy& hierarchy, const RadiositySystem& system,
+                                           const std::vector<Rgb>& B) const {
+  return impl_->enclosed_power_share(hierarchy, system, B);
 }
 
 std::size_t LinkHierarchy::link_count() const { return impl_->sources.size(); }

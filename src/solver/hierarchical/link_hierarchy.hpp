@@ -93,6 +93,13 @@ class LinkHierarchy {
   std::vector<Rgb> irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
                               const std::vector<Rgb>& B) const;
 
+  /// The share of the power that radiosity `B` (per unknown) sends from sides whose rays all
+  /// meet receiving surfaces (kEnclosureRays each; estimated from sides drawn by power): near 1
+  /// in a closed scene, where no light can leave, so what the power balance calls escaped is
+  /// the links' own loss. Thread safety: as solve().
+  double enclosed_power_share(const PatchHierarchy& hierarchy, const RadiositySystem& system,
+                              const std::vector<Rgb>& B) const;
+
   std::size_t link_count() const;
   /// Memory of the links, the cluster tree and the sweeps' per-node arrays, bytes.
   std::size_t bytes() const;
