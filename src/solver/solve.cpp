@@ -785,7 +785,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
           std::string("hierarchical: ") + share +
           " % of the emitted power is unaccounted for, though the surfaces that send the light are enclosed (no light "
           "can leave): the links lost it, and every bounce compounds the loss (near reflectance 1 the radiosity comes "
-          "out many times that per cent low); SolverMethod::gauss_seidel (where its rows fit) or a smaller hierarchical.epsilon is more accurate");
+          "out many times that per cent low); SolverMethod::gauss_seidel (where its rows fit) or a smaller "
+          "hierarchical.epsilon is more accurate");
     }
   }
   if (status == SolveStatus::converged)

@@ -1100,7 +1100,6 @@ struct LinkHierarchy::Impl {
     return true;
   }
 
-
   /// The share of the power `B` sends (A B per side, channel means) that leaves sides in
   /// enclosed places, estimated from up to kEnclosureSamples sides drawn by that power (at
   /// stratified, fixed points of its cumulative sum): a side is enclosed when all its rays meet
