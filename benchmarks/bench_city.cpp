@@ -309,7 +309,6 @@ int usage(const char* bad) {
 
 }  // namespace
 
-
 /// --plot: the 22k, 246k and 1M cities (at the given facet size), the Monte Carlo
 /// configuration and the hierarchical solver each, then an SVG of time and peak memory against
 /// the facet count (log-log), a refusal drawn as a cross at the time it took.

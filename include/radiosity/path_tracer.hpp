@@ -1,7 +1,6 @@
 // A brute-force, unbiased path tracer: the ground truth that radiosity images are checked against.
 #pragma once
 
-
 #include "radiosity/common.hpp"
 #include "radiosity/render.hpp"
 #include "radiosity/scene.hpp"

@@ -270,7 +270,6 @@ struct Bounds {
   float diagonal() const;
 };
 
-
 /// Polygons, materials, groups, lights and a camera. Everything is validated on entry, so a Scene that
 /// exists is usable by every solver.
 /// Thread safety: const member functions may be called concurrently; mutation needs exclusive access.

@@ -52,7 +52,6 @@ float point_to_polygon_factor_fast(const glm::vec3& x, const glm::vec3& n, const
 /// point's unit normal. In [0, 1].
 double contour_factor(const glm::dvec3* r, int m, const glm::dvec3& n);
 
-
 /// What a ray-cast (or analytic) estimator has done since it was made, for benchmarks.
 struct RayCastCounters {
   std::uint64_t factors = 0;   ///< element-patch factors computed

@@ -172,7 +172,6 @@ bool inward_planes(const glm::dvec3* p, int n, std::vector<glm::dvec3>& out) {
 
 }  // namespace
 
-
 struct ExactPolygonTransport::Impl {
   std::vector<Face> faces;
   float epsilon = 0.0f;

@@ -9,7 +9,6 @@
 
 namespace radiosity::detail {
 
-
 /// The mean reflectance with which pass 1 reflects off `m` as an ideal mirror, or 0: the
 /// material's specular part when it is ideal (specular_exponent 0). Glossy lobes are not
 /// carried.

@@ -55,7 +55,6 @@ class CellMap {
   float area_ = 0.0f;
 };
 
-
 /// Gauss-Legendre 2-point nodes on [0,1]: 1/2 -+ 1/(2 sqrt 3).
 inline constexpr float kGaussLo = 0.5f - 0.28867513459481287f, kGaussHi = 0.5f + 0.28867513459481287f;
 

@@ -85,7 +85,6 @@ bool triangles_overlap(const std::array<glm::dvec2, 3>& a, const std::array<glm:
   return !separated_by_edges_of(a, b) && !separated_by_edges_of(b, a);
 }
 
-
 /// Pairs (i, j), i < j, of a chart's triangles whose projections overlap more than `tol` deep:
 /// a uniform grid over the chart's bounds with about one triangle per cell, each pair tested
 /// once (in the cell that holds the lower corner of the intersection of their bounding boxes).

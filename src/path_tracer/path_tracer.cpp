@@ -57,7 +57,6 @@ constexpr std::size_t kPathsPerBand = std::size_t{1} << 17;
   throw Error(ErrorCode::invalid_argument, "PathTraceOptions::" + what);
 }
 
-
 using detail::kInvPi;
 using detail::kPi;
 float max_component(const Rgb& c) { return detail::max_channel(c); }

@@ -24,7 +24,6 @@ const char* type_name(LightType type) {
   return "unknown";
 }
 
-
 std::string text(const glm::vec3& v) {
   std::ostringstream s;
   s << '(' << v.x << ", " << v.y << ", " << v.z << ')';

@@ -16,11 +16,6 @@
 
 namespace radiosity::detail {
 
-namespace {
-
-
-}  // namespace
-
 std::size_t row_memory_bytes(std::size_t rows, std::size_t patches, bool sparse, std::size_t max_row_entries) {
   const std::size_t row_bytes = sparse ? std::min(patches, max_row_entries) * 2 * sizeof(float) : patches * sizeof(float);
   return rows * row_bytes;

@@ -37,7 +37,6 @@ constexpr std::size_t kPhotonBlock = 2048;
 /// Photons count for an estimate only on surfaces within about 25 degrees of the query's normal.
 constexpr float kMinNormalCosine = 0.9f;
 
-
 /// Cosine-weighted direction about the unit normal n (Malley's method).
 glm::vec3 cosine_direction(const glm::vec3& n, const glm::vec2& u) {
   const ShadingFrame frame = ShadingFrame::from_normal(n);

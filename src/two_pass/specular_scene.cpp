@@ -23,7 +23,6 @@ namespace radiosity::detail {
 
 namespace {
 
-
 }  // namespace
 
 SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights)

@@ -167,7 +167,6 @@ TEST_CASE("glTF groups are node names - else mesh names - else mesh and its inde
   }
 }
 
-
 TEST_CASE("glTF node transforms: a child's translation rotation and scale under its parent's matrix") {
   test::GltfBuilder b;
   const int quad = b.mesh(b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}));

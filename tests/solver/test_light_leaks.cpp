@@ -189,7 +189,6 @@ glm::dvec3 image_mean_rgb(const rad::Image& image) {
 
 double image_mean(const rad::Image& image) { return image_mean_rgb(image).x; }
 
-
 struct LeakScene {
   std::string name;
   rad::Scene scene;

@@ -386,7 +386,6 @@ inline rad::Scene load(const std::string& path, bool strict, bool two_sided, boo
   return scene;
 }
 
-
 inline void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
 }

@@ -346,7 +346,6 @@ class JsonCheck {
 // tinygltf's callbacks: files only from the glTF's own folder (tinygltf would also look in the
 // working directory), images kept encoded for the textures that are used.
 
-
 bool file_exists(const std::string& path, void* user) {
   const auto* ctx = static_cast<const LoadContext*>(user);
   if (path.compare(0, ctx->base_prefix.size(), ctx->base_prefix) != 0) return false;
@@ -388,7 +387,6 @@ std::string one_line(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ';');
   return text;
 }
-
 
 }  // namespace
 

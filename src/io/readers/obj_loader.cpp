@@ -148,7 +148,6 @@ std::optional<float> parse_finite_float(std::string_view s) {
   return static_cast<float>(*v);
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // MTL reader: a list of "key values" lines, each key's line kept for messages.
 
