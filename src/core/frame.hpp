@@ -20,4 +20,13 @@ inline void tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
   b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
 }
 
+/// The frame of tangent_frame() as a value: local directions (z along the normal) to world
+/// ones, for the modules that draw directions around a surface normal (ray-cast rows, sky and
+/// enclosure rays, lights, bakes). to_world() keeps the unit length of a unit local direction.
+struct Frame {
+  glm::vec3 t, b, n;
+  explicit Frame(const glm::vec3& normal) : n(normal) { tangent_frame(n, t, b); }
+  glm::vec3 to_world(const glm::vec3& local) const { return local.x * t + local.y * b + local.z * n; }
+};
+
 }  // namespace radiosity::detail

@@ -540,8 +540,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     const ShiftedHalton4 halton(rng);
     for (std::uint32_t r = 0; r < count; ++r) halton.point(r, scratch.directions[r], scratch.points[r]);
     const glm::vec3 n = back ? -source.normal : source.normal;
-    glm::vec3 t, b;
-    tangent_frame(n, t, b);
+    const Frame frame(n);
     const Element& el = hierarchy_.element(from);
     std::array<glm::vec3, 4> corners{};
     for (int k = 0; k < el.corner_count(); ++k)
@@ -551,8 +550,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     // The first segments of all rays, traced as packets (they share an origin region).
     for (std::uint32_t r = 0; r < count; ++r) {
       scratch.origin[r] = sampler(scratch.points[r]) + epsilon_ * n;
-      const glm::vec3 local = cosine_hemisphere(scratch.directions[r]);
-      scratch.dir[r] = local.x * t + local.y * b + local.z * n;
+      scratch.dir[r] = frame.to_world(cosine_hemisphere(scratch.directions[r]));
     }
     rays.scene.intersect(count, scratch.origin.data(), scratch.dir.data(), 0.0f, kInfinity, scratch.hits.data(),
                          scratch.found.data());

@@ -106,17 +106,15 @@ bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
     for (std::size_t k = begin; k < end; ++k) {
       const std::uint32_t e = sources[k];
       const glm::vec3 normal = hierarchy.normal(e);
-      glm::vec3 t, b;
-      detail::tangent_frame(normal, t, b);
+      const detail::Frame frame(normal);
       detail::Rng rng(ff.seed, e, detail::stream_key(detail::Stream::view_factor_sky));
       // Points and directions from one randomised 4D Halton set (core/halton.hpp), as the
       // Monte Carlo rows and the lights' first shot draw theirs.
       const detail::ShiftedHalton4 halton(rng);
       for (std::uint32_t i = 0; i < n; ++i) halton.point(i, directions[i], points[i]);
       for (std::uint32_t i = 0; i < n; ++i) {
-        const glm::vec3 w = detail::cosine_hemisphere(directions[i]);
         origin[i] = hierarchy.sample_point(e, points[i]) + epsilon * normal;
-        direction[i] = w.x * t + w.y * b + w.z * normal;
+        direction[i] = frame.to_world(detail::cosine_hemisphere(directions[i]));
       }
       occluders.occluded_incoherent(n, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                                     blocked.data());

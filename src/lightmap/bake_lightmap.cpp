@@ -303,12 +303,8 @@ class FinalGather {
     found.resize(rays);
     detail::Rng rng(options_.seed, texel, detail::stream_key(detail::Stream::lightmap_gather));
     detail::stratified(rays, rng, true, u.data());
-    glm::vec3 t, b;
-    detail::tangent_frame(n, t, b);
-    for (std::uint32_t r = 0; r < rays; ++r) {
-      const glm::vec3 w = detail::cosine_hemisphere(u[r]);
-      direction[r] = w.x * t + w.y * b + w.z * n;
-    }
+    const detail::Frame frame(n);
+    for (std::uint32_t r = 0; r < rays; ++r) direction[r] = frame.to_world(detail::cosine_hemisphere(u[r]));
     leaves_.intersect(rays, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                       hits.data(), found.data());
     Rgb direct(0.0f), indirect(0.0f);

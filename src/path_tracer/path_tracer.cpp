@@ -303,9 +303,7 @@ class PathTracer {
 
         // Cosine-weighted bounce: f cos / pdf = (rho/pi) cos / (cos/pi) = rho.
         const glm::vec3 l = detail::cosine_hemisphere_polar(rng.uniform2());
-        glm::vec3 t, b;
-        detail::tangent_frame(n, t, b);
-        dir = glm::normalize(l.x * t + l.y * b + l.z * n);
+        dir = glm::normalize(detail::Frame(n).to_world(l));
         prev_pdf = std::max(glm::dot(n, dir), 0.0f) * kInvPi;
         prev_delta = false;
         beta *= sh.reflectance;

@@ -73,8 +73,7 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads, co
     for (std::size_t k = begin; k < end; ++k) {
       const Polygon& polygon = polygons[out[k].polygon];
       const PolygonFan fan(polygon.vertices);
-      glm::vec3 t, b;
-      tangent_frame(polygon.normal, t, b);
+      const Frame frame(polygon.normal);
       Rng rng(kSeed, out[k].polygon);
       std::iota(order.begin(), order.end(), 0u);
       shuffle(order.data(), rays, rng);
@@ -87,7 +86,7 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads, co
       for (std::size_t i = 0; i < rays; ++i) {
         origin[i] = fan.sample(stratum(i)) + lift * polygon.normal;
         const glm::vec3 d = cosine_hemisphere(stratum(order[i]));
-        dir[i] = d.x * t + d.y * b + d.z * polygon.normal;
+        dir[i] = frame.to_world(d);
       }
       rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
       const std::size_t hits = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), std::uint8_t{1}));

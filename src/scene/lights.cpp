@@ -134,10 +134,7 @@ Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, cons
                       float epsilon, const glm::vec2& u_sky) {
   if (!lights.has_sky()) return Rgb(0.0f);
   // Cosine-weighted: L cos / pdf = pi L.
-  glm::vec3 t, b;
-  tangent_frame(n, t, b);
-  const glm::vec3 local = cosine_hemisphere(u_sky);
-  const glm::vec3 w = glm::normalize(local.x * t + local.y * b + local.z * n);
+  const glm::vec3 w = glm::normalize(Frame(n).to_world(cosine_hemisphere(u_sky)));
   const Rgb L = lights.sky_radiance(w);
   if (L == Rgb(0.0f) || occluders.occluded(x + epsilon * n, w, 0.0f, std::numeric_limits<float>::infinity()))
     return Rgb(0.0f);

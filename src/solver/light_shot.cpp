@@ -153,8 +153,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
   for (int k = 0; k < count; ++k) corners[k] = hierarchy_.vertices()[el.corners[static_cast<std::size_t>(k)]];
   const glm::vec3 n = back_side ? -hierarchy_.normal(e) : hierarchy_.normal(e);
   const CellSampler sampler(corners, count);
-  glm::vec3 t, b;
-  tangent_frame(n, t, b);
+  const Frame frame(n);
   LightRays& r = LightRays::for_this_thread();
 
   Rgb H(0.0f);
@@ -198,7 +197,7 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
           w = incidence(light, x, in) ? std::max(0.0f, glm::dot(n, in.wi)) * channel_mean(in.irradiance) : 0.0f;
         } else if (sky) {
           const glm::vec3 l = cosine_hemisphere(r.direction_uv[k]);
-          dir = l.x * t + l.y * b + l.z * n;  // unit: the frame is orthonormal
+          dir = frame.to_world(l);  // unit: the frame is orthonormal
           w = channel_mean(light.sky_radiance(dir));
           if (!(w > 0.0f)) continue;  // below the horizon: no sky there to hide
         } else {

@@ -1077,8 +1077,7 @@ struct LinkHierarchy::Impl {
   template <typename Visit>
   bool enclosure_rays(const PatchHierarchy& h, std::uint32_t e, bool back, Visit&& visit) const {
     const glm::vec3 n = back ? -h.normal(e) : h.normal(e);
-    glm::vec3 t, b;
-    tangent_frame(n, t, b);
+    const Frame frame(n);
     Rng rng(seed, 2ull * e + (back ? 1u : 0u), stream_key(Stream::hierarchical_enclosure));
     const ShiftedHalton4 halton(rng);
     std::array<glm::vec3, kEnclosureBatch> origin, direction;
@@ -1088,9 +1087,8 @@ struct LinkHierarchy::Impl {
       for (std::uint32_t k = 0; k < kEnclosureBatch; ++k) {
         glm::vec2 dir2, point2;
         halton.point(first + k, dir2, point2);
-        const glm::vec3 w = cosine_hemisphere(dir2);
         origin[k] = h.sample_point(e, point2) + ray_epsilon * n;
-        direction[k] = w.x * t + w.y * b + w.z * n;
+        direction[k] = frame.to_world(cosine_hemisphere(dir2));
       }
       occluders.intersect(kEnclosureBatch, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                           hits.data(), found.data());
