@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/frame.hpp"
+#include "core/halton.hpp"
 #include "core/sampling.hpp"
 #include "core/rng.hpp"
 
@@ -117,6 +118,11 @@ TEST_SUITE("core") {
       CHECK(std::fabs(glm::dot(t, n)) < 1e-5f);
       CHECK(std::fabs(glm::dot(b, n)) < 1e-5f);
       CHECK(glm::length(glm::cross(t, b) - n) < 1e-5f);
+      // Frame::to_world takes the local axes to t, b, n.
+      const core::Frame frame(n);
+      CHECK(glm::length(frame.to_world(glm::vec3(1, 0, 0)) - t) == 0.0f);
+      CHECK(glm::length(frame.to_world(glm::vec3(0, 1, 0)) - b) == 0.0f);
+      CHECK(glm::length(frame.to_world(glm::vec3(0, 0, 1)) - n) == 0.0f);
     };
     for (const glm::vec3& n : {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::vec3(0, -1, 0),
                                glm::normalize(glm::vec3(1, 1, 1e-7f)), glm::normalize(glm::vec3(1, 1, -1e-7f))})
@@ -251,6 +257,44 @@ TEST_SUITE("core") {
           CHECK(v_strata[k] == 1);
         }
       }
+    }
+  }
+
+  TEST_CASE("shifted Halton points: the sequence plus the shift modulo 1, below 1, stratified in 4D") {
+    radiosity::detail::Rng rng(11, 3, 0);
+    const core::ShiftedHalton4 halton(rng);
+    // Point k - point 0 (mod 1) is the sequence's point k + 1 - its point 1, whatever the shift,
+    // in the table and past it (k >= kHaltonTable is computed, not looked up).
+    glm::vec2 a0, b0;
+    halton.point(0, a0, b0);
+    const std::array<double, 4> p0 = {a0.x, a0.y, b0.x, b0.y};
+    const std::array<std::uint32_t, 4> bases = {2, 3, 5, 7};
+    for (const std::uint32_t k : {1u, 2u, 17u, 4095u, core::kHaltonTable - 1, core::kHaltonTable, 100000u}) {
+      glm::vec2 a, b;
+      halton.point(k, a, b);
+      const std::array<double, 4> p = {a.x, a.y, b.x, b.y};
+      for (std::size_t d = 0; d < 4; ++d) {
+        CHECK(p[d] >= 0.0);
+        CHECK(p[d] < 1.0);
+        double diff = p[d] - p0[d] - (core::radical_inverse(k + 1, bases[d]) - core::radical_inverse(1, bases[d]));
+        diff -= std::round(diff);
+        CHECK(std::fabs(diff) < 1e-6);  // the 24-bit floats' rounding, twice
+      }
+    }
+    // Stratified: per dimension, the first b^2 points of base b put exactly b points in each
+    // interval [j / b, (j + 1) / b), counted from point 0 modulo 1 (the shift moves them all).
+    for (std::size_t d = 0; d < 4; ++d) {
+      const std::uint32_t base = bases[d];
+      std::vector<int> count(base, 0);
+      for (std::uint32_t k = 0; k < base * base; ++k) {
+        glm::vec2 a, b;
+        halton.point(k, a, b);
+        const double x = std::array<double, 4>{a.x, a.y, b.x, b.y}[d] - p0[d];
+        double unit = x - std::floor(x);
+        if (unit > 1.0 - 1e-6) unit = 0.0;  // just below a wrap by rounding: 0
+        ++count[std::min<std::size_t>(base - 1, static_cast<std::size_t>(unit * base + 1e-5))];
+      }
+      for (const int c : count) CHECK(c == static_cast<int>(base));
     }
   }
 }
