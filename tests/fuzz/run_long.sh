@@ -30,7 +30,13 @@ for ((k = first; k < first + millions; ++k)); do
     -print_final_stats=1 -detect_leaks="$leaks" -artifact_prefix="$work/artifacts/$format/" \
     "$work/corpus/$format" "$work/seeds/$format" > "$log" 2>&1
   rc=$?
-  echo "$format chunk $k rc $rc $(grep -h 'number_of_executed_units' "$log") $(date +%T)" >> "$work/long/$format.summary"
+  echo "$format chunk $k rc $rc $(grep -h 'number_of_executed_units' "$log" | head -1) $(date +%T)" >> "$work/long/$format.summary"
+  # A chunk that ran all its inputs can still end on the RSS limit as libFuzzer exits, from
+  # Assimp's leaks piled up over the chunk (the "input" it then writes is empty): not a finding.
+  if [ "$rc" -ne 0 ] && grep -q '^Done 1000000 runs' "$log"; then
+    rm -f "$work/artifacts/$format/oom-da39a3ee5e6b4b0d3255bfef95601890afd80709"  # the empty input
+    continue
+  fi
   if [ "$rc" -ne 0 ]; then
     echo "run_long: $format chunk $k stopped (exit $rc): see $log and $work/artifacts/$format/" >&2
     exit 1
