@@ -46,6 +46,12 @@ struct HierarchicalOptions {
   /// Refinement passes at most: the first links against the emitted light, each later one
   /// refines them against the radiosity solved so far (multigridding), until no link changes.
   int max_passes = 3;
+  /// Balance the transport of closed regions (sides whose rays all meet surfaces): each side
+  /// then delivers the power it sends and gathers 1 from uniform radiosity, as the true
+  /// transport does, so that a room of reflectance near 1 neither loses nor gains light through
+  /// the links' per-link errors (docs/HIERARCHICAL.md, "Balancing closed regions"). Off, the
+  /// links' own estimates are used (a closed room can then come out 10-60 % off).
+  bool balance_closed_regions = true;
 };
 
 /// Adaptive subdivision of elements where radiosity varies fast (shadow boundaries, near

@@ -556,6 +556,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       links = std::make_unique<detail::LinkHierarchy>(scene, hierarchy, o.seed, o.threads,
                                                       light_shooter ? &light_shooter->occluders() : nullptr);
       links->set_memory_budget(o.memory_budget_bytes, "SolveOptions::memory_budget_bytes");
+      links->set_balancing(o.hierarchical.balance_closed_regions);
     }
     detail::SubdivisionLimits limits;
     if (o.adaptive.enabled) {

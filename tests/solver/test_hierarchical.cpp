@@ -367,13 +367,20 @@ TEST_SUITE("solver") {
     // through the coincident floor (Gauss-Seidel 10.2, hierarchical 30.4: the model's ambiguity,
     // which the z-fighting warning names), and every radiosity stays below the bound max E /
     // (1 - rho_max) = 3142.
+    // The balancing of closed regions, on by default, removes the gain (below); the hold is
+    // what remains for regions it does not reach, so it is tested with the balancing off.
     rad::Scene scene = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/exported_room.obj");
     scene.make_two_sided();
-    const rad::Solution sol = rad::solve(scene, hierarchical(0.05f));
+    rad::SolveOptions unbalanced = hierarchical(0.05f);
+    unbalanced.hierarchical.balance_closed_regions = false;
+    const rad::Solution sol = rad::solve(scene, unbalanced);
     REQUIRE(sol.status() == rad::SolveStatus::converged);
-    bool warned = false;
-    for (const std::string& w : sol.report().warnings) warned = warned || w.find("maximum principle") != std::string::npos;
-    CHECK(warned);
+    auto held = [](const rad::Solution& s) {
+      for (const std::string& w : s.report().warnings)
+        if (w.find("maximum principle") != std::string::npos) return true;
+      return false;
+    };
+    CHECK(held(sol));
     const float bound = 31.416f / (1.0f - 0.99f) * 1.001f;
     for (const rad::Rgb& b : sol.radiosity()) CHECK(std::max({b.x, b.y, b.z}) < bound);
     for (const rad::Rgb& b : sol.back_radiosity()) CHECK(std::max({b.x, b.y, b.z}) < bound);
@@ -387,14 +394,30 @@ TEST_SUITE("solver") {
     const double inside = sol.group_back_radiosity("room").y, expected = ref.group_back_radiosity("room").y;
     MESSAGE("inside of the room: hierarchical " << inside << ", gauss-seidel " << expected);
     CHECK(relative(inside, expected) < 0.02);
+    // Balanced (the default): no gain to hold, the room's inside and the box's outside within
+    // 2 % of Gauss-Seidel (measured 0.4 % and 0.1 %), the box's inside (lit only through the
+    // coincident floor) 12 % off instead of three times too bright.
+    const rad::Solution balanced = rad::solve(scene, hierarchical(0.05f));
+    REQUIRE(balanced.status() == rad::SolveStatus::converged);
+    CHECK_FALSE(held(balanced));
+    MESSAGE("balanced: room inside " << balanced.group_back_radiosity("room").y << ", box "
+                                     << balanced.group_radiosity("box").y << " (gauss-seidel "
+                                     << ref.group_radiosity("box").y << "), box inside "
+                                     << balanced.group_back_radiosity("box").y << " ("
+                                     << ref.group_back_radiosity("box").y << ")");
+    CHECK(relative(balanced.group_back_radiosity("room").y, expected) < 0.02);
+    CHECK(relative(balanced.group_radiosity("box").y, ref.group_radiosity("box").y) < 0.02);
+    CHECK(relative(balanced.group_back_radiosity("box").y, ref.group_back_radiosity("box").y) < 0.25);
   }
 
   TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there") {
     // A room as an exporter writes it (outward winding, Kd 1 clamped to 0.99), made two-sided,
-    // a lamp panel 0.2 m under the ceiling: closed, so no light can leave, yet the links lose
-    // some (measured: 6.7 % of the emitted power, 9.3 % of the green; Gauss-Seidel 0.2 %), which rho = 0.99
-    // turns into a green channel 9 % low. The solve says so. The open Cornell box (31 % leaves
-    // through its front) and Gauss-Seidel on the room do not warn.
+    // a lamp panel 0.2 m under the ceiling: closed, so no light can leave. Without the balancing
+    // of closed regions the links lose some (measured: 6.7 % of the emitted power, 9.3 % of the
+    // green; Gauss-Seidel 0.2 %), which rho = 0.99 turns into a green channel 9 % low, and the
+    // solve says so. The open Cornell box (31 % leaves through its front) and Gauss-Seidel on
+    // the room do not warn. Balanced (the default), the loss is under 1 % and the room and the
+    // crate within 5 % of Gauss-Seidel (measured -3 % and -4 %; unbalanced -9 % and -16 %).
     auto warned = [](const rad::Solution& sol) {
       for (const std::string& w : sol.report().warnings)
         if (w.find("unaccounted for") != std::string::npos) return true;
@@ -402,7 +425,9 @@ TEST_SUITE("solver") {
     };
     rad::Scene room = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/room_lamp_under_ceiling.obj");
     room.make_two_sided();
-    const rad::Solution sol = rad::solve(room, hierarchical(0.05f));
+    rad::SolveOptions unbalanced = hierarchical(0.05f);
+    unbalanced.hierarchical.balance_closed_regions = false;
+    const rad::Solution sol = rad::solve(room, unbalanced);
     REQUIRE(sol.status() == rad::SolveStatus::converged);
     const double escaped = sol.report().escaped_power.y / sol.report().emitted_power.y;
     MESSAGE("closed room, hierarchical: escaped " << escaped);
@@ -417,12 +442,54 @@ TEST_SUITE("solver") {
     const rad::Solution ref = rad::solve(room, gs);
     CHECK(std::abs(ref.report().escaped_power.y) < 0.01f * ref.report().emitted_power.y);
     CHECK_FALSE(warned(ref));
+    const rad::Solution balanced = rad::solve(room, hierarchical(0.05f));
+    REQUIRE(balanced.status() == rad::SolveStatus::converged);
+    MESSAGE("balanced: escaped " << balanced.report().escaped_power.y / balanced.report().emitted_power.y
+                                 << ", room inside " << balanced.group_back_radiosity("room").y << " (gauss-seidel "
+                                 << ref.group_back_radiosity("room").y << "), crate " << balanced.group_radiosity("crate").y
+                                 << " (" << ref.group_radiosity("crate").y << ")");
+    CHECK(std::abs(balanced.report().escaped_power.y) < 0.01f * balanced.report().emitted_power.y);
+    CHECK_FALSE(warned(balanced));
+    for (int c = 0; c < 3; ++c) {
+      CHECK(relative(balanced.group_back_radiosity("room")[c], ref.group_back_radiosity("room")[c]) < 0.05);
+      CHECK(relative(balanced.group_radiosity("crate")[c], ref.group_radiosity("crate")[c]) < 0.05);
+    }
+  }
+
+  TEST_CASE("hierarchical: a closed room with a lamp 1 cm under its ceiling, finely meshed, agrees with Gauss-Seidel" *
+            test::release_only) {
+    // 9 300 elements of 0.01 m^2, reflectance 0.99, made two-sided. Without the balancing the
+    // links gained energy here: the room's inside came out 60 % too bright (19.2 against 11.7)
+    // and absorbed / emitted was 1.5, with no warning. Balanced: measured +1.9 % and +0.5 %
+    // (red, green), the crate +8 % and +4 %.
+    rad::Scene room = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/room_lamp_1cm_under_ceiling.obj");
+    room.make_two_sided();
+    rad::SolveOptions o = hierarchical(0.05f);
+    o.tolerance = 1e-4;  // rho 0.99: about 1 % from the converged answer, for both solvers
+    o.mesh.max_patch_area = 0.01f;
+    o.mesh.max_element_area = 0.01f;
+    const rad::Solution sol = rad::solve(room, o);
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    rad::SolveOptions gs = o;
+    gs.method = rad::SolverMethod::gauss_seidel;
+    const rad::Solution ref = rad::solve(room, gs);
+    REQUIRE(ref.status() == rad::SolveStatus::converged);
+    MESSAGE("room inside " << sol.group_back_radiosity("room").y << " (gauss-seidel " << ref.group_back_radiosity("room").y
+                           << "), crate " << sol.group_radiosity("crate").y << " (" << ref.group_radiosity("crate").y
+                           << "), absorbed / emitted " << sol.report().absorbed_power.y / sol.report().emitted_power.y);
+    CHECK(std::abs(sol.report().escaped_power.y) < 0.03f * sol.report().emitted_power.y);
+    for (int c = 0; c < 3; ++c) {
+      CHECK(relative(sol.group_back_radiosity("room")[c], ref.group_back_radiosity("room")[c]) < 0.05);
+      CHECK(relative(sol.group_radiosity("crate")[c], ref.group_radiosity("crate")[c]) < 0.12);
+    }
   }
 
   TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to at most E / (1 - rho)") {
     // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
-    // The links gain about 1 % here (absorbed / emitted 1.013 at rho 0.8), so the sweeps grow and
-    // are held: measured mean 94.6, largest 99.9987 (before the hold: mean 159 after one pass
+    // Balanced (every side of the closed box delivers what it sends and gathers 1 from uniform
+    // radiosity): measured mean 99.999, largest 99.999. Before the balancing the links gained
+    // about 1 % here (absorbed / emitted 1.013 at rho 0.8), so the sweeps grew and were held:
+    // mean 94.6, largest 99.9987 (before the hold: mean 159 after one pass
     // held and the next not, or divergence).
     const rad::Scene scene = furnace(rad::Rgb(1.0f), rad::Rgb(0.99f));
     rad::SolveOptions o = hierarchical(0.05f);
@@ -441,6 +508,6 @@ TEST_SUITE("solver") {
     MESSAGE("furnace at rho 0.99: mean " << mean << ", largest " << largest << " (exact 100), held "
                                          << sol.report().warnings.size());
     CHECK(largest < 100.0 * 1.0001);
-    CHECK(mean > 90.0);
+    CHECK(mean > 99.9);
   }
 }

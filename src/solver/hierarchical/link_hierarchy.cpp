@@ -105,6 +105,14 @@ constexpr std::size_t kEnclosureSamples = 1024;
 /// reference: mean -0.17 % -> -0.12 %, walls -0.37 % -> -0.29 %, element RMS 1.72 % -> 1.71 %
 /// (half the step: -0.15 %, walls -0.33 %).
 constexpr float kExtrapolate = 1.0f;
+/// Rounds of the row and column balancing of closed regions (update_scales()), and the most a
+/// side's scale may raise its transport (lowering it is not bounded: a side that delivers more
+/// than it sends, as coincident surfaces seen twice do, must be brought down all the way, or a
+/// region of reflectance 0.99 gains energy on every sweep).
+constexpr int kBalanceRounds = 8;
+constexpr float kMaxBalance = 4.0f;
+/// The smallest share of the sides' area that must be enclosed for the balancing to run.
+constexpr double kBalanceMinShare = 0.01;
 
 float mean(const Rgb& c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 
@@ -140,6 +148,7 @@ struct LinkHierarchy::Impl {
   /// Bytes the refinement's link arrays may reach (LinkHierarchy::set_memory_budget()).
   std::size_t memory_budget = kDefaultMemoryBudget;
   const char* memory_budget_field = "SolveOptions::memory_budget_bytes";
+  bool balancing = true;  ///< LinkHierarchy::set_balancing()
   float ray_epsilon;
   /// Per position of tree.order(): the area of the patches before it, for sampling a
   /// cluster's surface by area.
@@ -171,6 +180,16 @@ struct LinkHierarchy::Impl {
   GrowableArray<float> coefficients;  ///< negative for a partly hidden link (the factor is the magnitude)
   std::uint32_t linked_elements = 0;  ///< the element count the receiver indices were made for
   bool linked = false;
+  /// Per element side (2 e + 1 for its back): what its radiosity is multiplied by before the
+  /// sweeps' gather, so that an enclosed side delivers the power it sends (update_scales());
+  /// empty when no side is enclosed.
+  std::vector<float> send_scale;
+  /// Per element side: what the irradiance the links bring it is multiplied by (a closed
+  /// region's rows; update_scales()); empty when no side is in one.
+  std::vector<float> receive_scale;
+  /// Per element side: whether update_scales() found it enclosed (0 not yet tested, 1 open, 2
+  /// enclosed).
+  std::vector<std::uint8_t> side_enclosure;
 
   /// Node radiosity for the oracle and the sweeps.
   struct Values {
@@ -413,6 +432,10 @@ struct LinkHierarchy::Impl {
     v.front.assign(count, Rgb(0.0f));
     v.back.assign(sys.has_backs() ? count : 0, Rgb(0.0f));
     for (std::size_t u = 0; u < sys.unknowns(); ++u) (u < sys.fronts() ? v.front : v.back)[sys.element(u)] = B[u];
+    leaf_values(hierarchy, v);
+  }
+  /// The rest of node_values() from the leaves' values already in v.front and v.back.
+  void leaf_values(const PatchHierarchy& hierarchy, Values& v) const {
     hierarchy.aggregate(v.front);
     if (!v.back.empty()) hierarchy.aggregate(v.back);
     const std::vector<Patch>& patches = hierarchy.patches();
@@ -982,6 +1005,8 @@ struct LinkHierarchy::Impl {
     coefficients.clear();
     linked_elements = 0;
     linked = false;
+    send_scale = {};
+    receive_scale = {};
   }
 
   /// Adds the links in `chunks` to the receiver-ordered arrays, after each receiver's links
@@ -1131,6 +1156,256 @@ struct LinkHierarchy::Impl {
     return static_cast<double>(count) / static_cast<double>(samples);
   }
 
+  // ---- Delivery in closed regions ----------------------------------------------------------
+
+  /// Sets send_scale and receive_scale from the links as they stand. In a closed region the
+  /// true transport is balanced both ways: each side delivers all the power A B it sends to
+  /// sides that take it in (its column), and each side gathers from uniform radiosity 1 an
+  /// irradiance of 1 (its row). The links' estimates miss both by a few per cent per side
+  /// (cluster moments, corrected centroid transport, a few visibility rays: a lamp under a
+  /// ceiling delivers 0.93 of its power and gathers 0.90), and a region of reflectance near 1
+  /// multiplies the error up to 1 / (1 - rho) times. The transport is therefore scaled, H_u =
+  /// r_u G(g B)_u, with g and r found by kBalanceRounds rounds of iterative proportional
+  /// fitting (Sinkhorn's balancing, as View3D's enclosure adjustment balances a factor matrix),
+  /// g at most kMaxBalance and r within [1/2, kMaxBalance]:
+  /// - g_v for an enclosed side v (its kEnclosureRays rays all meet receiving surfaces, as in
+  ///   enclosed_power_share()): 1 / the power the scaled links deliver per unit of its A B,
+  ///   from the adjoint of gather() (adjoint_delivery());
+  /// - r_u for a side whose rays all meet wholly enclosed polygon sides (a closed room's
+  ///   inside): 1 / what it gathers from radiosity g on the enclosed sides.
+  /// Sides of open scenes are left alone: what they send partly leaves the scene, and 32 rays
+  /// cannot say how much. Deterministic: fixed rays per side, the adjoint in one serial pass.
+  /// The rows cannot always be met: a receiving cluster that spreads light over members the
+  /// source sees unlike (a ceiling above a lamp 1 cm under it, fine-meshed, gathers 1.76 from
+  /// uniform radiosity) asks for more than any scaling can give, and its r and the lamp's g
+  /// would run to the bounds; r >= 1/2 stops that. Measured against Gauss-Seidel on exported
+  /// rooms (docs/HIERARCHICAL.md, "Balancing closed regions").
+  void update_scales(const PatchHierarchy& h) {
+    send_scale = {};
+    receive_scale = {};
+    const std::uint32_t elements = linked_elements;
+    if (!balancing || !linked || elements != h.elements().size()) return;
+    const std::vector<Patch>& patches = h.patches();
+    bool backs = false;
+    for (const std::uint8_t b : has_back) backs = backs || b != 0;
+    const std::size_t sides = 2 * std::size_t{elements};
+    // Which leaf sides are enclosed.
+    std::vector<std::uint8_t> receives(2 * scene.polygons().size(), 0);
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      receives[2 * std::size_t{patches[p].polygon}] = 1;
+      if (has_back[p]) receives[2 * std::size_t{patches[p].polygon} + 1] = 1;
+    }
+    auto each_leaf_side = [&](auto&& f) {
+      parallel_for(threads, elements, 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t e = begin; e < end; ++e) {
+          const Element& el = h.element(static_cast<std::uint32_t>(e));
+          if (!el.is_leaf() || !(el.area > 0.0f)) continue;
+          for (std::size_t side = 0; side < (has_back[el.patch] ? 2u : 1u); ++side) f(e, side);
+        }
+      });
+    };
+    // Kept across passes (the geometry does not change; split elements add sides): 0 not yet
+    // tested, 1 open, 2 enclosed.
+    side_enclosure.resize(sides, 0);
+    each_leaf_side([&](std::size_t e, std::size_t side) {
+      std::uint8_t& known = side_enclosure[2 * e + side];
+      if (known != 0) return;
+      known = enclosure_rays(h, static_cast<std::uint32_t>(e), side == 1,
+                             [&](bool found, const RayScene::Hit& hit, bool front) {
+                               return found && !scene.polygons()[hit.id].obstruction_only &&
+                                      receives[2 * std::size_t{hit.id} + (front ? 0 : 1)];
+                             })
+                  ? 2
+                  : 1;
+    });
+    std::vector<std::uint8_t> enclosed(sides, 0);
+    for (std::size_t k = 0; k < sides; ++k) enclosed[k] = side_enclosure[k] == 2 ? 1 : 0;
+    double enclosed_area = 0.0, total_area = 0.0;
+    for (std::size_t k = 0; k < sides; ++k) {
+      const Element& el = h.element(static_cast<std::uint32_t>(k / 2));
+      if (!el.is_leaf() || (k % 2 == 1 && !has_back[el.patch])) continue;
+      total_area += el.area;
+      enclosed_area += enclosed[k] ? el.area : 0.0;
+    }
+    // The balancing's rounds each cost a gather and a pass over the links: not for a few
+    // enclosed corners of an open scene (16 of the 22k city's sides).
+    if (!(enclosed_area >= kBalanceMinShare * total_area)) return;
+    // Polygon sides all of whose leaves are enclosed, and the sides that see only those.
+    std::vector<std::uint8_t> closed_polygon = receives;
+    for (std::uint32_t e = 0; e < elements; ++e) {
+      const Element& el = h.element(e);
+      if (!el.is_leaf() || !(el.area > 0.0f)) continue;
+      const std::size_t polygon = patches[el.patch].polygon;
+      for (std::size_t side = 0; side < (has_back[el.patch] ? 2u : 1u); ++side)
+        if (!enclosed[2 * std::size_t{e} + side]) closed_polygon[2 * polygon + side] = 0;
+    }
+    std::vector<std::uint8_t> closed(sides, 0);
+    each_leaf_side([&](std::size_t e, std::size_t side) {
+      if (!enclosed[2 * e + side]) return;
+      closed[2 * e + side] = enclosure_rays(h, static_cast<std::uint32_t>(e), side == 1,
+                                            [&](bool found, const RayScene::Hit& hit, bool front) {
+                                              return found && closed_polygon[2 * std::size_t{hit.id} + (front ? 0 : 1)];
+                                            });
+    });
+    const bool rows = std::find(closed.begin(), closed.end(), std::uint8_t{1}) != closed.end();
+
+    std::vector<float> g(sides, 1.0f), r(sides, 1.0f);
+    std::vector<double> delivered;
+    Values v;
+    std::vector<Rgb> front, back, unused_front, unused_back;
+    for (int round = 0; round < kBalanceRounds; ++round) {
+      if (rows) {
+        v.front.assign(elements, Rgb(0.0f));
+        v.back.assign(backs ? elements : 0, Rgb(0.0f));
+        for (std::size_t k = 0; k < sides; ++k)
+          if (enclosed[k]) (k % 2 == 0 ? v.front : v.back)[k / 2] = Rgb(g[k]);
+        leaf_values(h, v);
+        gather_sides(h, v, backs, false, front, back, unused_front, unused_back);
+        for (std::size_t k = 0; k < sides; ++k) {
+          if (!closed[k]) continue;
+          const float gathered = (k % 2 == 0 ? front : back)[k / 2].x;
+          if (gathered > 0.0f) r[k] = std::clamp(1.0f / gathered, 0.5f, kMaxBalance);
+        }
+      }
+      adjoint_delivery(h, backs, r, delivered);
+      for (std::size_t k = 0; k < sides; ++k) {
+        if (!enclosed[k]) continue;
+        const double per_unit = delivered[k] / h.element(static_cast<std::uint32_t>(k / 2)).area;
+        if (per_unit > 0.0) g[k] = static_cast<float>(std::min(1.0 / per_unit, double{kMaxBalance}));
+      }
+    }
+    send_scale = std::move(g);
+    if (rows) receive_scale = std::move(r);
+  }
+
+  /// Per element side (2 e + 1 for its back), the power the links deliver to every leaf side
+  /// (each weighted by `weight`, per element side: receive_scale's part) per unit of that
+  /// side's value: the adjoint of leaf_values() and gather_sides() (the push's transpose, the
+  /// link sums' transpose, the cluster moments' transpose, the pull's transpose). For a leaf,
+  /// delivered / area is the fraction of the power it sends that arrives. One serial pass over
+  /// the links: the same sums in the same order at any thread count.
+  void adjoint_delivery(const PatchHierarchy& h, bool backs, const std::vector<float>& weight,
+                        std::vector<double>& delivered) const {
+    const std::uint32_t elements = linked_elements;
+    const std::vector<Patch>& patches = h.patches();
+    // W per element side: the weighted area of its leaves (what unit irradiance on it delivers).
+    std::vector<double> W(2 * std::size_t{elements}, 0.0);
+    for (std::uint32_t e = elements; e-- > 0;) {
+      const Element& el = h.element(e);
+      for (std::size_t side = 0; side < 2; ++side) {
+        double& w = W[2 * std::size_t{e} + side];
+        if (el.is_leaf()) {
+          w = static_cast<double>(el.area) * weight[2 * std::size_t{e} + side];
+          continue;
+        }
+        for (std::uint32_t k = 0; k < 4; ++k) w += W[2 * std::size_t{el.first_child + k} + side];
+      }
+    }
+    // Q per cluster: the power its patches take in from unit irradiance moments (the push's
+    // element_irradiance() on each patch side).
+    const std::uint32_t C = cluster_count();
+    std::vector<std::array<double, 6>> Q(C, std::array<double, 6>{});
+    for (std::uint32_t i = C; i-- > 0;) {
+      const ClusterNode& c = tree.node(i);
+      if (!c.is_leaf()) {
+        for (int a = 0; a < 6; ++a) Q[i][a] = Q[c.children[0]][a] + Q[c.children[1]][a];
+        continue;
+      }
+      const std::uint32_t p = tree.order()[c.first];
+      const glm::vec3& n = patches[p].normal;
+      const double wf = W[2 * std::size_t{patches[p].root}];
+      const double wb = backs && has_back[p] ? W[2 * std::size_t{patches[p].root} + 1] : 0.0;
+      for (int a = 0; a < 3; ++a) {
+        Q[i][2 * a] += wf * std::max(0.0f, n[a]) + wb * std::max(0.0f, -n[a]);
+        Q[i][2 * a + 1] += wf * std::max(0.0f, -n[a]) + wb * std::max(0.0f, n[a]);
+      }
+    }
+    // The links, receiver by receiver: what each source's value delivers. R per cluster: per
+    // unit of its six sending moments.
+    delivered.assign(2 * std::size_t{elements}, 0.0);
+    std::vector<std::array<double, 6>> R(C, std::array<double, 6>{});
+    auto from_source = [&](NodeHandle s, const glm::vec3& w, double kappa) {  // kappa per unit I_s(w)
+      if (is_cluster(s)) {
+        for (int a = 0; a < 3; ++a) R[handle_index(s)][w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
+        return;
+      }
+      const std::uint32_t e = element_of(s);
+      delivered[2 * std::size_t{e} + (is_back(s) ? 1 : 0)] +=
+          kappa * h.element(e).area * std::max(0.0f, glm::dot(side_normal(h, s), w)) * kInvPi;
+    };
+    const std::uint64_t receivers = offsets.size() - 1;
+    for (std::uint64_t i = 0; i < receivers; ++i) {
+      const std::uint64_t first = offsets[i], last = offsets[i + 1];
+      if (first == last) continue;
+      const NodeHandle r = receiver_handle(i, elements);
+      const glm::vec3 cr = centroid(h, r);
+      if (is_cluster(r)) {
+        const std::array<double, 6>& q = Q[handle_index(r)];
+        for (std::uint64_t k = first; k < last; ++k) {
+          const NodeHandle s = sources[k];
+          const glm::vec3 w = glm::normalize(cr - centroid(h, s));
+          double taken = 0.0;  // element_irradiance(Q, -w)
+          for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * q[2 * a] : w[a] * q[2 * a + 1];
+          from_source(s, w, std::abs(coefficients[k]) * taken);
+        }
+        continue;
+      }
+      const double taken = W[2 * std::size_t{element_of(r)} + (is_back(r) ? 1 : 0)];
+      const glm::vec3 nr = side_normal(h, r);
+      for (std::uint64_t k = first; k < last; ++k) {
+        const NodeHandle s = sources[k];
+        if (!is_cluster(s)) {
+          delivered[2 * std::size_t{element_of(s)} + (is_back(s) ? 1 : 0)] += std::abs(coefficients[k]) * taken;
+          continue;
+        }
+        const glm::vec3 w = glm::normalize(cr - centroid(h, s));
+        from_source(s, w, std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w)) * taken);
+      }
+    }
+    // Down the cluster tree (parents have smaller ids), then into each patch's root element by
+    // add_surface()'s split of its normal.
+    for (std::uint32_t i = 0; i < C; ++i) {
+      const ClusterNode& c = tree.node(i);
+      if (!c.is_leaf()) {
+        for (const std::uint32_t child : c.children)
+          for (int a = 0; a < 6; ++a) R[child][a] += R[i][a];
+        continue;
+      }
+      const std::uint32_t p = tree.order()[c.first];
+      const glm::vec3& n = patches[p].normal;
+      const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+      double front = 0.0, back = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        front += R[i][n[a] >= 0.0f ? 2 * a : 2 * a + 1] * std::abs(n[a]) / l1;
+        back += R[i][n[a] >= 0.0f ? 2 * a + 1 : 2 * a] * std::abs(n[a]) / l1;
+      }
+      delivered[2 * std::size_t{patches[p].root}] += front * patches[p].area;
+      if (backs && has_back[p]) delivered[2 * std::size_t{patches[p].root} + 1] += back * patches[p].area;
+    }
+    // The pull's transpose: an inner element's value is its children's area-weighted mean.
+    for (std::uint32_t e = 0; e < elements; ++e) {
+      const Element& el = h.element(e);
+      if (el.is_leaf()) continue;
+      double sum = 0.0;
+      for (std::uint32_t k = 0; k < 4; ++k) sum += h.element(el.first_child + k).area;
+      if (!(sum > 0.0)) continue;
+      for (std::uint32_t k = 0; k < 4; ++k)
+        for (std::size_t side = 0; side < 2; ++side)
+          delivered[2 * std::size_t{el.first_child + k} + side] +=
+              delivered[2 * std::size_t{e} + side] * h.element(el.first_child + k).area / sum;
+    }  }
+
+  /// `B` (per unknown) as the sweeps send it: times send_scale.
+  const std::vector<Rgb>& sent(const RadiositySystem& sys, const std::vector<Rgb>& B, std::vector<Rgb>& out) const {
+    if (send_scale.empty()) return B;
+    out.resize(B.size());
+    for (std::size_t u = 0; u < B.size(); ++u) {
+      const std::size_t k = 2 * std::size_t{sys.element(u)} + (u >= sys.fronts() ? 1 : 0);
+      out[u] = k < send_scale.size() ? B[u] * send_scale[k] : B[u];
+    }
+    return out;
+  }
+
   // ---- Sweeps -------------------------------------------------------------------------------
 
   /// Gather and push: the irradiance per unknown from the links with node values `v`.
@@ -1147,14 +1422,31 @@ struct LinkHierarchy::Impl {
   /// holding the high ones alone biases the irradiance low (a furnace's mean by -2.4 %).
   void gather(const PatchHierarchy& hierarchy, const RadiositySystem& sys, const Values& v,
               std::vector<Rgb>& H, bool hold = false) const {
+    std::vector<Rgb> front, back, bound_front, bound_back;
+    gather_sides(hierarchy, v, sys.has_backs(), hold, front, back, bound_front, bound_back);
+    H.resize(sys.unknowns());
+    for (std::size_t u = 0; u < sys.unknowns(); ++u) {
+      const bool is_front = u < sys.fronts();
+      const std::uint32_t e = sys.element(u);
+      H[u] = (is_front ? front : back)[e];
+      if (hold) H[u] = glm::min(H[u], (is_front ? bound_front : bound_back)[e]);
+      if (!receive_scale.empty()) H[u] *= receive_scale[2 * std::size_t{e} + (is_front ? 0 : 1)];
+    }
+  }
+  /// gather()'s work: the irradiance per element side (`back` empty without `backs`), pushed
+  /// down to every leaf, and with `hold` the maximum principle's bound per element side.
+  void gather_sides(const PatchHierarchy& hierarchy, const Values& v, bool backs, bool hold, std::vector<Rgb>& front,
+                    std::vector<Rgb>& back, std::vector<Rgb>& bound_front, std::vector<Rgb>& bound_back) const {
     const std::uint32_t elements = linked_elements;
     RADIOSITY_ASSERT(hierarchy.elements().size() == elements);
     const std::uint32_t C = cluster_count();
     std::vector<Moments> received(C, Moments{});
-    std::vector<Rgb> front(elements, Rgb(0.0f)), back(sys.has_backs() ? elements : 0, Rgb(0.0f));
+    front.assign(elements, Rgb(0.0f));
+    back.assign(backs ? elements : 0, Rgb(0.0f));
     // The maximum principle's bound per node: the largest radiosity its own links bring.
-    std::vector<Rgb> bound_cluster(hold ? C : 0, Rgb(0.0f)), bound_front(hold ? elements : 0, Rgb(0.0f)),
-        bound_back(hold ? back.size() : 0, Rgb(0.0f));
+    std::vector<Rgb> bound_cluster(hold ? C : 0, Rgb(0.0f));
+    bound_front.assign(hold ? elements : 0, Rgb(0.0f));
+    bound_back.assign(hold ? back.size() : 0, Rgb(0.0f));
     auto source_max = [&](NodeHandle s) -> const Rgb& {
       return is_cluster(s) ? v.cluster_max[handle_index(s)] : (is_back(s) ? v.back : v.front)[element_of(s)];
     };
@@ -1224,13 +1516,6 @@ struct LinkHierarchy::Impl {
         if (!back.empty())
           bound_back[el.first_child + k] = glm::max(bound_back[el.first_child + k], bound_back[e]);
       }
-    }
-    H.resize(sys.unknowns());
-    for (std::size_t u = 0; u < sys.unknowns(); ++u) {
-      const bool is_front = u < sys.fronts();
-      const std::uint32_t e = sys.element(u);
-      H[u] = (is_front ? front : back)[e];
-      if (hold) H[u] = glm::min(H[u], (is_front ? bound_front : bound_back)[e]);
     }
   }
 
@@ -1353,6 +1638,7 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   }
   replaced = {};
   m.merge(chunks, elements);
+  m.update_scales(hierarchy);
   return true;
 }
 
@@ -1381,8 +1667,10 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
   result.held = hold;
   int growing = 0;
   double last_change = std::numeric_limits<double>::infinity();
+  std::vector<Rgb> scaled;  // result.B as sent (Impl::sent())
   for (int it = 1; it <= max_iterations; ++it) {
-    m.node_values(ctx.hierarchy, sys, result.B, values);
+    const std::vector<Rgb>& B_sent = m.sent(sys, result.B, scaled);
+    m.node_values(ctx.hierarchy, sys, B_sent, values);
     m.gather(ctx.hierarchy, sys, values, result.H, hold);
     if (hold) Impl::cap_delivered_power(sys, result.B, result.H);
     // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp), from the previous sweep's values.
@@ -1407,7 +1695,8 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
     if (end_sweep(ctx, result, it, change, seconds_since(t0))) break;
   }
   // Irradiance for the energy balance, from the final radiosity.
-  m.node_values(ctx.hierarchy, sys, result.B, values);
+  const std::vector<Rgb>& B_sent = m.sent(sys, result.B, scaled);
+  m.node_values(ctx.hierarchy, sys, B_sent, values);
   m.gather(ctx.hierarchy, sys, values, result.H, hold);
   if (hold) Impl::cap_delivered_power(sys, result.B, result.H);
   return result;
@@ -1418,7 +1707,8 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
   std::vector<Rgb> H(system.unknowns(), Rgb(0.0f));
   if (!impl_->linked) return H;
   Impl::Values values;
-  impl_->node_values(hierarchy, system, B, values);
+  std::vector<Rgb> scaled;
+  impl_->node_values(hierarchy, system, impl_->sent(system, B, scaled), values);
   impl_->gather(hierarchy, system, values, H);
   return H;
 }
@@ -1429,6 +1719,8 @@ double LinkHierarchy::enclosed_power_share(const PatchHierarchy& hierarchy, cons
 }
 
 std::size_t LinkHierarchy::link_count() const { return impl_->sources.size(); }
+
+void LinkHierarchy::set_balancing(bool on) { impl_->balancing = on; }
 
 void LinkHierarchy::set_memory_budget(std::size_t bytes, const char* field) {
   impl_->memory_budget = resolve_memory_budget(bytes);

@@ -68,6 +68,10 @@ class LinkHierarchy {
   /// that would pass it throws Error{memory_budget} with the figure before its arrays are made,
   /// naming `field` (a string literal: the option the user sets).
   void set_memory_budget(std::size_t bytes, const char* field);
+  /// Whether refine() balances the transport of closed regions (on by default: the sweeps
+  /// conserve their power; docs/HIERARCHICAL.md, "Balancing closed regions"). Off, the links'
+  /// own estimates are used, as the view factors want them.
+  void set_balancing(bool on);
   LinkHierarchy(const LinkHierarchy&) = delete;
   LinkHierarchy& operator=(const LinkHierarchy&) = delete;
 

@@ -21,6 +21,8 @@ LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hier
   const RadiositySystem system(scene, hierarchy, false);
   LinkHierarchy links(scene, hierarchy, seed, threads);
   links.set_memory_budget(memory_budget, "ViewFactorOptions::memory_budget_bytes");
+  // The links' own factors: the view factor options have their own enclosure correction.
+  links.set_balancing(false);
   // Unit radiosity everywhere: the oracle judges the geometry alone, and its threshold (the
   // irradiance a link may get wrong) is then a view factor.
   const std::vector<Rgb> one(system.unknowns(), Rgb(1.0f));
