@@ -110,6 +110,7 @@ constexpr float kExtrapolate = 1.0f;
 /// than it sends, as coincident surfaces seen twice do, must be brought down all the way, or a
 /// region of reflectance 0.99 gains energy on every sweep).
 constexpr int kBalanceRounds = 8;
+constexpr int kWarmBalanceRounds = 3;  ///< from the last refinement pass's scales
 constexpr float kMaxBalance = 4.0f;
 /// The smallest share of the sides' area that must be enclosed for the balancing to run.
 constexpr double kBalanceMinShare = 0.01;
@@ -1181,6 +1182,8 @@ struct LinkHierarchy::Impl {
   /// would run to the bounds; r >= 1/2 stops that. Measured against Gauss-Seidel on exported
   /// rooms (docs/HIERARCHICAL.md, "Balancing closed regions").
   void update_scales(const PatchHierarchy& h) {
+    // A later pass starts from the last pass's scales (most links are the same): fewer rounds.
+    std::vector<float> last_send = std::move(send_scale), last_receive = std::move(receive_scale);
     send_scale = {};
     receive_scale = {};
     const std::uint32_t elements = linked_elements;
@@ -1250,10 +1253,13 @@ struct LinkHierarchy::Impl {
     const bool rows = std::find(closed.begin(), closed.end(), std::uint8_t{1}) != closed.end();
 
     std::vector<float> g(sides, 1.0f), r(sides, 1.0f);
+    std::copy_n(last_send.begin(), std::min(sides, last_send.size()), g.begin());
+    std::copy_n(last_receive.begin(), std::min(sides, last_receive.size()), r.begin());
+    const int rounds = last_send.empty() ? kBalanceRounds : kWarmBalanceRounds;
     std::vector<double> delivered;
     Values v;
     std::vector<Rgb> front, back, unused_front, unused_back;
-    for (int round = 0; round < kBalanceRounds; ++round) {
+    for (int round = 0; round < rounds; ++round) {
       if (rows) {
         v.front.assign(elements, Rgb(0.0f));
         v.back.assign(backs ? elements : 0, Rgb(0.0f));
