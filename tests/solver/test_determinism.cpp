@@ -94,6 +94,24 @@ std::vector<Case> cases() {
   c.push_back({"jacobi", [](unsigned t) { return solve_with(F::monte_carlo, S::jacobi, t); }});
   c.push_back({"progressive", [](unsigned t) { return solve_with(F::ray_cast, S::progressive, t); }});
   c.push_back({"hierarchical", [](unsigned t) { return solve_with(F::monte_carlo, S::hierarchical, t); }});
+  c.push_back({"hierarchical, a closed region balanced", [](unsigned t) {
+                 // A closed box with a lamp hanging inside: HierarchicalOptions::
+                 // balance_closed_regions at work (enclosure rays, the adjoint, the rounds).
+                 static const rad::Scene room = [] {
+                   rad::Material grey, lamp;
+                   grey.reflectance = rad::Rgb(0.9f);
+                   lamp.emission = rad::Rgb(10.0f);
+                   rad::Scene s = test::closed_box(grey);
+                   const rad::MaterialId id = s.add_material(lamp);
+                   s.add_polygon({{0.3f, 0.3f, 0.9f}, {0.3f, 0.7f, 0.9f}, {0.7f, 0.7f, 0.9f}, {0.7f, 0.3f, 0.9f}}, id, "lamp");
+                   return s;
+                 }();
+                 rad::SolveOptions o = coarse_solve(t);
+                 o.method = S::hierarchical;
+                 o.mesh.max_patch_area = 0.05f;
+                 o.mesh.max_element_area = 0.0125f;
+                 return solution_values(rad::solve(room, o));
+               }});
   c.push_back({"view_factor_matrix exact", [](unsigned t) {
                  rad::ViewFactorOptions o;
                  o.form_factors.method = F::ray_cast;
