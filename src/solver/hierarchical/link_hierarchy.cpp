@@ -1399,7 +1399,8 @@ struct LinkHierarchy::Impl {
         for (std::size_t side = 0; side < 2; ++side)
           delivered[2 * std::size_t{el.first_child + k} + side] +=
               delivered[2 * std::size_t{e} + side] * h.element(el.first_child + k).area / sum;
-    }  }
+    }
+  }
 
   /// `B` (per unknown) as the sweeps send it: times send_scale.
   const std::vector<Rgb>& sent(const RadiositySystem& sys, const std::vector<Rgb>& B, std::vector<Rgb>& out) const {
@@ -1436,7 +1437,8 @@ struct LinkHierarchy::Impl {
       const std::uint32_t e = sys.element(u);
       H[u] = (is_front ? front : back)[e];
       if (hold) H[u] = glm::min(H[u], (is_front ? bound_front : bound_back)[e]);
-      if (!receive_scale.empty()) H[u] *= receive_scale[2 * std::size_t{e} + (is_front ? 0 : 1)];
+      const std::size_t k = 2 * std::size_t{e} + (is_front ? 0 : 1);
+      if (k < receive_scale.size()) H[u] *= receive_scale[k];
     }
   }
   /// gather()'s work: the irradiance per element side (`back` empty without `backs`), pushed
@@ -1738,7 +1740,8 @@ std::size_t LinkHierarchy::bytes() const {
   const std::size_t clusters = m.tree.nodes().size();
   return m.sources.size() * sizeof(NodeHandle) + m.coefficients.size() * sizeof(float) +
          m.offsets.capacity() * sizeof(std::uint64_t) + clusters * (sizeof(ClusterNode) + 2 * sizeof(Moments)) +
-         m.cumulative_area.capacity() * sizeof(double) + m.sample_patches.capacity() * sizeof(Impl::SamplePatch);
+         m.cumulative_area.capacity() * sizeof(double) + m.sample_patches.capacity() * sizeof(Impl::SamplePatch) +
+         (m.send_scale.capacity() + m.receive_scale.capacity()) * sizeof(float) + m.side_enclosure.capacity();
 }
 
 const ClusterTree& LinkHierarchy::tree() const { return impl_->tree; }
