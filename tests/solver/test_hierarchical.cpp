@@ -395,8 +395,8 @@ TEST_SUITE("solver") {
     MESSAGE("inside of the room: hierarchical " << inside << ", gauss-seidel " << expected);
     CHECK(relative(inside, expected) < 0.02);
     // Balanced (the default): no gain to hold, the room's inside and the box's outside within
-    // 2 % of Gauss-Seidel (measured -0.75 % and -0.1 %), the box's inside (lit only through the
-    // coincident floor: the model's ambiguity) 24 % off instead of three times too bright.
+    // 2 % of Gauss-Seidel (measured +0.4 % and +1.0 %), the box's inside (lit only through the
+    // coincident floor: the model's ambiguity) 29 % off instead of three times too bright.
     const rad::Solution balanced = rad::solve(scene, hierarchical(0.05f));
     REQUIRE(balanced.status() == rad::SolveStatus::converged);
     CHECK_FALSE(held(balanced));
@@ -407,7 +407,7 @@ TEST_SUITE("solver") {
                                      << ref.group_back_radiosity("box").y << ")");
     CHECK(relative(balanced.group_back_radiosity("room").y, expected) < 0.02);
     CHECK(relative(balanced.group_radiosity("box").y, ref.group_radiosity("box").y) < 0.02);
-    CHECK(relative(balanced.group_back_radiosity("box").y, ref.group_back_radiosity("box").y) < 0.5);
+    CHECK(relative(balanced.group_back_radiosity("box").y, ref.group_back_radiosity("box").y) < 0.6);
   }
 
   TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there") {
@@ -416,8 +416,9 @@ TEST_SUITE("solver") {
     // of closed regions the links lose some (measured: 6.7 % of the emitted power, 9.3 % of the
     // green; Gauss-Seidel 0.2 %), which rho = 0.99 turns into a green channel 9 % low, and the
     // solve says so. The open Cornell box (31 % leaves through its front) and Gauss-Seidel on
-    // the room do not warn. Balanced (the default), the loss is under 1 % and the room and the
-    // crate within 5 % of Gauss-Seidel (measured -3 % and -4 %; unbalanced -9 % and -16 %).
+    // the room do not warn. Balanced (the default), the loss is under 1 % (measured -0.02 %) and
+    // the room and the crate within 5 % of Gauss-Seidel (green -3.4 % and -3.3 %; unbalanced -9 %
+    // and -16 %).
     auto warned = [](const rad::Solution& sol) {
       for (const std::string& w : sol.report().warnings)
         if (w.find("unaccounted for") != std::string::npos) return true;
@@ -460,8 +461,8 @@ TEST_SUITE("solver") {
             test::release_only) {
     // 9 300 elements of 0.01 m^2, reflectance 0.99, made two-sided. Without the balancing the
     // links gained energy here: the room's inside came out 60 % too bright (19.2 against 11.7)
-    // and absorbed / emitted was 1.5, with no warning. Balanced: measured +1.9 % and +0.5 %
-    // (red, green), the crate +8 % and +4 %.
+    // and absorbed / emitted was 1.5, with no warning. Balanced: measured -1.0 % (green), the
+    // crate +1.4 %, absorbed / emitted 1.0004.
     rad::Scene room = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/room_lamp_1cm_under_ceiling.obj");
     room.make_two_sided();
     rad::SolveOptions o = hierarchical(0.05f);

@@ -1173,9 +1173,10 @@ struct LinkHierarchy::Impl {
   ///   enclosed_power_share()): 1 / the power the scaled links deliver per unit of its A B,
   ///   from the adjoint of gather() (adjoint_delivery());
   /// - r_u for a side whose rays all meet wholly enclosed polygon sides (a closed room's
-  ///   inside): 1 / what it gathers from radiosity g on the enclosed sides.
+  ///   inside): 1 / what it gathers from radiosity g on the enclosed sides. Such a closed
+  ///   side's g counts only what the links take to closed sides (a second adjoint pass).
   /// Sides of open scenes are left alone: what they send partly leaves the scene, and 32 rays
-  /// cannot say how much. Deterministic: fixed rays per side, the adjoint in one serial pass.
+  /// cannot say how much. Deterministic: fixed rays per side, the adjoint in serial passes.
   /// The rows cannot always be met: a receiving cluster that spreads light over members the
   /// source sees unlike (a ceiling above a lamp 1 cm under it, fine-meshed, gathers 1.76 from
   /// uniform radiosity) asks for more than any scaling can give, and its r and the lamp's g
@@ -1256,7 +1257,8 @@ struct LinkHierarchy::Impl {
     std::copy_n(last_send.begin(), std::min(sides, last_send.size()), g.begin());
     std::copy_n(last_receive.begin(), std::min(sides, last_receive.size()), r.begin());
     const int rounds = last_send.empty() ? kBalanceRounds : kWarmBalanceRounds;
-    std::vector<double> delivered;
+    std::vector<double> delivered, delivered_closed;
+    std::vector<float> r_closed(rows ? sides : 0, 0.0f);
     Values v;
     std::vector<Rgb> front, back, unused_front, unused_back;
     for (int round = 0; round < rounds; ++round) {
@@ -1274,9 +1276,16 @@ struct LinkHierarchy::Impl {
         }
       }
       adjoint_delivery(h, backs, r, delivered);
+      if (rows) {
+        // A closed side's light lands on closed sides only: what the links take to other sides
+        // (through the walls, to a two-sided room's outer faces, through receiving clusters
+        // that hold both) is their error, and counting it as delivered would leave it lost.
+        for (std::size_t k = 0; k < sides; ++k) r_closed[k] = closed[k] ? r[k] : 0.0f;
+        adjoint_delivery(h, backs, r_closed, delivered_closed);
+      }
       for (std::size_t k = 0; k < sides; ++k) {
         if (!enclosed[k]) continue;
-        const double per_unit = delivered[k] / h.element(static_cast<std::uint32_t>(k / 2)).area;
+        const double per_unit = (closed[k] ? delivered_closed : delivered)[k] / h.element(static_cast<std::uint32_t>(k / 2)).area;
         if (per_unit > 0.0) g[k] = static_cast<float>(std::min(1.0 / per_unit, double{kMaxBalance}));
       }
     }
