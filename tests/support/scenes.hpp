@@ -37,6 +37,23 @@ inline rad::Scene closed_box(const rad::Material& m, glm::vec3 s = glm::vec3(1.0
   return scene;
 }
 
+/// `scene`'s polygons (materials and groups kept; lights and camera not) turned by `degrees`
+/// about the vertical line through `pivot`: the same scene with every wall off the axes.
+inline rad::Scene turned_about_y(const rad::Scene& scene, float degrees, glm::vec3 pivot = glm::vec3(0.0f)) {
+  rad::Scene out;
+  for (const rad::Material& m : scene.materials()) out.add_material(m);
+  const float t = degrees * 3.14159265f / 180.0f, c = std::cos(t), s = std::sin(t);
+  for (const rad::Polygon& p : scene.polygons()) {
+    std::vector<glm::vec3> v;
+    for (const glm::vec3& x : p.vertices) {
+      const glm::vec3 d = x - pivot;
+      v.push_back(pivot + glm::vec3(c * d.x + s * d.z, d.y, -s * d.x + c * d.z));
+    }
+    out.add_polygon(v, p.material, scene.groups()[p.group]);
+  }
+  return out;
+}
+
 /// A point light named `name` (a light group of its own) of `intensity` W/sr at `position`.
 inline rad::Light point_light(const char* name, float intensity, const glm::vec3& position) {
   rad::Light l;

@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <map>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -115,6 +117,91 @@ ClusterTree::ClusterTree(const PatchHierarchy& hierarchy) {
   RADIOSITY_ASSERT(nodes_.size() == 2 * static_cast<std::size_t>(n) - 1);
 }
 
+std::uint32_t MomentBases::axis_id(const glm::vec3& n) {
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    if (n[b] != 0.0f || n[c] != 0.0f) continue;
+    if (n[a] == 1.0f) return static_cast<std::uint32_t>(2 * a);
+    if (n[a] == -1.0f) return static_cast<std::uint32_t>(2 * a + 1);
+  }
+  return kNone;
+}
+
+MomentBases::MomentBases(const ClusterTree& tree, const PatchHierarchy& hierarchy,
+                         const std::vector<std::uint8_t>& has_back) {
+  const std::vector<Patch>& patches = hierarchy.patches();
+  RADIOSITY_ASSERT(has_back.size() == patches.size());
+  // Direction ids, in patch order (so the same on every run): the axes' own, else one per
+  // quantised normal.
+  std::map<std::array<std::int64_t, 3>, std::uint32_t> ids;
+  std::uint32_t next = 6;
+  auto id_of = [&](const glm::vec3& n) {
+    const std::uint32_t axis = axis_id(n);
+    if (axis != kNone) return axis;
+    const std::array<std::int64_t, 3> key{std::llround(double{n.x} * 1048576.0), std::llround(double{n.y} * 1048576.0),
+                                          std::llround(double{n.z} * 1048576.0)};
+    const auto [at, inserted] = ids.emplace(key, next);
+    if (inserted) ++next;
+    return at->second;
+  };
+  front_.resize(patches.size());
+  back_.assign(patches.size(), kNone);
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    front_[p] = id_of(patches[p].normal);
+    if (has_back[p]) back_[p] = id_of(-patches[p].normal);
+  }
+  // Bases bottom-up (children have larger ids than their parent). A cluster's set is its
+  // children's union while that has at most six directions; kOverflow marks a cluster beyond,
+  // and every cluster above it.
+  constexpr std::uint32_t kOverflow = 0;
+  const std::size_t C = tree.nodes().size();
+  of_cluster_.assign(C, kOverflow);
+  std::map<std::vector<std::uint32_t>, std::uint32_t> index;
+  // The direction sets themselves, per basis (the axes' flag alone does not say which axes).
+  std::vector<std::vector<std::uint32_t>> sets(1);
+  std::vector<std::uint32_t> set;
+  for (std::size_t i = C; i-- > 0;) {
+    const ClusterNode& node = tree.node(static_cast<std::uint32_t>(i));
+    set.clear();
+    if (node.is_leaf()) {
+      const std::uint32_t p = tree.order()[node.first];
+      set.push_back(front_[p]);
+      if (back_[p] != kNone) set.push_back(back_[p]);
+    } else {
+      const std::uint32_t l = of_cluster_[node.children[0]], r = of_cluster_[node.children[1]];
+      if (l == kOverflow || r == kOverflow) continue;
+      std::set_union(sets[l].begin(), sets[l].end(), sets[r].begin(), sets[r].end(), std::back_inserter(set));
+    }
+    std::sort(set.begin(), set.end());
+    set.erase(std::unique(set.begin(), set.end()), set.end());
+    if (set.size() > 6) continue;
+    auto found = index.find(set);
+    if (found == index.end()) {
+      if (bases_.size() >= kMaxBases) continue;
+      MomentBasis b;
+      b.axes = set.back() < 6;  // every direction along an axis: the axis moments are exact
+      b.count = static_cast<std::uint8_t>(set.size());
+      for (std::size_t k = 0; k < set.size(); ++k) b.ids[k] = set[k];
+      found = index.emplace(set, static_cast<std::uint32_t>(bases_.size())).first;
+      bases_.push_back(b);
+      sets.push_back(set);
+    }
+    of_cluster_[i] = found->second;
+  }
+  // The explicit bases' directions: each id's first patch side's normal.
+  std::vector<glm::vec3> direction(next, glm::vec3(0.0f));
+  for (int a = 0; a < 6; ++a) direction[static_cast<std::size_t>(a)] = axis_direction(a);
+  for (std::size_t p = patches.size(); p-- > 0;) {  // the first patch's normal last, so it stays
+    direction[front_[p]] = patches[p].normal;
+    if (back_[p] != kNone) direction[back_[p]] = -patches[p].normal;
+  }
+  for (std::size_t k = 1; k < bases_.size(); ++k) {
+    MomentBasis& b = bases_[k];
+    for (int j = 0; j < b.count; ++j) b.directions[static_cast<std::size_t>(j)] = direction[b.ids[static_cast<std::size_t>(j)]];
+  }
+  for (std::size_t i = 0; i < C; ++i) explicit_clusters_ += bases_[of_cluster_[i]].axes ? 0 : 1;
+}
+
 void add_surface(Moments& P, const glm::vec3& n, const Rgb& power) {
   const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
   RADIOSITY_ASSERT(l1 > 0.0f);
@@ -125,13 +212,19 @@ void add_surface(Moments& P, const glm::vec3& n, const Rgb& power) {
   }
 }
 
+Rgb intensity(const Moments& P, const MomentBasis& b, const glm::vec3& w) {
+  // I(w) = (1/pi) sum_k P_k max(0, u_k . w) (docs/HIERARCHICAL.md, "Transport through a cluster").
+  return kInvPi * directional_sum(P, b, w);
+}
+
 Rgb intensity(const Moments& P, const glm::vec3& w) {
   // I(w) = (1/pi) sum_a |w_a| P[sign(w_a) a] (docs/HIERARCHICAL.md, "Transport through a cluster").
   return kInvPi * directional_sum(P, w);
 }
 
-void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const std::vector<Rgb>& front,
-                     const std::vector<Rgb>& back, unsigned threads, std::vector<Moments>& out) {
+void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, const MomentBases& bases,
+                     const std::vector<Rgb>& front, const std::vector<Rgb>& back, unsigned threads,
+                     std::vector<Moments>& out) {
   const std::vector<Patch>& patches = hierarchy.patches();
   RADIOSITY_ASSERT(front.size() == patches.size());
   RADIOSITY_ASSERT(back.empty() || back.size() == patches.size());
@@ -139,9 +232,13 @@ void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, c
   // Leaves: each patch's B A split by its normal, every leaf written by one index alone.
   parallel_for(threads, patches.size(), 1024, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
-      Moments& leaf = out[tree.leaf_of(static_cast<std::uint32_t>(p))];
-      add_surface(leaf, patches[p].normal, front[p] * patches[p].area);
-      if (!back.empty()) add_surface(leaf, -patches[p].normal, back[p] * patches[p].area);
+      const std::uint32_t c = tree.leaf_of(static_cast<std::uint32_t>(p));
+      const auto patch = static_cast<std::uint32_t>(p);
+      const glm::vec3& n = patches[p].normal;
+      add_surface(out[c], bases.of(c), bases.front(patch, n), front[p] * patches[p].area);
+      // A patch without a back side sends 0 there (and may lack the direction).
+      if (!back.empty() && back[p] != Rgb(0.0f))
+        add_surface(out[c], bases.of(c), bases.back(patch, n), back[p] * patches[p].area);
     }
   });
   // Inner nodes: children before parents (depth-first ids), left child then right, so every sum
@@ -149,7 +246,8 @@ void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, c
   for (std::size_t i = tree.nodes().size(); i-- > 0;) {
     const ClusterNode& node = tree.node(static_cast<std::uint32_t>(i));
     if (node.is_leaf()) continue;
-    for (int k = 0; k < 6; ++k) out[i][k] = out[node.children[0]][k] + out[node.children[1]][k];
+    for (const std::uint32_t child : node.children)
+      pull_moments(out[child], bases.of(child), out[i], bases.of(static_cast<std::uint32_t>(i)));
   }
 }
 
@@ -157,6 +255,17 @@ void add_irradiance(Moments& E, const glm::vec3& d, const Rgb& flux) {
   for (int a = 0; a < 3; ++a) {
     if (d[a] > 0.0f) E[2 * a] += flux * d[a];
     if (d[a] < 0.0f) E[2 * a + 1] -= flux * d[a];
+  }
+}
+
+void add_irradiance(Moments& E, const MomentBasis& b, const glm::vec3& d, const Rgb& flux) {
+  if (b.axes) {
+    add_irradiance(E, d, flux);
+    return;
+  }
+  for (int k = 0; k < b.count; ++k) {
+    const float c = glm::dot(b.directions[static_cast<std::size_t>(k)], d);
+    if (c > 0.0f) E[static_cast<std::size_t>(k)] += flux * c;
   }
 }
 

@@ -170,7 +170,9 @@ struct LinkHierarchy::Impl {
     std::uint8_t corner_count, has_back;
   };
   std::vector<SamplePatch> sample_patches;
-  /// Per cluster: its sides' area split by their normals as add_surface() splits power
+  /// Per cluster: the directions its moments are kept along (refresh_patch_data()).
+  MomentBases bases;
+  /// Per cluster: its sides' area in its basis, as add_surface() adds power
   /// (refresh_patch_data()): what it shows toward a direction (projected_area()).
   std::vector<std::array<float, 6>> area_moments;
 
@@ -311,21 +313,20 @@ struct LinkHierarchy::Impl {
       sp.normal = patch.normal;
       sp.has_back = has_back[order[k]];
     }
+    bases = MomentBases(tree, hierarchy, has_back);
     const std::uint32_t C = cluster_count();
     area_moments.assign(C, std::array<float, 6>{});
     for (std::uint32_t i = C; i-- > 0;) {
       const ClusterNode& c = tree.node(i);
       std::array<float, 6>& m = area_moments[i];
       if (!c.is_leaf()) {
-        for (int a = 0; a < 6; ++a) m[a] = area_moments[c.children[0]][a] + area_moments[c.children[1]][a];
+        for (const std::uint32_t child : c.children) pull_moments(area_moments[child], bases.of(child), m, bases.of(i));
         continue;
       }
       const std::uint32_t p = tree.order()[c.first];
       const Patch& patch = hierarchy.patches()[p];
-      Moments one{};
-      add_surface(one, patch.normal, Rgb(patch.area));
-      if (has_back[p]) add_surface(one, -patch.normal, Rgb(patch.area));
-      for (int a = 0; a < 6; ++a) m[a] = one[a].x;
+      add_surface(m, bases.of(i), bases.front(p, patch.normal), patch.area);
+      if (has_back[p]) add_surface(m, bases.of(i), bases.back(p, patch.normal), patch.area);
     }
   }
 
@@ -333,7 +334,7 @@ struct LinkHierarchy::Impl {
   /// A max(0, n . v) (exact for axis-aligned sides of a cluster, as the moments are).
   float projected_area(const PatchHierarchy& h, NodeHandle n, const glm::vec3& v) const {
     if (!is_cluster(n)) return h.element(element_of(n)).area * std::max(0.0f, glm::dot(side_normal(h, n), v));
-    return directional_sum(area_moments[handle_index(n)], v);
+    return directional_sum(area_moments[handle_index(n)], bases.of(handle_index(n)), v);
   }
 
   /// The unoccluded transport (pi x power, for B = 1 on every side) from `s` to `r` taken
@@ -353,7 +354,9 @@ struct LinkHierarchy::Impl {
   /// directional_sum()); an element side's are A n_a and -A n_a (the sum is then A n . v).
   /// Stored by component, so that refined_transport()'s loop over pairs is vectorised.
   struct TransportEnds {
-    static constexpr std::size_t kMax = 64;  ///< 4^3: an element's third level
+    /// 4^3, an element's third level; a cluster's third level is at most 8 clusters of up to
+    /// 6 ends (an explicit basis) or 16 elements.
+    static constexpr std::size_t kMax = 64;
     alignas(16) std::array<float, kMax> x, y, z, pos_x, pos_y, pos_z, neg_x, neg_y, neg_z;
     std::size_t count = 0;
     void add(const glm::vec3& at, const glm::vec3& pos, const glm::vec3& neg) {
@@ -371,8 +374,19 @@ struct LinkHierarchy::Impl {
     const int k = levels > 0 ? children(h, n, kids) : 0;
     if (k == 0) {
       if (is_cluster(n)) {
-        const std::array<float, 6>& m = area_moments[handle_index(n)];
-        out.add(cluster_centroid[handle_index(n)], glm::vec3(m[0], m[2], m[4]), glm::vec3(m[1], m[3], m[5]));
+        const std::uint32_t c = handle_index(n);
+        const std::array<float, 6>& m = area_moments[c];
+        const MomentBasis& b = bases.of(c);
+        if (b.axes) {
+          out.add(cluster_centroid[c], glm::vec3(m[0], m[2], m[4]), glm::vec3(m[1], m[3], m[5]));
+          return;
+        }
+        // An explicit basis: one end per direction, as an element of that normal and area at
+        // the centroid (the pairs' products then sum to the product of the sums).
+        for (int j = 0; j < b.count; ++j) {
+          const glm::vec3 an = m[static_cast<std::size_t>(j)] * b.directions[static_cast<std::size_t>(j)];
+          out.add(cluster_centroid[c], an, -an);
+        }
       } else {
         const Element& e = h.element(element_of(n));
         const glm::vec3 an = e.area * side_normal(h, n);
@@ -445,7 +459,7 @@ struct LinkHierarchy::Impl {
       patch_front[p] = v.front[patches[p].root];
       if (!v.back.empty()) patch_back[p] = v.back[patches[p].root];
     }
-    sending_moments(tree, hierarchy, patch_front, patch_back, threads, v.sending);
+    sending_moments(tree, hierarchy, bases, patch_front, patch_back, threads, v.sending);
     v.cluster_max.assign(tree.nodes().size(), Rgb(0.0f));
     for (std::uint32_t c = cluster_count(); c-- > 0;) {  // children after parents
       const ClusterNode& node = tree.node(c);
@@ -497,7 +511,7 @@ struct LinkHierarchy::Impl {
 
   /// Radiant intensity (W/sr) of node `h` toward the unit direction `w`.
   Rgb source_intensity(const PatchHierarchy& hierarchy, const Values& v, NodeHandle h, const glm::vec3& w) const {
-    if (is_cluster(h)) return intensity(v.sending[handle_index(h)], w);
+    if (is_cluster(h)) return intensity(v.sending[handle_index(h)], bases.of(handle_index(h)), w);
     const std::uint32_t e = element_of(h);
     const float cosine = std::max(0.0f, glm::dot(side_normal(hierarchy, h), w));
     const Rgb& B = (is_back(h) ? v.back : v.front)[e];
@@ -762,11 +776,24 @@ struct LinkHierarchy::Impl {
   /// False when no side of cluster `c` faces any point of the box `to`. A side of normal n at
   /// x faces y when n . (y - x) > 0, which needs an axis a along which n and y - x have the same
   /// sign: n's share on +a (or -a) is in the cluster's area moments, and y - x can be positive
-  /// along a only if the box reaches above the cluster's lowest a. A necessary condition, so
-  /// never a wrong refusal; it drops a roof cluster seen from the ground below in one step.
+  /// along a only if the box reaches above the cluster's lowest a (with an explicit basis, the
+  /// largest u . (y - x) per direction u). A necessary condition, so never a wrong refusal; it
+  /// drops a roof cluster seen from the ground below in one step.
   bool cluster_faces(std::uint32_t c, const Bounds& to, float tolerance) const {
     const std::array<float, 6>& m = area_moments[c];
     const Bounds& from = tree.node(c).bounds;
+    const MomentBasis& b = bases.of(c);
+    if (!b.axes) {
+      // Each direction u it has area along: the largest u . (y - x) over the two boxes.
+      for (int k = 0; k < b.count; ++k) {
+        if (!(m[static_cast<std::size_t>(k)] > 0.0f)) continue;
+        const glm::vec3& u = b.directions[static_cast<std::size_t>(k)];
+        float reach = 0.0f;
+        for (int a = 0; a < 3; ++a) reach += u[a] >= 0.0f ? u[a] * (to.upper[a] - from.lower[a]) : u[a] * (to.lower[a] - from.upper[a]);
+        if (reach > tolerance) return true;
+      }
+      return false;
+    }
     for (int a = 0; a < 3; ++a) {
       if (m[static_cast<std::size_t>(2 * a)] > 0.0f && to.upper[a] > from.lower[a] + tolerance) return true;
       if (m[static_cast<std::size_t>(2 * a + 1)] > 0.0f && to.lower[a] < from.upper[a] - tolerance) return true;
@@ -1323,17 +1350,13 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t i = C; i-- > 0;) {
       const ClusterNode& c = tree.node(i);
       if (!c.is_leaf()) {
-        for (int a = 0; a < 6; ++a) Q[i][a] = Q[c.children[0]][a] + Q[c.children[1]][a];
+        for (const std::uint32_t child : c.children) push_transpose(Q[child], bases.of(child), Q[i], bases.of(i));
         continue;
       }
       const std::uint32_t p = tree.order()[c.first];
       const glm::vec3& n = patches[p].normal;
-      const double wf = W[2 * std::size_t{patches[p].root}];
-      const double wb = backs && has_back[p] ? W[2 * std::size_t{patches[p].root} + 1] : 0.0;
-      for (int a = 0; a < 3; ++a) {
-        Q[i][2 * a] += wf * std::max(0.0f, n[a]) + wb * std::max(0.0f, -n[a]);
-        Q[i][2 * a + 1] += wf * std::max(0.0f, -n[a]) + wb * std::max(0.0f, n[a]);
-      }
+      add_element_weight(Q[i], bases.of(i), bases.front(p, n), W[2 * std::size_t{patches[p].root}]);
+      if (backs && has_back[p]) add_element_weight(Q[i], bases.of(i), bases.back(p, n), W[2 * std::size_t{patches[p].root} + 1]);
     }
     // The links, receiver by receiver: what each source's value delivers. R per cluster: per
     // unit of its six sending moments.
@@ -1341,7 +1364,14 @@ struct LinkHierarchy::Impl {
     std::vector<std::array<double, 6>> R(C, std::array<double, 6>{});
     auto from_source = [&](NodeHandle s, const glm::vec3& w, double kappa) {  // kappa per unit I_s(w)
       if (is_cluster(s)) {
-        for (int a = 0; a < 3; ++a) R[handle_index(s)][w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
+        const MomentBasis& b = bases.of(handle_index(s));
+        std::array<double, 6>& to = R[handle_index(s)];
+        if (b.axes) {
+          for (int a = 0; a < 3; ++a) to[w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
+          return;
+        }
+        for (int k = 0; k < b.count; ++k)
+          to[static_cast<std::size_t>(k)] += kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w));
         return;
       }
       const std::uint32_t e = element_of(s);
@@ -1356,11 +1386,18 @@ struct LinkHierarchy::Impl {
       const glm::vec3 cr = centroid(h, r);
       if (is_cluster(r)) {
         const std::array<double, 6>& q = Q[handle_index(r)];
+        const MomentBasis& b = bases.of(handle_index(r));
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
           const glm::vec3 w = glm::normalize(cr - centroid(h, s));
-          double taken = 0.0;  // element_irradiance(Q, -w)
-          for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * q[2 * a] : w[a] * q[2 * a + 1];
+          // add_irradiance()'s transpose: sum_k Q_k max(0, u_k . d), d = -w.
+          double taken = 0.0;
+          if (b.axes) {
+            for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * q[2 * a] : w[a] * q[2 * a + 1];
+          } else {
+            for (int j = 0; j < b.count; ++j)
+              taken += std::max(0.0f, -glm::dot(b.directions[static_cast<std::size_t>(j)], w)) * q[static_cast<std::size_t>(j)];
+          }
           from_source(s, w, std::abs(coefficients[k]) * taken);
         }
         continue;
@@ -1382,20 +1419,26 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t i = 0; i < C; ++i) {
       const ClusterNode& c = tree.node(i);
       if (!c.is_leaf()) {
-        for (const std::uint32_t child : c.children)
-          for (int a = 0; a < 6; ++a) R[child][a] += R[i][a];
+        for (const std::uint32_t child : c.children) {
+          // pull_moments()'s transpose.
+          const MomentBasis& cb = bases.of(child);
+          const MomentBasis& pb = bases.of(i);
+          if (cb.axes && pb.axes) {
+            for (int a = 0; a < 6; ++a) R[child][a] += R[i][a];
+            continue;
+          }
+          for (int k = 0; k < cb.slots(); ++k) {
+            const SideDirection d = cb.direction(k);
+            if (pb.axes || pb.slot(d.id) >= 0) R[child][static_cast<std::size_t>(k)] += surface_share(R[i], pb, d);
+          }
+        }
         continue;
       }
       const std::uint32_t p = tree.order()[c.first];
       const glm::vec3& n = patches[p].normal;
-      const float l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
-      double front = 0.0, back = 0.0;
-      for (int a = 0; a < 3; ++a) {
-        front += R[i][n[a] >= 0.0f ? 2 * a : 2 * a + 1] * std::abs(n[a]) / l1;
-        back += R[i][n[a] >= 0.0f ? 2 * a + 1 : 2 * a] * std::abs(n[a]) / l1;
-      }
-      delivered[2 * std::size_t{patches[p].root}] += front * patches[p].area;
-      if (backs && has_back[p]) delivered[2 * std::size_t{patches[p].root} + 1] += back * patches[p].area;
+      delivered[2 * std::size_t{patches[p].root}] += surface_share(R[i], bases.of(i), bases.front(p, n)) * patches[p].area;
+      if (backs && has_back[p])
+        delivered[2 * std::size_t{patches[p].root} + 1] += surface_share(R[i], bases.of(i), bases.back(p, n)) * patches[p].area;
     }
     // The pull's transpose: an inner element's value is its children's area-weighted mean.
     for (std::uint32_t e = 0; e < elements; ++e) {
@@ -1483,7 +1526,7 @@ struct LinkHierarchy::Impl {
           for (std::uint64_t k = first; k < last; ++k) {
             const NodeHandle s = sources[k];
             const glm::vec3 w = glm::normalize(cr - centroid(hierarchy, s));
-            add_irradiance(E, -w, std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w));
+            add_irradiance(E, bases.of(handle_index(r)), -w, std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w));
           }
           continue;
         }
@@ -1508,17 +1551,17 @@ struct LinkHierarchy::Impl {
       const ClusterNode& node = tree.node(c);
       if (!node.is_leaf()) {
         for (std::uint32_t child : node.children) {
-          for (int a = 0; a < 6; ++a) received[child][a] += received[c][a];
+          push_moments(received[c], bases.of(c), received[child], bases.of(child));
           if (hold) bound_cluster[child] = glm::max(bound_cluster[child], bound_cluster[c]);
         }
         continue;
       }
       const std::uint32_t p = tree.order()[node.first];
       const Patch& patch = hierarchy.patches()[p];
-      front[patch.root] += element_irradiance(received[c], patch.normal);
+      front[patch.root] += element_irradiance(received[c], bases.of(c), bases.front(p, patch.normal));
       if (hold) bound_front[patch.root] = glm::max(bound_front[patch.root], bound_cluster[c]);
       if (!back.empty() && has_back[p]) {
-        back[patch.root] += element_irradiance(received[c], -patch.normal);
+        back[patch.root] += element_irradiance(received[c], bases.of(c), bases.back(p, patch.normal));
         if (hold) bound_back[patch.root] = glm::max(bound_back[patch.root], bound_cluster[c]);
       }
     }
@@ -1750,7 +1793,8 @@ std::size_t LinkHierarchy::bytes() const {
   return m.sources.size() * sizeof(NodeHandle) + m.coefficients.size() * sizeof(float) +
          m.offsets.capacity() * sizeof(std::uint64_t) + clusters * (sizeof(ClusterNode) + 2 * sizeof(Moments)) +
          m.cumulative_area.capacity() * sizeof(double) + m.sample_patches.capacity() * sizeof(Impl::SamplePatch) +
-         (m.send_scale.capacity() + m.receive_scale.capacity()) * sizeof(float) + m.side_enclosure.capacity();
+         (m.send_scale.capacity() + m.receive_scale.capacity()) * sizeof(float) + m.side_enclosure.capacity() +
+         m.bases.memory_bytes();
 }
 
 const ClusterTree& LinkHierarchy::tree() const { return impl_->tree; }
