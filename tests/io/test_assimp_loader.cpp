@@ -391,6 +391,18 @@ TEST_CASE("Assimp broken COLLADA: a stray character in an index list - an array 
   }
 }
 
+TEST_CASE("Assimp broken 3DS: an animation track whose key count its chunk cannot hold is refused before Assimp reserves it") {
+  // Found by radiosity_fuzz_3ds (session 19): 778923887 rotation keys in a 30-byte chunk, for
+  // which Assimp 5.2 reserved 18.7 GB before reading one (tests/data/fuzz/3ds).
+  const fs::path found = fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "3ds" / "track_key_count.3ds";
+  const Error e = load_error(found);
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "track_key_count.3ds: 3DS animation track (chunk 0xB021 at byte 1794) declares 778923887 "
+                           "keys, but its 30 bytes hold at most 1 (a corrupted file or a wrong count)"));
+  // The room exported by Assimp has no such track and still loads (the next test reads it whole).
+  CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.3ds").polygons().size() > 0);
+}
+
 TEST_CASE("Assimp: a room exported as COLLADA - ASCII FBX and 3DS reads as its OBJ does - the lamp emitting") {
   // tests/data/assimp: tests/data/messy/exported_room.obj written by Assimp 5.2's exporters
   // (the fuzz targets' seeds too). Assimp triangulates, so the OBJ's 14 polygons are 28 triangles
