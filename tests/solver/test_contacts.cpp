@@ -58,12 +58,18 @@ TEST_SUITE("solver") {
     CHECK(crossing);
 
     const double pi = 3.14159265358979323846;
+    // The three matrix estimators with Gauss-Seidel, then the hierarchical solver (its links'
+    // shadow rays find buried points as these do; what receiving clusters push down is given to
+    // each part by the share of it that is not buried: docs/HIERARCHICAL.md, "Buried parts").
     const std::vector<rad::FormFactorMethod> methods{rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::hemicube,
-                                                     rad::FormFactorMethod::monte_carlo};
+                                                     rad::FormFactorMethod::monte_carlo, rad::FormFactorMethod::automatic};
     for (rad::FormFactorMethod method : methods) {
+      const bool hierarchical = method == rad::FormFactorMethod::automatic;
       CAPTURE(static_cast<int>(method));
+      CAPTURE(hierarchical);
       rad::SolveOptions o;
       o.form_factors.method = method;
+      if (hierarchical) o.method = rad::SolverMethod::hierarchical;
       // 64 rather than 128: the same figures (display RMSE 0.049 against the path tracer, the
       // box's bottom at 3e-4 of the floor) at 60 % of the time.
       o.form_factors.hemicube_resolution = 64;
@@ -87,9 +93,19 @@ TEST_SUITE("solver") {
       MESSAGE("floor mean " << floor_mean << "; under the box " << under << ", box bottom " << bottom
                             << ", floor inside the ball " << in_ball << ", ball below the floor " << ball_below);
       CHECK(under < 1e-3 * floor_mean);
-      CHECK(bottom < 1e-3 * floor_mean);
       CHECK(in_ball < 1e-3 * floor_mean);
-      CHECK(ball_below < 1e-3 * floor_mean);
+      if (!hierarchical) {
+        CHECK(bottom < 1e-3 * floor_mean);
+        CHECK(ball_below < 1e-3 * floor_mean);
+      } else {
+        // The box's bottom (its rays start below the floor it lies on and leave the room) and
+        // the ball below the floor (outside the room) are not buried, only out of sight of
+        // everything: their light comes from receiving clusters pushed down (measured 1.9e-3
+        // and 1.7e-2 of the floor's mean, session 19). The floor under the box and inside the
+        // ball are buried and get none.
+        CHECK(bottom < 5e-3 * floor_mean);
+        CHECK(ball_below < 3e-2 * floor_mean);
+      }
 
       // No bright seam: a patch of floor 3-15 cm outside the box's -x side is no brighter than
       // the path tracer says (it is partly shadowed by the box).

@@ -193,6 +193,17 @@ struct LinkHierarchy::Impl {
   /// Per element side: whether update_scales() found it enclosed (0 not yet tested, 1 open, 2
   /// enclosed).
   std::vector<std::uint8_t> side_enclosure;
+  /// Per element side (2 e + 1 for its back): the share of its area that is not buried (inside
+  /// a block standing on it: update_exposure()), leaves sampled once, inner elements the
+  /// area-weighted mean of their children (empty until refine()). What a receiving node gathers
+  /// is pushed to each part below it in proportion, so that a floor element half under a block
+  /// gets nothing for its buried half.
+  std::vector<float> exposure;
+  /// Per cluster with a buried part: an index into open_moments, its sides' exposed area in its
+  /// basis (as area_moments holds their area); kNone for a cluster wholly exposed. A cluster's
+  /// exposure toward a direction is the one over the other (cluster_exposure_toward()).
+  std::vector<std::uint32_t> open_index;
+  std::vector<std::array<float, 6>> open_moments;
 
   /// Node radiosity for the oracle and the sweeps.
   struct Values {
@@ -1122,6 +1133,148 @@ struct LinkHierarchy::Impl {
     linked = true;
   }
 
+  // ---- Buried parts ------------------------------------------------------------------------
+
+  /// The share of element side (e, back)'s area that is not buried: of kExposurePoints points
+  /// (2 x 2 cell centres), those from which some of kExposureDirections rays (the normal, and
+  /// three at 60 degrees from it) does not end on the back of a one-sided polygon. A point
+  /// under a block standing on it sees only the block's insides every way; a point under a
+  /// one-sided table top sees its back above but out to the sides. Rays and hemicubes find
+  /// buried points by themselves (docs/FORM_FACTORS.md, "Touching ... geometry"), as do the
+  /// links' shadow rays from a receiver's points; light pushed down from a receiving cluster or
+  /// a larger element does not, and this share is what the push gives each part.
+  float sample_exposure(const PatchHierarchy& h, std::uint32_t e, bool back, const std::vector<std::uint8_t>& back_surface) const {
+    const glm::vec3 n = back ? -h.normal(e) : h.normal(e);
+    const Frame frame(n);
+    constexpr float kSin = 0.8660254f, kCos = 0.5f;  // 60 degrees
+    const std::array<glm::vec3, 4> directions{frame.to_world(glm::vec3(0.0f, 0.0f, 1.0f)),
+                                              frame.to_world(glm::vec3(kSin, 0.0f, kCos)),
+                                              frame.to_world(glm::vec3(-0.5f * kSin, 0.8660254f * kSin, kCos)),
+                                              frame.to_world(glm::vec3(-0.5f * kSin, -0.8660254f * kSin, kCos))};
+    constexpr std::array<float, 2> kCells{0.25f, 0.75f};
+    int exposed = 0;
+    for (const float u : kCells)
+      for (const float v : kCells) {
+        const glm::vec3 x = h.sample_point(e, glm::vec2(u, v)) + ray_epsilon * n;
+        bool buried = true;
+        for (const glm::vec3& d : directions) {
+          const std::optional<RayScene::Hit> hit = occluders.intersect(x, d, 0.0f, std::numeric_limits<float>::infinity());
+          const bool sealed = hit && glm::dot(d, hit->geometric_normal) > 0.0f && !back_surface[hit->id];
+          if (!sealed) {
+            buried = false;
+            break;
+          }
+        }
+        exposed += buried ? 0 : 1;
+      }
+    return static_cast<float>(exposed) / 4.0f;
+  }
+
+  /// exposure, open_index and open_moments for the elements as they stand: new leaves sampled, inner
+  /// elements and clusters aggregated. After refinement, which may split elements.
+  void update_exposure(const PatchHierarchy& h) {
+    const std::size_t count = h.elements().size();
+    const std::vector<Patch>& patches = h.patches();
+    exposure.resize(2 * count, -1.0f);
+    std::vector<std::uint8_t> back_surface(scene.polygons().size(), 0);
+    for (std::size_t p = 0; p < patches.size(); ++p)
+      if (has_back[p]) back_surface[patches[p].polygon] = 1;
+    std::vector<std::uint32_t> todo;
+    for (std::uint32_t e = 0; e < count; ++e)
+      if (h.element(e).is_leaf() && exposure[2 * std::size_t{e}] < 0.0f) todo.push_back(e);
+    parallel_for(threads, todo.size(), 256, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t e = todo[i];
+        exposure[2 * std::size_t{e}] = sample_exposure(h, e, false, back_surface);
+        exposure[2 * std::size_t{e} + 1] = has_back[h.element(e).patch] ? sample_exposure(h, e, true, back_surface) : 1.0f;
+      }
+    });
+    for (std::uint32_t e = static_cast<std::uint32_t>(count); e-- > 0;) {  // children before parents
+      const Element& el = h.element(e);
+      if (el.is_leaf()) continue;
+      for (std::size_t side = 0; side < 2; ++side) {
+        double area = 0.0, open = 0.0;
+        for (std::uint32_t k = 0; k < 4; ++k) {
+          const double a = h.element(el.first_child + k).area;
+          area += a;
+          open += a * exposure[2 * std::size_t{el.first_child + k} + side];
+        }
+        exposure[2 * std::size_t{e} + side] = area > 0.0 ? static_cast<float>(open / area) : 1.0f;
+      }
+    }
+    // The clusters' exposed area moments, only where something below is buried.
+    const std::uint32_t C = cluster_count();
+    open_index.assign(C, kNone);
+    open_moments.clear();
+    for (std::uint32_t i = C; i-- > 0;) {
+      const ClusterNode& c = tree.node(i);
+      std::array<float, 6> open{};
+      if (c.is_leaf()) {
+        const std::uint32_t p = tree.order()[c.first];
+        const std::uint32_t root = patches[p].root;
+        const float front = exposure[2 * std::size_t{root}], back = exposure[2 * std::size_t{root} + 1];
+        if (front == 1.0f && (!has_back[p] || back == 1.0f)) continue;
+        add_surface(open, bases.of(i), bases.front(p, patches[p].normal), patches[p].area * front);
+        if (has_back[p]) add_surface(open, bases.of(i), bases.back(p, patches[p].normal), patches[p].area * back);
+      } else {
+        if (open_index[c.children[0]] == kNone && open_index[c.children[1]] == kNone) continue;
+        for (const std::uint32_t child : c.children)
+          pull_moments(open_index[child] == kNone ? area_moments[child] : open_moments[open_index[child]],
+                       bases.of(child), open, bases.of(i));
+      }
+      open_index[i] = static_cast<std::uint32_t>(open_moments.size());
+      open_moments.push_back(open);
+    }
+  }
+  /// What a node's irradiance is multiplied by as it is pushed to a part below it: the part's
+  /// exposure over the node's (power kept: the node's is the parts' area-weighted mean).
+  static float exposure_ratio(float part, float node) { return node > 0.0f ? part / node : 0.0f; }
+  float element_exposure(std::uint32_t e, bool back) const {
+    const std::size_t k = 2 * std::size_t{e} + (back ? 1 : 0);
+    return k < exposure.size() ? exposure[k] : 1.0f;
+  }
+  /// The exposure of cluster `c`'s sides of direction `d`: their exposed area over their area
+  /// (on the axes, of the sides its moments for `d` stand for).
+  float cluster_exposure_toward(std::uint32_t c, const SideDirection& d) const {
+    const std::uint32_t k = c < open_index.size() ? open_index[c] : kNone;
+    if (k == kNone) return 1.0f;
+    const float area = element_irradiance(area_moments[c], bases.of(c), d);
+    return area > 0.0f ? element_irradiance(open_moments[k], bases.of(c), d) / area : 1.0f;
+  }
+  bool wholly_exposed(std::uint32_t c) const { return c >= open_index.size() || open_index[c] == kNone; }
+  /// push_moments() from cluster `pc` to its child `cc`, each direction of the child's in
+  /// proportion to its exposure over the parent's.
+  template <typename T>
+  void push_exposed(const std::array<T, 6>& parent, std::uint32_t pc, std::array<T, 6>& child, std::uint32_t cc) const {
+    const MomentBasis& pb = bases.of(pc);
+    const MomentBasis& cb = bases.of(cc);
+    if (wholly_exposed(pc) && wholly_exposed(cc)) {
+      push_moments(parent, pb, child, cb);
+      return;
+    }
+    for (int j = 0; j < cb.slots(); ++j) {
+      const SideDirection d = cb.direction(j);
+      child[static_cast<std::size_t>(j)] +=
+          element_irradiance(parent, pb, d) * exposure_ratio(cluster_exposure_toward(cc, d), cluster_exposure_toward(pc, d));
+    }
+  }
+  /// push_exposed()'s transpose (the balancing's adjoint).
+  template <typename T>
+  void push_exposed_transpose(const std::array<T, 6>& Qc, std::uint32_t cc, std::array<T, 6>& Qp, std::uint32_t pc) const {
+    const MomentBasis& pb = bases.of(pc);
+    const MomentBasis& cb = bases.of(cc);
+    if (wholly_exposed(pc) && wholly_exposed(cc)) {
+      push_transpose(Qc, cb, Qp, pb);
+      return;
+    }
+    for (int j = 0; j < cb.slots(); ++j) {
+      const SideDirection d = cb.direction(j);
+      add_element_weight(Qp, pb, d,
+                         Qc[static_cast<std::size_t>(j)] *
+                             exposure_ratio(cluster_exposure_toward(cc, d), cluster_exposure_toward(pc, d)));
+    }
+  }
+
   // ---- Enclosure ----------------------------------------------------------------------------
 
   /// Casts an element side's kEnclosureRays cosine-distributed rays (points and directions from
@@ -1340,7 +1493,9 @@ struct LinkHierarchy::Impl {
           w = static_cast<double>(el.area) * weight[2 * std::size_t{e} + side];
           continue;
         }
-        for (std::uint32_t k = 0; k < 4; ++k) w += W[2 * std::size_t{el.first_child + k} + side];
+        for (std::uint32_t k = 0; k < 4; ++k)  // the push's transpose, its exposure ratios too
+          w += W[2 * std::size_t{el.first_child + k} + side] *
+               exposure_ratio(element_exposure(el.first_child + k, side == 1), element_exposure(e, side == 1));
       }
     }
     // Q per cluster: the power its patches take in from unit irradiance moments (the push's
@@ -1350,13 +1505,20 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t i = C; i-- > 0;) {
       const ClusterNode& c = tree.node(i);
       if (!c.is_leaf()) {
-        for (const std::uint32_t child : c.children) push_transpose(Q[child], bases.of(child), Q[i], bases.of(i));
+        for (const std::uint32_t child : c.children) push_exposed_transpose(Q[child], child, Q[i], i);
         continue;
       }
       const std::uint32_t p = tree.order()[c.first];
       const glm::vec3& n = patches[p].normal;
-      add_element_weight(Q[i], bases.of(i), bases.front(p, n), W[2 * std::size_t{patches[p].root}]);
-      if (backs && has_back[p]) add_element_weight(Q[i], bases.of(i), bases.back(p, n), W[2 * std::size_t{patches[p].root} + 1]);
+      const std::uint32_t root = patches[p].root;
+      const SideDirection front = bases.front(p, n), back = bases.back(p, n);
+      add_element_weight(Q[i], bases.of(i), front,
+                         W[2 * std::size_t{root}] *
+                             exposure_ratio(element_exposure(root, false), cluster_exposure_toward(i, front)));
+      if (backs && has_back[p])
+        add_element_weight(Q[i], bases.of(i), back,
+                           W[2 * std::size_t{root} + 1] *
+                               exposure_ratio(element_exposure(root, true), cluster_exposure_toward(i, back)));
     }
     // The links, receiver by receiver: what each source's value delivers. R per cluster: per
     // unit of its six sending moments.
@@ -1551,17 +1713,20 @@ struct LinkHierarchy::Impl {
       const ClusterNode& node = tree.node(c);
       if (!node.is_leaf()) {
         for (std::uint32_t child : node.children) {
-          push_moments(received[c], bases.of(c), received[child], bases.of(child));
+          push_exposed(received[c], c, received[child], child);
           if (hold) bound_cluster[child] = glm::max(bound_cluster[child], bound_cluster[c]);
         }
         continue;
       }
       const std::uint32_t p = tree.order()[node.first];
       const Patch& patch = hierarchy.patches()[p];
-      front[patch.root] += element_irradiance(received[c], bases.of(c), bases.front(p, patch.normal));
+      const SideDirection front_side = bases.front(p, patch.normal), back_side = bases.back(p, patch.normal);
+      front[patch.root] += element_irradiance(received[c], bases.of(c), front_side) *
+                           exposure_ratio(element_exposure(patch.root, false), cluster_exposure_toward(c, front_side));
       if (hold) bound_front[patch.root] = glm::max(bound_front[patch.root], bound_cluster[c]);
       if (!back.empty() && has_back[p]) {
-        back[patch.root] += element_irradiance(received[c], bases.of(c), bases.back(p, patch.normal));
+        back[patch.root] += element_irradiance(received[c], bases.of(c), back_side) *
+                            exposure_ratio(element_exposure(patch.root, true), cluster_exposure_toward(c, back_side));
         if (hold) bound_back[patch.root] = glm::max(bound_back[patch.root], bound_cluster[c]);
       }
     }
@@ -1569,8 +1734,9 @@ struct LinkHierarchy::Impl {
       const Element& el = hierarchy.element(e);
       if (el.is_leaf()) continue;
       for (std::uint32_t k = 0; k < 4; ++k) {
-        front[el.first_child + k] += front[e];
-        if (!back.empty()) back[el.first_child + k] += back[e];
+        const std::uint32_t child = el.first_child + k;
+        front[child] += front[e] * exposure_ratio(element_exposure(child, false), element_exposure(e, false));
+        if (!back.empty()) back[child] += back[e] * exposure_ratio(element_exposure(child, true), element_exposure(e, true));
         if (!hold) continue;
         bound_front[el.first_child + k] = glm::max(bound_front[el.first_child + k], bound_front[e]);
         if (!back.empty())
@@ -1698,6 +1864,7 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   }
   replaced = {};
   m.merge(chunks, elements);
+  m.update_exposure(hierarchy);
   m.update_scales(hierarchy);
   return true;
 }
