@@ -602,7 +602,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       if (solved && split.empty() && stats.links_replaced == 0) break;  // nothing changed
       report.refinement_passes = pass;
       detail::SolverContext context{scene, hierarchy, *system, nullptr, o, gate, nullptr};
-      r = links->solve(context, solved ? current_B() : std::vector<Rgb>{}, held);
+      r = links->solve(context, solved ? current_B() : std::vector<Rgb>{}, held, false);
       if (r.held && !held) {
         held = true;
         report.warnings.push_back(
@@ -617,6 +617,15 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       solved = true;
       if (status == SolveStatus::cancelled) break;
       B_now = r.B;
+    }
+    // The irradiance of the radiosity kept, once, with the links as they stand (those of its
+    // solve, or after a cancelled pass those restored, over any elements it split): the
+    // passes' solves leave it to here, each a gather fewer (the 246k city's three passes: 9
+    // gathers -> 7).
+    if (solved) {
+      const std::vector<Rgb> H = links->irradiance(hierarchy, *system, current_B(), held);
+      for (std::size_t i = 0; i < system->unknowns(); ++i)
+        H_of(i) = system->light.empty() ? H[i] : H[i] + system->light[i];
     }
     report.link_count = links->link_count();
     report.form_factor_bytes = std::max(report.form_factor_bytes, links->bytes());

@@ -1869,7 +1869,8 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   return true;
 }
 
-SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rgb>& B0, bool hold) const {
+SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rgb>& B0, bool hold,
+                                  bool with_irradiance) const {
   const Impl& m = *impl_;
   const RadiositySystem& sys = ctx.system;
   const std::size_t n = sys.unknowns();
@@ -1922,21 +1923,19 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
     if (end_sweep(ctx, result, it, change, seconds_since(t0))) break;
   }
   // Irradiance for the energy balance, from the final radiosity.
-  const std::vector<Rgb>& B_sent = m.sent(sys, result.B, scaled);
-  m.node_values(ctx.hierarchy, sys, B_sent, values);
-  m.gather(ctx.hierarchy, sys, values, result.H, hold);
-  if (hold) Impl::cap_delivered_power(sys, result.B, result.H);
+  if (with_irradiance) result.H = irradiance(ctx.hierarchy, sys, result.B, hold);
   return result;
 }
 
 std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
-                                           const std::vector<Rgb>& B) const {
+                                           const std::vector<Rgb>& B, bool hold) const {
   std::vector<Rgb> H(system.unknowns(), Rgb(0.0f));
   if (!impl_->linked) return H;
   Impl::Values values;
   std::vector<Rgb> scaled;
   impl_->node_values(hierarchy, system, impl_->sent(system, B, scaled), values);
-  impl_->gather(hierarchy, system, values, H);
+  impl_->gather(hierarchy, system, values, H, hold);
+  if (hold) Impl::cap_delivered_power(system, B, H);
   return H;
 }
 

@@ -90,12 +90,16 @@ class LinkHierarchy {
   /// cancel. H in the result is the irradiance from surfaces only. Sweeps that keep growing
   /// (links that gain energy) start again with each irradiance held to the maximum principle
   /// (SolverResult::held); `hold` holds from the start (a later pass of a solve that needed it).
-  SolverResult solve(const SolverContext& context, const std::vector<Rgb>& B0, bool hold = false) const;
+  /// Without `with_irradiance`, H in the result is left zero: a caller that refines and solves
+  /// again takes it once at the end (irradiance()), a gather per pass saved.
+  SolverResult solve(const SolverContext& context, const std::vector<Rgb>& B0, bool hold = false,
+                     bool with_irradiance = true) const;
 
   /// The irradiance per unknown that radiosity `B` (per unknown) sends along the links: one
-  /// gather and push. With B = the emission it is the direct irradiance from the emitters.
+  /// gather and push (`hold`: held to the maximum principle, as solve() holds it). With B = the
+  /// emission it is the direct irradiance from the emitters.
   std::vector<Rgb> irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
-                              const std::vector<Rgb>& B) const;
+                              const std::vector<Rgb>& B, bool hold = false) const;
 
   /// The share of the power that radiosity `B` (per unknown) sends from sides whose rays all
   /// meet receiving surfaces (kEnclosureRays each; estimated from sides drawn by power): near 1
