@@ -699,12 +699,17 @@ struct LinkHierarchy::Impl {
       if (!(glm::dot(ns, x - es.centroid) > 0.0f)) return 0.0f;
       return point_to_polygon_factor_fast(x, nr, polygon.data(), es.corner_count());
     };
-    if (n == 1) return at(h.element(re).centroid);
+    const Element& er = h.element(re);
+    if (n == 1) return at(er.centroid);
+    // PatchHierarchy::sample_point()'s warp, set up once for the n x n points rather than per point.
+    std::array<glm::vec3, 4> receiver{};
+    for (int k = 0; k < er.corner_count(); ++k) receiver[static_cast<std::size_t>(k)] = h.vertices()[er.corners[k]];
+    const CellSampler cell(receiver.data(), er.corner_count());
     float sum = 0.0f;
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j)
-        sum += at(h.sample_point(re, glm::vec2((static_cast<float>(i) + 0.5f) / static_cast<float>(n),
-                                                (static_cast<float>(j) + 0.5f) / static_cast<float>(n))));
+        sum += at(cell(glm::vec2((static_cast<float>(i) + 0.5f) / static_cast<float>(n),
+                                 (static_cast<float>(j) + 0.5f) / static_cast<float>(n))));
     return sum / static_cast<float>(n * n);
   }
 
