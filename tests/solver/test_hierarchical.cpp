@@ -116,8 +116,9 @@ rad::Solution gauss_seidel_reference(const rad::Scene& scene, float element_area
 }
 
 /// The hierarchical solve at `epsilon` on gauss_seidel_reference()'s mesh, converged.
-rad::Solution hierarchical_on(const rad::Scene& scene, float element_area, float epsilon) {
+rad::Solution hierarchical_on(const rad::Scene& scene, float element_area, float epsilon, std::uint64_t seed = 1) {
   rad::SolveOptions h = hierarchical(epsilon);
+  h.seed = seed;
   h.tolerance = 1e-5;
   h.mesh.max_patch_area = h.mesh.max_element_area = element_area;
   rad::Solution out = rad::solve(scene, h);
@@ -125,19 +126,33 @@ rad::Solution hierarchical_on(const rad::Scene& scene, float element_area, float
   return out;
 }
 
-/// Every named group's channels within `tolerance` (relative) of the reference's, and the share
-/// of the emitted power that escapes within `escaped` (absolute).
-void check_agreement(const rad::Scene& scene, const rad::Solution& reference, const rad::Solution& solution,
+/// Every named group's channels, averaged over `solutions` (solves that differ only in their
+/// seed), within `tolerance` (relative) of the reference's, and the share of the emitted power
+/// that escapes within `escaped` (absolute). Over several seeds the check measures the solver's
+/// bias rather than one random stream's luck: on the Cornell box at 100 mm elements a single
+/// seed's group means scatter by about 1 % (session 20, six seeds).
+void check_agreement(const rad::Scene& scene, const rad::Solution& reference, const std::vector<rad::Solution>& solutions,
                      double tolerance, double escaped) {
+  REQUIRE(!solutions.empty());
+  const double n = static_cast<double>(solutions.size());
   for (const std::string& g : scene.groups()) {
     if (g.empty()) continue;
     CAPTURE(g);
-    const rad::Rgb a = reference.group_radiosity(g), b = solution.group_radiosity(g);
+    const rad::Rgb a = reference.group_radiosity(g);
+    glm::dvec3 b(0.0);
+    for (const rad::Solution& s : solutions) b += glm::dvec3(s.group_radiosity(g)) / n;
     for (int c = 0; c < 3; ++c) CHECK(relative(b[c], a[c]) < tolerance);
   }
   const rad::SolveReport& ra = reference.report();
-  const rad::SolveReport& rb = solution.report();
-  CHECK(std::abs(rb.escaped_power.y / rb.emitted_power.y - ra.escaped_power.y / ra.emitted_power.y) < escaped);
+  double share = 0.0;
+  for (const rad::Solution& s : solutions) share += s.report().escaped_power.y / s.report().emitted_power.y / n;
+  CHECK(std::abs(share - ra.escaped_power.y / ra.emitted_power.y) < escaped);
+}
+void check_agreement(const rad::Scene& scene, const rad::Solution& reference, rad::Solution solution,
+                     double tolerance, double escaped) {
+  std::vector<rad::Solution> one;
+  one.push_back(std::move(solution));
+  check_agreement(scene, reference, one, tolerance, escaped);
 }
 
 
@@ -239,19 +254,23 @@ TEST_SUITE("solver") {
     // The reference's targets are the elements themselves (patches = elements), as the links'
     // finest ends are: with element-to-patch factors a patch half hidden under a block sends its
     // mean radiosity from its visible half too, an error of the reference of up to 40 % on the
-    // leaves next to the blocks (measured). Measured worst group and channel at 100 mm elements:
-    // 1.43 % at epsilon 0.05 (the ceiling; session 19), 0.65 % at 0.005 (session 16). The
-    // issue's goal is 0.5 %: not met yet (docs/HIERARCHICAL.md, "Where it stands").
+    // leaves next to the blocks (measured). The group means averaged over four seeds (one seed's
+    // scatter by about 1 %, which hid the bias); measured worst group and channel at 100 mm
+    // elements: 1.13 % at epsilon 0.05, 0.75 % at 0.005 (the ceiling both times; session 20).
+    // The goal is 0.5 %: not met yet (docs/HIERARCHICAL.md, "Where it stands").
     const rad::Scene scene = rad::cornell_box();
     const rad::Solution gs = gauss_seidel_reference(scene, 10000.0f);  // 100 mm
     for (float eps : {0.05f, 0.005f}) {
       CAPTURE(eps);
-      const rad::Solution hr = hierarchical_on(scene, 10000.0f, eps);
-      CHECK(hr.report().link_count > 0);
-      CHECK(hr.report().link_pairs_examined >= hr.report().link_count);  // every link was a pair looked at
-      CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
+      std::vector<rad::Solution> seeds;
+      for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+        const rad::Solution& hr = seeds.emplace_back(hierarchical_on(scene, 10000.0f, eps, seed));
+        CHECK(hr.report().link_count > 0);
+        CHECK(hr.report().link_pairs_examined >= hr.report().link_count);  // every link was a pair looked at
+        CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
+      }
       // The open front lets out about 31 % of the light in both.
-      check_agreement(scene, gs, hr, 0.015, 0.01);
+      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.015 : 0.01, 0.01);
     }
   }
 
