@@ -485,3 +485,57 @@ TEST_SUITE("form_factors") {
       CHECK(limited.group_radiosity(g).x == doctest::Approx(expected).epsilon(0.005));
   }
 }
+
+TEST_SUITE("form_factors") {
+  TEST_CASE("an emitting polygon meshed into more patches than exact_emitters: a penumbra's light by the exact patches' own visibility") {
+    // A 1 m square lamp (16 patches, more than exact_emitters = 4) 1 m above a black floor, and
+    // a black shelf at half height over half the floor, whose edge throws a penumbra. Each
+    // floor element takes its 4 nearest lamp patches exactly and the rest by rays; the exact
+    // ones' visibility must be theirs: under the shelf's edge the near patches are hidden and
+    // the far ones seen (or the reverse), and the whole lamp's visible fraction, used for them
+    // until session 20, gave the penumbra's elements up to ~50 % too little or too much light.
+    // Against every lamp patch exact (whose shared whole-lamp visibility is right: it multiplies
+    // all of them).
+    rad::Scene scene;
+    rad::Material black;
+    black.reflectance = rad::Rgb(0.0f);
+    rad::Material lamp = black;
+    lamp.emission = rad::Rgb(10.0f);
+    const rad::MaterialId b = scene.add_material(black), l = scene.add_material(lamp);
+    rad::add_quad(scene, {-2, 0, -2}, {0, 0, 4}, {4, 0, 0}, b, "floor");           // facing +y
+    rad::add_quad(scene, {-0.5f, 1, -0.5f}, {1, 0, 0}, {0, 0, 1}, l, "lamp");      // facing -y
+    rad::add_quad(scene, {-2, 0.5f, -2}, {2.1f, 0, 0}, {0, 0, 4}, b, "shelf");     // facing -y
+    rad::SolveOptions o;
+    o.method = rad::SolverMethod::gauss_seidel;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.mesh.max_patch_area = o.mesh.max_element_area = 1.0f / 16.0f + 1e-4f;
+    o.form_factors.exact_emitters = 4;
+    const rad::Solution limited = rad::solve(scene, o);
+    o.form_factors.exact_emitters = 0;
+    const rad::Solution all = rad::solve(scene, o);
+    const rad::PatchHierarchy& h = all.hierarchy();
+    REQUIRE(limited.hierarchy().leaves() == h.leaves());
+    double peak = 0.0;
+    for (std::uint32_t e : h.leaves()) peak = std::max(peak, static_cast<double>(all.irradiance()[e].x));
+    // The penumbra: floor leaves between 5 % and 95 % of the brightest.
+    double sum_limited = 0.0, sum_all = 0.0, penumbra_limited = 0.0, penumbra_all = 0.0;
+    int penumbra = 0;
+    for (std::uint32_t e : h.leaves()) {
+      if (scene.groups()[scene.polygons()[h.patches()[h.element(e).patch].polygon].group] != "floor") continue;
+      const double a = all.irradiance()[e].x * h.element(e).area, x = limited.irradiance()[e].x * h.element(e).area;
+      sum_limited += x;
+      sum_all += a;
+      if (all.irradiance()[e].x < 0.05 * peak || all.irradiance()[e].x > 0.95 * peak) continue;
+      ++penumbra;
+      penumbra_limited += x;
+      penumbra_all += a;
+    }
+    MESSAGE("penumbra leaves " << penumbra << ": their light " << penumbra_limited / penumbra_all - 1.0
+                               << ", the floor's " << sum_limited / sum_all - 1.0);
+    // Each element's light has the noise of the rays that count the far patches (about 100 of
+    // its 1024 land on them); summed over the penumbra's 128 leaves, a bias stands out.
+    REQUIRE(penumbra >= 100);
+    CHECK(std::fabs(penumbra_limited / penumbra_all - 1.0) < 0.015);
+    CHECK(std::fabs(sum_limited / sum_all - 1.0) < 0.01);
+  }
+}
