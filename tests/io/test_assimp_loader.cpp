@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,13 @@ using test::load_error;
 using test::near;
 
 fs::path write(const std::string& name, const std::string& bytes) { return test::write_file(kTmp / name, bytes); }
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 /// A unit square in z = 0 facing +z, as one quad face.
 const char* const kPly =
@@ -401,6 +410,36 @@ TEST_CASE("Assimp broken 3DS: an animation track whose key count its chunk canno
                            "keys, but its 30 bytes hold at most 1 (a corrupted file or a wrong count)"));
   // The room exported by Assimp has no such track and still loads (the next test reads it whole).
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.3ds").polygons().size() > 0);
+}
+
+TEST_CASE("Assimp broken COLLADA: primitives whose index lists do not match their counts are refused before Assimp aborts") {
+  // Found by radiosity_fuzz_dae (session 20): the exported room with one <polylist>'s index list
+  // (<p>) erased. Assimp 5.2's parser asserts that a primitive element read as many primitives
+  // as its count, and Debian's build keeps the assertion: abort(), the whole program gone.
+  const fs::path found = fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "dae" / "polylist_without_p.dae";
+  const Error e = load_error(found);
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "polylist_without_p.dae:105:9: a <polylist> of count 1 has 0 index lists (<p>), not one"));
+  // The same room with variants of the mistake, each refused with its line; the room itself loads.
+  const std::string room = read_text(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.dae");
+  CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.dae").polygons().size() > 0);
+  const std::size_t p = room.find("<p>");
+  REQUIRE(p != std::string::npos);
+  const std::size_t p_end = room.find("</p>", p) + 4;
+  const std::string list = room.substr(p, p_end - p);
+  // Two index lists in one polylist.
+  std::string twice = room;
+  twice.insert(p_end, list);
+  CHECK(contains(load_error(write("two_lists.dae", twice)).what(), "has 2 index lists (<p>), not one"));
+  // The vertex counts after the index list.
+  const std::size_t v = room.rfind("<vcount>", p);
+  REQUIRE(v != std::string::npos);
+  const std::size_t v_end = room.find("</vcount>", v) + 9;
+  std::string late = room;
+  const std::string counts = room.substr(v, v_end - v);
+  late.insert(p_end, counts);
+  late.erase(v, v_end - v);
+  CHECK(contains(load_error(write("late_vcount.dae", late)).what(), "comes before its vertex counts (<vcount>)"));
 }
 
 TEST_CASE("Assimp: a room exported as COLLADA - ASCII FBX and 3DS reads as its OBJ does - the lamp emitting") {

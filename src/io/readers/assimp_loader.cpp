@@ -198,10 +198,81 @@ void check_3ds_tracks(const fs::path& path) {
   walk(walk, 0, bytes.size(), 0);
 }
 
+/// The primitives (<triangles>, <polylist>, ...) of a COLLADA text whose index lists Assimp 5.2
+/// cannot read without an internal assertion, which Debian's build keeps and which aborts the
+/// process (ColladaParser::ReadIndexData, ReadPrimitives): a <triangles> or <polylist> whose
+/// count is not that of its one index list (<p>; a missing one, found by libFuzzer in session 20,
+/// or several), a <polygons> with other than count <p>s, a <polylist> with no <vcount> before its
+/// <p>, a <tristrips> or <linestrips> strip too short to make one primitive. `fail(at, problem)`
+/// throws.
+template <typename Fail>
+void check_collada_primitives(const std::string& text, const Fail& fail) {
+  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  // The unsigned value of attribute `name` in the tag [at, end), or `fallback` when absent.
+  auto attribute = [&](std::size_t at, std::size_t end, const char* name, std::size_t fallback) {
+    const std::string key = std::string(" ") + name + "=\"";
+    const std::size_t k = text.find(key, at);
+    if (k == std::string::npos || k > end) return fallback;
+    std::size_t value = 0;
+    for (std::size_t i = k + key.size(); i < end && text[i] >= '0' && text[i] <= '9'; ++i)
+      value = std::min(value * 10 + std::size_t(text[i] - '0'), std::size_t{1} << 40);
+    return value;
+  };
+  // Whether the element opening at `at` is named exactly `name` (not a longer name).
+  auto named = [&](std::size_t at, const std::string& name) {
+    const std::size_t after = at + 1 + name.size();
+    return text.compare(at + 1, name.size(), name) == 0 && after < text.size() &&
+           (blank(text[after]) || text[after] == '>' || text[after] == '/');
+  };
+  for (const std::string primitive : {"triangles", "polylist", "polygons", "tristrips", "linestrips"}) {
+    for (std::size_t at = text.find("<" + primitive); at != std::string::npos; at = text.find("<" + primitive, at + 1)) {
+      if (!named(at, primitive)) continue;
+      const std::size_t open_end = text.find('>', at);
+      if (open_end == std::string::npos) return;  // truncated: Assimp's XML parser refuses it
+      const std::size_t count = attribute(at, open_end, "count", 0);
+      const bool empty = text[open_end - 1] == '/';
+      const std::size_t close = empty ? open_end : std::min(text.find("</" + primitive, open_end), text.size());
+      std::size_t lists = 0, offsets = 1;
+      bool vcount = false;
+      for (std::size_t k = text.find('<', open_end); k < close; k = text.find('<', k + 1)) {
+        if (named(k, "input")) {
+          const std::size_t end = text.find('>', k);
+          offsets = std::max(offsets, attribute(k, std::min(end, close), "offset", 0) + 1);
+        } else if (named(k, "vcount") || named(k, "p")) {
+          const std::size_t content = text.find('>', k);
+          if (content == std::string::npos || content >= close || text[content - 1] == '/') continue;
+          const std::size_t end = std::min(text.find('<', content), close);
+          std::size_t numbers = 0;
+          for (std::size_t i = content + 1; i < end; ++i)
+            if (!blank(text[i]) && (i == content + 1 || blank(text[i - 1]))) ++numbers;
+          if (numbers == 0) continue;  // an empty list: Assimp skips it
+          if (named(k, "vcount")) {
+            vcount = true;
+            continue;
+          }
+          if (primitive == "polylist" && count > 0 && !vcount)
+            fail(k, "a <polylist>'s index list (<p>) comes before its vertex counts (<vcount>)");
+          const std::size_t vertices = numbers / offsets;
+          if (primitive == "tristrips" && vertices < 2) fail(k, "a <tristrips> strip has fewer than 2 vertices");
+          if (primitive == "linestrips" && vertices < 1) fail(k, "a <linestrips> strip has no vertex");
+          ++lists;
+        }
+      }
+      const bool one_list = primitive == "triangles" || primitive == "polylist";
+      if (one_list && count > 0 && lists != 1)
+        fail(at, "a <" + primitive + "> of count " + std::to_string(count) + " has " + std::to_string(lists) +
+                     " index lists (<p>), not one");
+      if (primitive == "polygons" && lists != count)
+        fail(at, "a <polygons> of count " + std::to_string(count) + " has " + std::to_string(lists) + " index lists (<p>)");
+    }
+  }
+}
+
 /// What Assimp 5.2's COLLADA reader trusts and should not: an index list (<p>) that holds
 /// anything but numbers makes it loop forever, an array (<float_array count="N">) holding more
-/// values than its count makes it write beyond what it allocated. Such corruptions are refused
-/// here first, with their line.
+/// values than its count makes it write beyond what it allocated, and primitives whose index
+/// lists do not match their counts abort it (check_collada_primitives()). Such corruptions are
+/// refused here first, with their line.
 void check_collada(const fs::path& path) {
   const std::string text = read_file(path, "COLLADA file");
   auto fail = [&](std::size_t at, const std::string& problem) {
@@ -232,6 +303,7 @@ void check_collada(const fs::path& path) {
         fail(at, std::string(tag + 1) + " holds " + std::to_string(values) + " values, more than its count " + std::to_string(count));
     }
   }
+  check_collada_primitives(text, fail);
 }
 
 glm::dmat4 to_glm(const aiMatrix4x4& m) {
