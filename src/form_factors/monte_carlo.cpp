@@ -95,10 +95,6 @@ class PatchSetSampler {
   std::vector<float> cumulative_;
 };
 
-}  // namespace
-
-namespace {
-
 /// Hit weights per target, with the touched targets listed so that clearing costs O(hits).
 /// Weights are > 0 (1 for a plain hit, less after mirrors and windows).
 class HitCounter {
