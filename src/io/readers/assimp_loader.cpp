@@ -205,9 +205,11 @@ void check_3ds_tracks(const fs::path& path) {
 /// or several), a <polygons> with other than count <p>s, a <polylist> with no <vcount> before its
 /// <p>, a <tristrips> or <linestrips> strip too short to make one primitive. `fail(at, problem)`
 /// throws.
+/// XML's white space.
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
 template <typename Fail>
 void check_collada_primitives(const std::string& text, const Fail& fail) {
-  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
   // The unsigned value of attribute `name` in the tag [at, end), or `fallback` when absent.
   auto attribute = [&](std::size_t at, std::size_t end, const char* name, std::size_t fallback) {
     const std::string key = std::string(" ") + name + "=\"";
@@ -278,7 +280,6 @@ void check_collada(const fs::path& path) {
   auto fail = [&](std::size_t at, const std::string& problem) {
     throw Error(ErrorCode::parse_error, path.string() + ":" + line_column(text, at) + ": " + problem);
   };
-  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
   for (std::size_t at = text.find("<p>"); at != std::string::npos; at = text.find("<p>", at + 3)) {
     const std::size_t end = std::min(text.find('<', at + 3), text.size());
     for (std::size_t i = at + 3; i < end; ++i)
