@@ -442,6 +442,38 @@ TEST_CASE("Assimp broken COLLADA: primitives whose index lists do not match thei
   CHECK(contains(load_error(write("late_vcount.dae", late)).what(), "comes before its vertex counts (<vcount>)"));
 }
 
+TEST_CASE("Assimp broken COLLADA: counts that promise more indices than the lists hold are refused before Assimp reserves them") {
+  // Found by radiosity_fuzz_dae (session 21): a <vcount> value of 43 digits. Assimp 5.2 sums the
+  // vertex counts and reserves that many indices (26 GB here) before reading the list, which
+  // ASan reports as out of memory and an ordinary build may get or fail to get.
+  const fs::path found = fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "dae" / "vcount_overflow.dae";
+  const Error e = load_error(found);
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "vcount_overflow.dae:143:9: a <polylist> promises over 10^12 vertices of 1 indices each "
+                           "(the sum of its <vcount>), but its index list (<p>) holds 24 indices"));
+  const std::string room = read_text(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.dae");
+  auto replaced = [&](std::string text, const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  // The room's first polylist (7 polygons, 27 indices) with one vertex count too many.
+  CHECK(contains(load_error(write("sum.dae", replaced(room, "<vcount>4 4 4 4 4 4 3 ", "<vcount>4 4 4 4 4 4 4 "))).what(),
+                 "sum.dae:210:9: a <polylist> promises 28 vertices of 1 indices each (the sum of its <vcount>), "
+                 "but its index list (<p>) holds 27 indices"));
+  // A count of 4e9 polygons (Assimp reserves 32 GB for their vertex counts) with 7 counts given.
+  CHECK(contains(load_error(write("count.dae", replaced(room, "<polylist count=\"7\"", "<polylist count=\"4000000000\""))).what(),
+                 "a <polylist> of count 4000000000 has 7 vertex counts (<vcount>)"));
+  // The window pane as 3e8 triangles (Assimp reserves 7 GB) with one list of 4 indices.
+  std::string triangles = replaced(room, "<polylist count=\"1\" material=\"defaultMaterial\">\n          <input offset=\"0\" semantic=\"VERTEX\" source=\"#Pane_1",
+                                   "<triangles count=\"300000000\" material=\"defaultMaterial\">\n          <input offset=\"0\" semantic=\"VERTEX\" source=\"#Pane_1");
+  const std::size_t last = triangles.rfind("</polylist>");
+  REQUIRE(last != std::string::npos);
+  triangles.replace(last, 11, "</triangles>");
+  CHECK(contains(load_error(write("triangles.dae", triangles)).what(),
+                 "a <triangles> promises 900000000 vertices of 1 indices each, but its index list (<p>) holds 4 indices"));
+}
+
 TEST_CASE("Assimp: a room exported as COLLADA - ASCII FBX and 3DS reads as its OBJ does - the lamp emitting") {
   // tests/data/assimp: tests/data/messy/exported_room.obj written by Assimp 5.2's exporters
   // (the fuzz targets' seeds too). Assimp triangulates, so the OBJ's 14 polygons are 28 triangles

@@ -226,7 +226,7 @@ void check_collada_primitives(const std::string& text, const Fail& fail) {
     return text.compare(at + 1, name.size(), name) == 0 && after < text.size() &&
            (blank(text[after]) || text[after] == '>' || text[after] == '/');
   };
-  for (const std::string primitive : {"triangles", "polylist", "polygons", "tristrips", "linestrips"}) {
+  for (const std::string primitive : {"triangles", "lines", "polylist", "polygons", "tristrips", "linestrips"}) {
     for (std::size_t at = text.find("<" + primitive); at != std::string::npos; at = text.find("<" + primitive, at + 1)) {
       if (!named(at, primitive)) continue;
       const std::size_t open_end = text.find('>', at);
@@ -234,7 +234,9 @@ void check_collada_primitives(const std::string& text, const Fail& fail) {
       const std::size_t count = attribute(at, open_end, "count", 0);
       const bool empty = text[open_end - 1] == '/';
       const std::size_t close = empty ? open_end : std::min(text.find("</" + primitive, open_end), text.size());
-      std::size_t lists = 0, offsets = 1;
+      std::size_t lists = 0, offsets = 1, indices = 0;
+      // The <vcount> values Assimp reads (the first `count`) and their sum, saturating.
+      std::size_t vcounts = 0, vcount_sum = 0;
       bool vcount = false;
       for (std::size_t k = text.find('<', open_end); k < close; k = text.find('<', k + 1)) {
         if (named(k, "input")) {
@@ -244,14 +246,25 @@ void check_collada_primitives(const std::string& text, const Fail& fail) {
           const std::size_t content = text.find('>', k);
           if (content == std::string::npos || content >= close || text[content - 1] == '/') continue;
           const std::size_t end = std::min(text.find('<', content), close);
+          const bool counts = named(k, "vcount");
           std::size_t numbers = 0;
-          for (std::size_t i = content + 1; i < end; ++i)
-            if (!blank(text[i]) && (i == content + 1 || blank(text[i - 1]))) ++numbers;
+          for (std::size_t i = content + 1; i < end;) {
+            if (blank(text[i])) {
+              ++i;
+              continue;
+            }
+            std::size_t value = 0;
+            for (; i < end && !blank(text[i]); ++i)
+              if (text[i] >= '0' && text[i] <= '9') value = std::min(value * 10 + std::size_t(text[i] - '0'), std::size_t{1} << 40);
+            ++numbers;
+            if (counts && vcounts < count) ++vcounts, vcount_sum = std::min(vcount_sum + value, std::size_t{1} << 50);
+          }
           if (numbers == 0) continue;  // an empty list: Assimp skips it
-          if (named(k, "vcount")) {
+          if (counts) {
             vcount = true;
             continue;
           }
+          indices += numbers;
           if (primitive == "polylist" && count > 0 && !vcount)
             fail(k, "a <polylist>'s index list (<p>) comes before its vertex counts (<vcount>)");
           const std::size_t vertices = numbers / offsets;
@@ -264,6 +277,22 @@ void check_collada_primitives(const std::string& text, const Fail& fail) {
       if (one_list && count > 0 && lists != 1)
         fail(at, "a <" + primitive + "> of count " + std::to_string(count) + " has " + std::to_string(lists) +
                      " index lists (<p>), not one");
+      // Assimp reserves the indices its counts promise before reading one (and then refuses a
+      // list of another length): a wrong count of a few digits asks for gigabytes.
+      // In doubles: the counts are capped at 2^40 and 2^50, so their product may not fit an integer.
+      const double promised =
+          primitive == "triangles" ? 3.0 * count : primitive == "lines" ? 2.0 * count : primitive == "polylist" ? double(vcount_sum) : 0.0;
+      if (primitive == "polylist" && count > 0 && vcounts < count)
+        fail(at, "a <polylist> of count " + std::to_string(count) + " has " + std::to_string(vcounts) +
+                     " vertex counts (<vcount>)");
+      if (count > 0 && lists == 1 && (primitive == "triangles" || primitive == "polylist") && promised * double(offsets) != double(indices))
+        fail(at, "a <" + primitive + "> promises " +
+                     (promised >= 0x1p40 ? std::string("over 10^12") : std::to_string(static_cast<std::uint64_t>(promised))) +
+                     " vertices of " + std::to_string(offsets) + " indices each" +
+                     (primitive == "polylist" ? " (the sum of its <vcount>)" : "") + ", but its index list (<p>) holds " +
+                     std::to_string(indices) + " indices");
+      if (primitive == "lines" && promised * double(offsets) > double(text.size()))
+        fail(at, "a <lines> of count " + std::to_string(count) + " promises more indices than the file holds characters");
       if (primitive == "polygons" && lists != count)
         fail(at, "a <polygons> of count " + std::to_string(count) + " has " + std::to_string(lists) + " index lists (<p>)");
     }
