@@ -377,14 +377,17 @@ rad::Quantity mesh_quantity(const std::string& quantity) {
   throw py::value_error("quantity: 'back_radiosity' is per element and per polygon only");
 }
 
-/// Area-weighted mean of `quantity` over each polygon's patches, (polygons, 3).
+/// Area-weighted mean of `quantity` over each polygon's patches, (polygons, 3); buried parts
+/// count as 0 (Solution::exposure(): a patch's value is its open part's).
 Doubles polygon_values(const PySolution& s, const std::string& quantity) {
   const std::vector<rad::Rgb> by_id = values_by_element_id(s.solution, quantity);
+  const std::vector<float>& exposure = s.solution.exposure();
   std::vector<glm::dvec3> sum(s.polygon_count, glm::dvec3(0.0));
   std::vector<double> area(s.polygon_count, 0.0);
   for (const rad::Patch& patch : s.solution.hierarchy().patches()) {
     if (patch.polygon >= s.polygon_count) continue;
-    sum[patch.polygon] += glm::dvec3(by_id[patch.root]) * static_cast<double>(patch.area);
+    const double open = exposure.empty() ? 1.0 : static_cast<double>(exposure[patch.root]);
+    sum[patch.polygon] += glm::dvec3(by_id[patch.root]) * static_cast<double>(patch.area) * open;
     area[patch.polygon] += patch.area;
   }
   Doubles out(std::vector<py::ssize_t>{static_cast<py::ssize_t>(s.polygon_count), 3});
@@ -821,6 +824,19 @@ PYBIND11_MODULE(radiosity, m) {
              return out;
            },
            "Areas of the leaf elements, (elements,).")
+      .def("element_exposure",
+           [](const PySolution& s) {
+             const rad::PatchHierarchy& h = s.solution.hierarchy();
+             const std::vector<float>& exposure = s.solution.exposure();
+             Doubles out(static_cast<py::ssize_t>(h.leaves().size()));
+             double* p = out.mutable_data();
+             for (const std::uint32_t e : h.leaves()) *p++ = exposure.empty() ? 1.0 : exposure[e];
+             return out;
+           },
+           "The share of each leaf element's area that is not buried (inside a solid standing on it, such as "
+           "the floor under a block resting on it), (elements,); all 1 where the solve did not measure it "
+           "(radiosity::Solution::exposure()). A partly buried element's values are its open part's: its power "
+           "is area x exposure x radiosity.")
       .def("element_centroids",
            [](const PySolution& s) {
              const rad::PatchHierarchy& h = s.solution.hierarchy();

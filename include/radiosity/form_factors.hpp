@@ -126,6 +126,13 @@ struct Target {
 struct SparseFactors {
   std::vector<std::uint32_t> index;  ///< patch ids (a row) or positions in the element list (a column)
   std::vector<float> value;          ///< the factors, > 0
+  /// A row's element: the share of its area that is not buried, i.e. not inside a solid
+  /// standing on it (the floor under a block resting on it; docs/ARCHITECTURE.md, "Contact and
+  /// light leaks"), as the estimator's rays found it. The factors are means over the whole
+  /// element, its buried part receiving nothing; the solvers divide them by this to have its
+  /// open part's. 1 when the estimator does not measure it (every method but monte_carlo) and
+  /// for columns.
+  float exposed = 1.0f;
 };
 
 /// An estimator bound to one scene and hierarchy (whose geometry it captures at construction,

@@ -214,9 +214,23 @@ class RADIOSITY_API Solution {
   const SolveReport& report() const { return report_; }
   const PatchHierarchy& hierarchy() const { return hierarchy_; }
   /// Radiosity B (W/m^2) per element id; inner nodes hold the area-weighted mean of their
-  /// children. This is the front side's; a translucent element (Material::diffuse_transmittance)
-  /// includes what its back receives and transmits.
+  /// children (weighted by their open area where exposure() is given). This is the front
+  /// side's; a translucent element (Material::diffuse_transmittance) includes what its back
+  /// receives and transmits. Where exposure() is below 1, the open part's.
   const std::vector<Rgb>& radiosity() const { return radiosity_; }
+  /// Per element id, the share of its area that is not buried: not inside a solid standing on
+  /// it, such as the floor under a block resting on it (docs/ARCHITECTURE.md, "Contact and
+  /// light leaks"); inner nodes the area-weighted mean of their children. Empty when the solve
+  /// did not measure it (it does for the matrix methods over FormFactorMethod::monte_carlo
+  /// rows): every element taken as open. Where an element is partly buried, its values
+  /// (radiosity, irradiance) are those of its open part, which is what shows (a floor element
+  /// half under a block is not shown at half its light), and it sends area x exposure x
+  /// radiosity; group_radiosity() and mesh_triangle_values() weight by that, so that they
+  /// stay power over area, a buried part counting as dark.
+  const std::vector<float>& exposure() const { return exposure_; }
+  /// Gives the solution its exposure() (solve() does). Throws Error{invalid_argument} when it
+  /// is neither empty nor one value per element id.
+  void set_exposure(std::vector<float> exposure);
   /// Back sides: the radiosity leaving the back side of each element id, rho' H_back + tau
   /// H_front: what a translucent element's back transmits (tau, diffuse_transmittance) plus
   /// what the back reflects (rho' = rho for a two-sided material, 0 for a one-sided one); 0 for
@@ -248,7 +262,8 @@ class RADIOSITY_API Solution {
   /// Per-vertex radiosity for display (see PatchHierarchy::vertex_values), optionally with
   /// the ambient term.
   std::vector<Rgb> vertex_radiosity(bool with_ambient = false) const;
-  /// Area-weighted mean radiosity over the patches of a group. Throws Error{invalid_argument}
+  /// Area-weighted mean radiosity over the patches of a group (their power over their area:
+  /// buried parts count as dark, exposure()). Throws Error{invalid_argument}
   /// naming the group when the scene has no such group.
   Rgb group_radiosity(std::string_view group) const;
   /// The same over the backs of the group's patches (back_radiosity(); 0 where a patch is
@@ -323,6 +338,7 @@ class RADIOSITY_API Solution {
   std::vector<Rgb> back_radiosity_;
   std::vector<Rgb> irradiance_;
   std::vector<Rgb> direct_irradiance_;
+  std::vector<float> exposure_;
   std::vector<SolvedMesh> meshes_;
   /// Shared between a solution and the solutions relit from it (immutable); null for none.
   std::shared_ptr<const std::vector<LightGroupSolution>> light_groups_;

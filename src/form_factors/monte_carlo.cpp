@@ -51,6 +51,7 @@
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
 #include "form_factors/visibility.hpp"
+#include "geometry/burial.hpp"
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "form_factors/pass1_material.hpp"
@@ -382,15 +383,20 @@ class MonteCarloEstimator final : public FormFactorEstimator {
         const std::uint32_t e = elements[k];
         const Patch& source = hierarchy_.patches()[hierarchy_.element(e).patch];
         Rng rng(options_.seed, e, stream_key(back ? Stream::monte_carlo_back_row : Stream::monte_carlo_row));
-        shoot(*rays, e, source, back, N, rng, scratch, [&](std::uint32_t, std::uint32_t j, float w, Path path) {
-          // Emitting patches reached directly are in the exact part (unless left to the rays for
-          // this element), through glass in the photon map.
-          if (!exact_[j] || (limited && by_rays[j]) || path == Path::specular) counter.add(j, w);
-        });
+        std::uint32_t buried_rays = 0;
+        shoot(
+            *rays, e, source, back, N, rng, scratch,
+            [&](std::uint32_t, std::uint32_t j, float w, Path path) {
+              // Emitting patches reached directly are in the exact part (unless left to the rays for
+              // this element), through glass in the photon map.
+              if (!exact_[j] || (limited && by_rays[j]) || path == Path::specular) counter.add(j, w);
+            },
+            &buried_rays);
         index.clear();
         value.clear();
         counter.drain(index, value, [&](std::uint32_t, float c) { return c * per_ray; });
         merge(index, value, own, out[k]);
+        out[k].exposed = static_cast<float>(N - buried_rays) * per_ray;
       }
     });
   }
@@ -565,6 +571,10 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     });
   }
 
+  /// shoot(): sealed first hits whose points are tested for burial before an element's later
+  /// ones are taken as buried, when all of these were.
+  static constexpr std::uint32_t kBurialProbes = 32;
+
   /// How a ray reached the surface it reports: straight, through mirrors and windows only, or
   /// through refracting glass (and maybe mirrors and windows too).
   enum class Path : std::uint8_t { direct, specular, glass };
@@ -590,9 +600,16 @@ class MonteCarloEstimator final : public FormFactorEstimator {
   /// its transmittance and the interface's Fresnel transmission; Path::glass). These are
   /// Wallace, Cohen & Greenberg's mirror and window form factors, traced instead of built from
   /// virtual mirror worlds (for a planar mirror the reflected ray is the ray to the virtual image).
+  ///
+  /// With `buried_rays`, counts there the rays that start at buried points (geometry/
+  /// burial.hpp: under a block standing on the element, inside a prop sunk into it): a ray that
+  /// first meets the back of a one-sided polygon is tested with the burial test's four rays
+  /// from its point, and after kBurialProbes such rays all found buried, the element's later
+  /// ones are taken as buried without the test (an element wholly under a block, or a room
+  /// seen from outside, costs at most 4 x kBurialProbes more rays).
   template <typename Hit>
   void shoot(const LeafRays& rays, std::uint32_t from, const Patch& source, bool back, std::uint32_t count, Rng& rng,
-             Scratch& scratch, const Hit& hit) const {
+             Scratch& scratch, const Hit& hit, std::uint32_t* buried_rays = nullptr) const {
     if (scratch.points.size() < count) scratch = Scratch(count);
     // Points and directions from one randomised 4D Halton set (core/halton.hpp): spread in the
     // four dimensions jointly, where two stratified 2D sets paired by a random permutation are
@@ -615,10 +632,35 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     }
     rays.scene.intersect(count, scratch.origin.data(), scratch.dir.data(), 0.0f, kInfinity, scratch.hits.data(),
                          scratch.found.data());
+    // The burial test's rays and what they count as sealed: the back of a one-sided polygon
+    // other than the source's own (which a ray meets only by rounding), and with extended form
+    // factors not a window or glass (which rays pass through either way).
+    std::array<glm::vec3, 4> burial{};
+    if (buried_rays) burial = burial_directions(n);
+    auto sealed = [&](const RayScene::Hit& h, const glm::vec3& d) {
+      const std::uint32_t polygon = rays.polygon[h.triangle];
+      return glm::dot(d, h.geometric_normal) >= 0.0f && rays.back[h.triangle] == kNone && polygon != source.polygon &&
+             (specular_depth_ == 0 || (specular_[polygon].window == 0.0f && specular_[polygon].glass == 0.0f));
+    };
+    std::uint32_t probed = 0;  // sealed first hits tested, all found buried so far
+    bool assume_buried = false;
+    auto count_buried = [&](std::uint32_t r) {
+      if (!buried_rays) return false;
+      if (!assume_buried) {
+        if (!buried(rays.scene, scratch.origin[r], burial, sealed)) {
+          probed = kBurialProbes + 1;  // an open point among them: keep testing
+          return false;
+        }
+        assume_buried = ++probed == kBurialProbes;
+      }
+      ++*buried_rays;
+      return true;
+    };
     for (std::uint32_t r = 0; r < count; ++r) {
       if (!scratch.found[r]) continue;  // escaped (an open scene)
       glm::vec3 x = scratch.origin[r], w = scratch.dir[r];
       std::optional<RayScene::Hit> h = scratch.hits[r];
+      if (sealed(*h, w) && count_buried(r)) continue;
       // The common case, fast: one-sided surfaces absorb at their back, and a hit on the
       // source's own plane is rounding. (Per-triangle arrays and Embree's normal, because the
       // hierarchy's structs would be cache misses.)

@@ -114,6 +114,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
       store.rows.emplace_back();
     }
   }
+  store.exposure.resize(store.rows.size(), 1.0f);
 
   // Form factors, in chunks so that progress is reported and cancel is honoured: about 15 ms
   // each (BlockSizer; a row does not depend on its chunk), from 8 to 16384 rows.
@@ -139,6 +140,11 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         r.value = std::move(from.value);
         r.index.shrink_to_fit();
         r.value.shrink_to_fit();
+        // The open part's factors (RadiositySystem::Weights).
+        const float x = effective_exposure(from.exposed);
+        if (x > 0.0f && x < 1.0f)
+          for (float& v : r.value) v /= x;
+        store.exposure[slots[k]] = x;
         slot_of(missing[k]) = slots[k];
       }
     } else {
@@ -148,6 +154,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         FactorVector& r = store.rows[slots[k]];
         r.index.clear();
         r.value.assign(buffer.data() + (k - begin) * n, buffer.data() + (k - begin + 1) * n);
+        store.exposure[slots[k]] = 1.0f;
         slot_of(missing[k]) = slots[k];
       }
     }
@@ -176,10 +183,30 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   std::vector<const FactorVector*> row_of(m, nullptr);
   for (std::size_t u = own_first; u < own_last; ++u) row_of[u] = &store.rows[slot_of(u)];
   auto row = [&](std::size_t i) -> const FactorVector& { return *row_of[i]; };
+  // Exposure (RadiositySystem::Weights): every process's, for the targets' means.
+  bool buried = false;
+  {
+    std::vector<Rgb> exposure(m, Rgb(1.0f));
+    for (std::size_t u = own_first; u < own_last; ++u) {
+      exposure[u] = Rgb(store.exposure[slot_of(u)]);
+      buried = buried || exposure[u].x < 1.0f;
+    }
+    if (split) {
+      split->all_gather(exposure, blocks);
+      for (const Rgb& x : exposure) buried = buried || x.x < 1.0f;
+    }
+    if (buried) {
+      result.exposure.resize(m);
+      for (std::size_t u = 0; u < m; ++u) result.exposure[u] = exposure[u].x;
+    }
+  }
+  const RadiositySystem::Weights weights = sys.weights(result.exposure);
+  const std::vector<Rgb> source = sys.exposed_source(result.exposure);
+  if (buried && B0.empty()) result.B = source;
   // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp; E_u with the lights' first shot); opaque
   // sides have no twin.
   auto radiosity = [&](std::size_t i, const Rgb& h) {
-    Rgb b = sys.source[i] + sys.reflectance[i] * h;
+    Rgb b = source[i] + sys.reflectance[i] * h;
     if (sys.twin[i] != kNone) b += sys.transmittance[i] * result.H[sys.twin[i]];
     return b;
   };
@@ -189,7 +216,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   const int max_iterations = ctx.options.max_iterations;
   result.status = SolveStatus::iteration_cap;
   for (int it = 1; it <= max_iterations; ++it) {
-    sys.patch_means(result.B, patch_B);
+    sys.patch_means(result.B, patch_B, weights);
     double change = 0.0;
     if (!gauss_seidel) {
       // Jacobi: every side from the previous sweep's patch radiosity; rows are independent.
@@ -211,7 +238,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         const Rgb b = radiosity(i, result.H[i]);
         const Rgb d = b - result.B[i];
         change += sys.area[i] * channel_l1(d);
-        patch_B[sys.patch[i]] += (sys.area[i] / sys.patch_area[sys.patch[i]]) * d;
+        patch_B[sys.patch[i]] += static_cast<float>(weights.side[i] / weights.target[sys.patch[i]]) * d;
         result.B[i] = b;
       };
       for (std::size_t i = 0; i < m; ++i) {
@@ -232,7 +259,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   }
 
   // Irradiance for the energy balance: H_e = sum_j F_ej B_j with the final radiosity.
-  sys.patch_means(result.B, patch_B);
+  sys.patch_means(result.B, patch_B, weights);
   parallel_for(ctx.options.threads, own_last - own_first, 256, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = own_first + begin; i < own_first + end; ++i) result.H[i] = row(i).dot(patch_B);
   });

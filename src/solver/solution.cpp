@@ -66,13 +66,22 @@ GroupId Solution::group_id(std::string_view group) const {
 
 namespace {
 
-/// Area-weighted mean of `values` (per element id) over the patches of group `g`.
-Rgb group_mean(const PatchHierarchy& hierarchy, const std::vector<Rgb>& values, GroupId g) {
+/// The weight of element `e`'s value, of area `area`, in a mean over area: the area times its
+/// exposure (Solution::exposure(); empty: 1), since its value is its open part's.
+double open_area(float area, const std::vector<float>& exposure, std::uint32_t e) {
+  const double a = area;
+  return exposure.empty() ? a : a * static_cast<double>(exposure[e]);
+}
+
+/// Area-weighted mean of `values` (per element id) over the patches of group `g`, buried parts
+/// counting as 0.
+Rgb group_mean(const PatchHierarchy& hierarchy, const std::vector<Rgb>& values, const std::vector<float>& exposure,
+               GroupId g) {
   glm::dvec3 sum(0.0);
   double area = 0.0;
   for (const Patch& p : hierarchy.patches())
     if (p.group == g) {
-      sum += static_cast<double>(p.area) * glm::dvec3(values[p.root]);
+      sum += open_area(p.area, exposure, p.root) * glm::dvec3(values[p.root]);
       area += p.area;
     }
   return area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
@@ -81,12 +90,12 @@ Rgb group_mean(const PatchHierarchy& hierarchy, const std::vector<Rgb>& values, 
 }  // namespace
 
 Rgb Solution::group_radiosity(std::string_view group) const {
-  return group_mean(hierarchy_, radiosity_, group_id(group));
+  return group_mean(hierarchy_, radiosity_, exposure_, group_id(group));
 }
 
 Rgb Solution::group_back_radiosity(std::string_view group) const {
   const GroupId g = group_id(group);
-  return back_radiosity_.empty() ? Rgb(0.0f) : group_mean(hierarchy_, back_radiosity_, g);
+  return back_radiosity_.empty() ? Rgb(0.0f) : group_mean(hierarchy_, back_radiosity_, {}, g);
 }
 
 const std::vector<LightGroupSolution>& Solution::light_groups() const {
@@ -104,7 +113,7 @@ const LightGroupSolution& Solution::solved_light_group(std::size_t light_group, 
 
 Rgb Solution::light_group_radiosity(std::size_t light_group, std::string_view group) const {
   const LightGroupSolution& g = solved_light_group(light_group, "light_group_radiosity");
-  return light_group_weights_[light_group] * group_mean(hierarchy_, g.radiosity, group_id(group));
+  return light_group_weights_[light_group] * group_mean(hierarchy_, g.radiosity, exposure_, group_id(group));
 }
 
 double Solution::group_area(std::string_view group) const {
@@ -197,7 +206,7 @@ std::vector<Rgb> Solution::mesh_triangle_values(MeshId mesh, Quantity quantity) 
     double area = 0.0;
     for (std::uint32_t j = ranges[p].first; j < ranges[p].first + ranges[p].second; ++j) {
       const Patch& patch = hierarchy_.patches()[j];
-      sum += static_cast<double>(patch.area) * glm::dvec3(values[patch.root]);
+      sum += open_area(patch.area, exposure_, patch.root) * glm::dvec3(values[patch.root]);
       area += patch.area;
     }
     if (area > 0.0) out[t] = Rgb(sum / area);
@@ -246,6 +255,14 @@ std::vector<Rgb> Solution::mesh_vertex_values(MeshId mesh, Quantity quantity) co
   for (std::size_t v = 0; v < out.size(); ++v)
     if (weight[v] > 0.0) out[v] = Rgb(sum[v] / weight[v]);
   return out;
+}
+
+void Solution::set_exposure(std::vector<float> exposure) {
+  if (!exposure.empty() && exposure.size() != hierarchy_.elements().size())
+    throw Error(ErrorCode::invalid_argument, "Solution::set_exposure: " + std::to_string(exposure.size()) +
+                                                 " values for " + std::to_string(hierarchy_.elements().size()) +
+                                                 " elements");
+  exposure_ = std::move(exposure);
 }
 
 void Solution::set_light_groups(std::vector<LightGroupSolution> groups) {
@@ -300,6 +317,7 @@ Solution Solution::relight(const std::vector<Rgb>& weights) const {
   Solution out(PatchHierarchy(hierarchy_), std::move(B), groups_, status_, report_, Rgb(0.0f), {}, std::move(back),
                std::move(H), std::move(direct));
   out.meshes_ = meshes_;
+  out.exposure_ = exposure_;
   out.light_groups_ = light_groups_;
   out.light_group_weights_ = weights;
   return out;

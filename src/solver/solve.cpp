@@ -34,15 +34,17 @@ using detail::seconds_since;
 /// methods have every row in `store`; progressive refinement takes the emitting targets'
 /// columns, from `columns` when it holds them for these leaves, else from the estimator.
 /// Split among processes (Jacobi), each has the rows of its block of unknowns
-/// (solve_matrix()): each computes its block, and the blocks are gathered.
+/// (solve_matrix()): each computes its block, and the blocks are gathered. `exposure` as
+/// SolverResult::exposure: the open parts' irradiance.
 std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const FormFactorEstimator& estimator,
                                    bool progressive, const detail::MatrixStore& store,
-                                   const detail::ColumnStore& columns, const detail::Communicator* split) {
+                                   const detail::ColumnStore& columns, const detail::Communicator* split,
+                                   const std::vector<float>& exposure) {
   std::vector<Rgb> patch_E;
-  sys.patch_means(sys.emission, patch_E);
+  sys.patch_means(sys.emission, patch_E, sys.weights(exposure));
   std::vector<Rgb> out(sys.fronts(), Rgb(0.0f));
   if (!sys.light.empty())
-    for (std::size_t u = 0; u < sys.fronts(); ++u) out[u] = sys.light[u];
+    for (std::size_t u = 0; u < sys.fronts(); ++u) out[u] = sys.exposed_light(u, exposure);
   if (!progressive) {
     // The fronts of this process's block of unknowns (solve_matrix()'s), or all of them.
     std::vector<std::size_t> blocks = split ? detail::even_blocks(sys.unknowns(), split->size())
@@ -485,12 +487,16 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // Side u's values, per element id.
   auto B_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? B_elements : B_back)[system->element(u)]; };
   auto H_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? H_elements : H_back)[system->element(u)]; };
+  // Per unknown, the share of it that is not buried, where the solver has it (the matrix
+  // methods over Monte Carlo rows: RadiositySystem::Weights); B and H are the open parts'.
+  std::vector<float> exposure;
   auto keep = [&](const detail::SolverResult& res) {
     resize();
+    exposure = res.exposure;
     // The solvers' irradiance is from surfaces; the lights' first shot arrives as well.
     for (std::size_t i = 0; i < system->unknowns(); ++i) {
       B_of(i) = res.B[i];
-      H_of(i) = system->light.empty() ? res.H[i] : res.H[i] + system->light[i];
+      H_of(i) = system->light.empty() ? res.H[i] : res.H[i] + system->exposed_light(i, exposure);
     }
     report.iterations += res.iterations;
     report.residual = res.residual;
@@ -625,7 +631,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     if (solved) {
       const std::vector<Rgb> H = links->irradiance(hierarchy, *system, current_B(), held);
       for (std::size_t i = 0; i < system->unknowns(); ++i)
-        H_of(i) = system->light.empty() ? H[i] : H[i] + system->light[i];
+        H_of(i) = system->light.empty() ? H[i] : H[i] + system->exposed_light(i, exposure);
     }
     report.link_count = links->link_count();
     report.form_factor_bytes = std::max(report.form_factor_bytes, links->bytes());
@@ -734,7 +740,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       const Material& m = scene.material(hierarchy.patches()[hierarchy.element(system->element(i)).patch].material);
       passed_on = static_cast<double>(detail::pass1_mirror(m) + detail::pass1_window(m) + detail::pass1_glass(m));
     }
-    absorbed += a *
+    // Over the open part only: H_of is its irradiance.
+    const double open = exposure.empty() ? a : a * static_cast<double>(exposure[i]);
+    absorbed += open *
                 glm::max(glm::dvec3(1.0 - passed_on) - glm::dvec3(system->reflectance[i]) -
                              glm::dvec3(system->transmittance[i]),
                          glm::dvec3(0.0)) *
@@ -744,6 +752,46 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   report.light_power = Rgb(lit);
   report.absorbed_power = Rgb(absorbed);
   report.escaped_power = Rgb(emitted - absorbed);
+  // Per element id, the share of it that is not buried (Solution::exposure()): the leaves'
+  // fronts from the solver, inner nodes their children's area-weighted mean; empty when the
+  // solver has none. Inner nodes' values are then their open parts' means, as the leaves' are.
+  std::vector<float> element_exposure;
+  if (!exposure.empty()) {
+    element_exposure.assign(hierarchy.elements().size(), 1.0f);
+    for (std::size_t u = 0; u < system->fronts(); ++u) element_exposure[system->leaves[u]] = exposure[u];
+    for (std::size_t e = element_exposure.size(); e-- > 0;) {  // children before parents
+      const Element& el = hierarchy.element(static_cast<std::uint32_t>(e));
+      if (el.is_leaf()) continue;
+      double area = 0.0, open = 0.0;
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const double a = hierarchy.element(el.first_child + k).area;
+        area += a;
+        open += a * static_cast<double>(element_exposure[el.first_child + k]);
+      }
+      element_exposure[e] = area > 0.0 ? static_cast<float>(open / area) : 1.0f;
+    }
+  }
+  auto aggregate = [&](std::vector<Rgb>& values) {
+    if (element_exposure.empty()) {
+      hierarchy.aggregate(values);
+      return;
+    }
+    for (std::size_t e = values.size(); e-- > 0;) {
+      const Element& el = hierarchy.element(static_cast<std::uint32_t>(e));
+      if (el.is_leaf()) continue;
+      glm::dvec3 sum(0.0), open_sum(0.0);
+      double area = 0.0, open = 0.0;
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const std::uint32_t c = el.first_child + k;
+        const double a = hierarchy.element(c).area, w = a * static_cast<double>(element_exposure[c]);
+        sum += a * glm::dvec3(values[c]);
+        open_sum += w * glm::dvec3(values[c]);
+        area += a;
+        open += w;
+      }
+      values[e] = open > 0.0 ? Rgb(open_sum / open) : area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
+    }
+  };
   // What arrived straight from the emitters; not for a cancelled solve, which may lack rows.
   std::vector<Rgb> H_direct;
   if (status != SolveStatus::cancelled) {
@@ -753,18 +801,18 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       direct = links->irradiance(hierarchy, *system, system->emission);
       direct.resize(system->fronts());
       if (!system->light.empty())
-        for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->light[u];
+        for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->exposed_light(u, exposure);
     } else {
-      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes);
+      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes, exposure);
     }
     H_direct.assign(hierarchy.elements().size(), Rgb(0.0f));
     for (std::size_t u = 0; u < system->fronts(); ++u) H_direct[system->leaves[u]] = direct[u];
-    hierarchy.aggregate(H_direct);
+    aggregate(H_direct);
   }
   // Inner nodes (split elements) hold the mean of their children from here on.
-  hierarchy.aggregate(B_elements);
-  hierarchy.aggregate(H_elements);
-  if (translucency) hierarchy.aggregate(B_back);
+  aggregate(B_elements);
+  aggregate(H_elements);
+  if (translucency) aggregate(B_back);
   std::vector<Rgb> ambient_elements;
   if (r.ambient != Rgb(0.0f)) {
     // The ambient reaches both sides of a translucent element, and each side sends on
@@ -802,9 +850,10 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   if (status == SolveStatus::converged)
     for (std::string& w : detail::back_lit_warnings(scene, hierarchy, B_elements, B_back))
       report.warnings.push_back(std::move(w));
-  return Solution(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report),
-                  r.ambient, std::move(ambient_elements), std::move(B_back), std::move(H_elements),
-                  std::move(H_direct));
+  Solution out(result_hierarchy(), std::move(B_elements), std::move(groups), status, std::move(report), r.ambient,
+               std::move(ambient_elements), std::move(B_back), std::move(H_elements), std::move(H_direct));
+  if (!element_exposure.empty()) out.set_exposure(std::move(element_exposure));
+  return out;
 }
 
 Problem::Problem(const Scene& scene, const SolveOptions& options) : impl_(std::make_unique<Impl>(scene, options)) {}

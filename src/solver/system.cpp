@@ -75,4 +75,40 @@ void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& p
   for (std::size_t j = 0; j < sum.size(); ++j) patch_B[j] = Rgb(sum[j] / static_cast<double>(patch_area[j]));
 }
 
+RadiositySystem::Weights RadiositySystem::weights(const std::vector<float>& exposure) const {
+  Weights w;
+  w.side = area;
+  RADIOSITY_ASSERT(exposure.empty() || exposure.size() == area.size());
+  for (std::size_t u = 0; u < exposure.size(); ++u) w.side[u] *= exposure[u];
+  if (exposure.empty()) {
+    w.target.assign(patch_area.begin(), patch_area.end());
+    return w;
+  }
+  w.target.assign(patch_area.size(), 0.0);
+  for (std::size_t u = 0; u < area.size(); ++u) w.target[patch[u]] += static_cast<double>(w.side[u]);
+  // A wholly buried target: the plain mean (its value reaches no one).
+  for (std::size_t u = 0; u < area.size(); ++u)
+    if (w.target[patch[u]] <= 0.0) w.side[u] = area[u];
+  for (std::size_t j = 0; j < patch_area.size(); ++j)
+    if (w.target[j] <= 0.0) w.target[j] = static_cast<double>(patch_area[j]);
+  return w;
+}
+
+void RadiositySystem::patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B, const Weights& w) const {
+  std::vector<glm::dvec3> sum(patch_area.size(), glm::dvec3(0.0));
+  for (std::size_t i = 0; i < B.size(); ++i) sum[patch[i]] += static_cast<double>(w.side[i]) * glm::dvec3(B[i]);
+  patch_B.resize(patch_area.size());
+  for (std::size_t j = 0; j < sum.size(); ++j) patch_B[j] = Rgb(sum[j] / w.target[j]);
+}
+
+std::vector<Rgb> RadiositySystem::exposed_source(const std::vector<float>& exposure) const {
+  if (exposure.empty() || light.empty()) return source;
+  std::vector<Rgb> out(source.size());
+  for (std::size_t u = 0; u < source.size(); ++u) {
+    out[u] = emission[u] + reflectance[u] * exposed_light(u, exposure);
+    if (twin[u] != kNone) out[u] += transmittance[u] * exposed_light(twin[u], exposure);
+  }
+  return out;
+}
+
 }  // namespace radiosity::detail

@@ -66,6 +66,27 @@ struct RadiositySystem {
   std::uint32_t element(std::size_t u) const { return leaves[u < fronts() ? u : twin[u]]; }
   /// Target radiosity from side radiosity (area-weighted means).
   void patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const;
+
+  /// Exposure: per unknown, the share of its area that is not buried (inside a solid standing
+  /// on it: geometry/burial.hpp), from the Monte Carlo rows (SparseFactors::exposed); empty
+  /// when the solver does not have it (every side taken as exposed). The rows' factors are
+  /// means over the whole element, so a floor element half under a block gathers half of what
+  /// its open half receives; divided by the exposure they are the open part's (solve_matrix()).
+  /// And a target's radiosity, as the rays that reach its open part see it, is the mean of its
+  /// sides weighted by their exposed areas, not the mean with its dark buried part.
+  struct Weights {
+    std::vector<float> side;     ///< per unknown: area x exposure
+    std::vector<double> target;  ///< per target: the sum of its sides', or its area where that is 0 (wholly buried)
+  };
+  Weights weights(const std::vector<float>& exposure) const;
+  /// Target radiosity from side radiosity, weighted by `w`.
+  void patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B, const Weights& w) const;
+  /// The lights' first shot onto unknown u's open part: light[u] / exposure[u] (as the rows).
+  Rgb exposed_light(std::size_t u, const std::vector<float>& exposure) const {
+    return u < exposure.size() && exposure[u] > 0.0f ? light[u] / exposure[u] : light[u];
+  }
+  /// `source` with the lights' first shot onto the open parts (exposed_light()).
+  std::vector<Rgb> exposed_source(const std::vector<float>& exposure) const;
   /// The unknown at position `index` of an estimator's column over `leaves`: the front for
   /// index < fronts(), the back of leaves[index - fronts()] beyond (kNone if it has none).
   std::uint32_t column_unknown(std::size_t index) const {
@@ -76,7 +97,10 @@ struct RadiositySystem {
 /// What a solver hands back to solve().
 struct SolverResult {
   std::vector<Rgb> B;          ///< per unknown
-  std::vector<Rgb> H;          ///< irradiance per unknown (for the absorbed power)
+  std::vector<Rgb> H;          ///< irradiance per unknown (for the absorbed power), onto its open part
+  /// Per unknown (RadiositySystem::Weights), or empty: every side exposed. B and H are the
+  /// sides' open parts'.
+  std::vector<float> exposure;
   Rgb ambient{0.0f};           ///< progressive refinement's ambient radiosity at the end
   SolveStatus status = SolveStatus::converged;
   int iterations = 0;
@@ -134,11 +158,20 @@ struct FactorVector {
   }
 };
 
+/// The exposure a solver uses for an element whose rows report `exposed`
+/// (SparseFactors::exposed): the same, except that a sliver left open, less than
+/// kMinExposure of the element, is taken as wholly exposed (its rows not divided), because its
+/// few open rays would make its radiosity noisy where it shows beside its neighbours. A wholly
+/// buried element (0) keeps 0: it sends nothing into its target's mean.
+inline constexpr float kMinExposure = 0.125f;
+inline float effective_exposure(float exposed) { return exposed == 0.0f || exposed >= kMinExposure ? exposed : 1.0f; }
+
 /// Rows F(element -> every target) kept across adaptive refinement passes, so a pass computes
 /// rows only for the elements it created. A subdivided element's row slots are reused by its
 /// children. The backs of translucent elements have rows of their own.
 struct MatrixStore {
-  std::vector<FactorVector> rows;        ///< by slot
+  std::vector<FactorVector> rows;        ///< by slot, divided by their exposure
+  std::vector<float> exposure;           ///< by slot: effective_exposure() of its row's element side
   std::vector<std::uint32_t> slot;       ///< element id -> slot of its front row, kNone when it has none
   std::vector<std::uint32_t> back_slot;  ///< element id -> slot of its back row, kNone when it has none
   std::vector<std::uint32_t> free_slots; ///< slots of elements that were subdivided

@@ -200,18 +200,24 @@ TEST_SUITE("scene") {
     CHECK(sum3(r.emitted_power) == doctest::Approx(sum3(r.light_power)).epsilon(1e-6));
     CHECK(sum3(r.light_power) > 0.0);
 
-    // Absorbed: sum over leaves of A (1 - rho) H, from the solution's irradiance.
+    // Absorbed: sum over leaves of A x (1 - rho) H, from the solution's irradiance, which is
+    // that of each leaf's open part x (the facets that buildings stand on are partly buried:
+    // Solution::exposure()).
     const rad::PatchHierarchy& h = sol.hierarchy();
+    auto open = [&](std::uint32_t e) { return sol.exposure().empty() ? 1.0 : static_cast<double>(sol.exposure()[e]); };
     double absorbed = 0.0;
     std::vector<std::uint32_t> leaves(h.leaves().begin(), h.leaves().end());
     for (std::uint32_t e : leaves) {
       const rad::Material& m = c.scene.material(h.patches()[h.element(e).patch].material);
-      absorbed += h.element(e).area * sum3((rad::Rgb(1.0f) - m.reflectance) * sol.irradiance()[e]);
+      absorbed += h.element(e).area * open(e) * sum3((rad::Rgb(1.0f) - m.reflectance) * sol.irradiance()[e]);
     }
+    CHECK(!sol.exposure().empty());
+    CHECK(*std::min_element(sol.exposure().begin(), sol.exposure().end()) < 1.0f);
     CHECK(absorbed == doctest::Approx(sum3(r.absorbed_power)).epsilon(1e-5));
     // Escaped, independently of the solve: the light each element sends that meets no surface's
     // front (into the sky, or onto a back), by another estimator's row sums (another seed, 4x the
-    // rays): sum over e of A_e B_e (1 - sum_j F(e -> j)).
+    // rays): sum over e of A_e x_e B_e (1 - sum_j F(e -> j) / x_e), the rows being means over
+    // the whole element, its buried part's rays meeting nothing that counts.
     rad::FormFactorOptions fo;
     fo.method = rad::FormFactorMethod::monte_carlo;
     fo.hemisphere_rays = 4096;
@@ -223,7 +229,8 @@ TEST_SUITE("scene") {
     for (std::size_t k = 0; k < leaves.size(); ++k) {
       double row = 0.0;
       for (float f : rows[k].value) row += f;
-      escaped += h.element(leaves[k]).area * sum3(sol.radiosity()[leaves[k]]) * (1.0 - row);
+      const double x = open(leaves[k]);
+      if (x > 0.0) escaped += h.element(leaves[k]).area * x * sum3(sol.radiosity()[leaves[k]]) * (1.0 - row / x);
     }
     const double emitted = sum3(r.emitted_power);
     MESSAGE("emitted " << emitted << ", absorbed " << absorbed / emitted << ", escaped (rays) " << escaped / emitted

@@ -75,16 +75,27 @@ TEST_SUITE("solver") {
           CHECK(H[c] >= 0.0f);
           CHECK(B[c] == doctest::Approx(m.emission[c] + m.reflectance[c] * H[c]).epsilon(1e-4));
         }
-        absorbed += h.element(e).area * (1.0 - m.reflectance.x) * H.x;
+        // H is the irradiance of the element's open part (Solution::exposure(): the floor
+        // around the blocks is partly buried).
+        const double open = sol.exposure().empty() ? 1.0 : sol.exposure()[e];
+        absorbed += h.element(e).area * open * (1.0 - m.reflectance.x) * H.x;
       }
       CHECK(absorbed == doctest::Approx(sol.report().absorbed_power.x).epsilon(1e-4));
-      // An inner node holds the area-weighted mean of its children.
+      // An inner node holds the mean of its children weighted by their open area (area x
+      // exposure), and its exposure is their area-weighted mean.
+      auto exposure = [&](std::uint32_t e) { return sol.exposure().empty() ? 1.0f : sol.exposure()[e]; };
       for (std::uint32_t p = 0; p < h.patches().size(); ++p) {
         const rad::Element& root = h.element(h.patches()[p].root);
         if (root.is_leaf()) continue;
-        rad::Rgb sum(0.0f);
-        for (std::uint32_t c = 0; c < 4; ++c) sum += h.element(root.first_child + c).area * sol.irradiance()[root.first_child + c];
-        CHECK(sol.irradiance()[h.patches()[p].root].x == doctest::Approx(sum.x / root.area).epsilon(1e-4));
+        double sum = 0.0, open = 0.0;
+        for (std::uint32_t c = 0; c < 4; ++c) {
+          const double w = static_cast<double>(h.element(root.first_child + c).area) * exposure(root.first_child + c);
+          sum += w * sol.irradiance()[root.first_child + c].x;
+          open += w;
+        }
+        REQUIRE(open > 0.0);
+        CHECK(sol.irradiance()[h.patches()[p].root].x == doctest::Approx(sum / open).epsilon(1e-4));
+        CHECK(exposure(h.patches()[p].root) == doctest::Approx(open / root.area).epsilon(1e-5));
       }
     }
   }

@@ -29,6 +29,7 @@
 #include "core/rng.hpp"
 #include "core/streams.hpp"
 #include "form_factors/estimators.hpp"
+#include "geometry/burial.hpp"
 
 namespace radiosity::detail {
 namespace {
@@ -199,6 +200,7 @@ struct LinkHierarchy::Impl {
   /// is pushed to each part below it in proportion, so that a floor element half under a block
   /// gets nothing for its buried half.
   std::vector<float> exposure;
+  bool any_buried = false;  ///< some leaf side has leaf_exposure() < 1
   /// Per cluster with a buried part: an index into open_moments, its sides' exposed area in its
   /// basis (as area_moments holds their area); kNone for a cluster wholly exposed. A cluster's
   /// exposure toward a direction is the one over the other (cluster_exposure_toward()).
@@ -458,12 +460,21 @@ struct LinkHierarchy::Impl {
     v.front.assign(count, Rgb(0.0f));
     v.back.assign(sys.has_backs() ? count : 0, Rgb(0.0f));
     for (std::size_t u = 0; u < sys.unknowns(); ++u) (u < sys.fronts() ? v.front : v.back)[sys.element(u)] = B[u];
-    leaf_values(hierarchy, v);
+    leaf_values(hierarchy, v, true);
   }
-  /// The rest of node_values() from the leaves' values already in v.front and v.back.
-  void leaf_values(const PatchHierarchy& hierarchy, Values& v) const {
-    hierarchy.aggregate(v.front);
-    if (!v.back.empty()) hierarchy.aggregate(v.back);
+  /// The rest of node_values() from the leaves' values already in v.front and v.back. With
+  /// `open`, the leaves' values are their open parts' (unknown_exposure()) and each inner
+  /// element takes its children's mean weighted by their open area: the links' factors see a
+  /// source's buried part as hidden, so a source sends its open part's radiosity. Without, area
+  /// means (the balancing's unit values).
+  void leaf_values(const PatchHierarchy& hierarchy, Values& v, bool open = false) const {
+    if (open && any_buried) {
+      aggregate_open(hierarchy, v.front, false);
+      if (!v.back.empty()) aggregate_open(hierarchy, v.back, true);
+    } else {
+      hierarchy.aggregate(v.front);
+      if (!v.back.empty()) hierarchy.aggregate(v.back);
+    }
     const std::vector<Patch>& patches = hierarchy.patches();
     std::vector<Rgb> patch_front(patches.size()), patch_back(v.back.empty() ? 0 : patches.size());
     for (std::size_t p = 0; p < patches.size(); ++p) {
@@ -1140,40 +1151,32 @@ struct LinkHierarchy::Impl {
 
   // ---- Buried parts ------------------------------------------------------------------------
 
-  /// The share of element side (e, back)'s area that is not buried: of kExposurePoints points
-  /// (2 x 2 cell centres), those from which some of kExposureDirections rays (the normal, and
-  /// three at 60 degrees from it) does not end on the back of a one-sided polygon. A point
-  /// under a block standing on it sees only the block's insides every way; a point under a
-  /// one-sided table top sees its back above but out to the sides. Rays and hemicubes find
+  /// The share of element side (e, back)'s area that is not buried: of 4 points (2 x 2 cell
+  /// centres), those that geometry/burial.hpp's test finds open. Rays and hemicubes find
   /// buried points by themselves (docs/FORM_FACTORS.md, "Touching ... geometry"), as do the
   /// links' shadow rays from a receiver's points; light pushed down from a receiving cluster or
   /// a larger element does not, and this share is what the push gives each part.
-  float sample_exposure(const PatchHierarchy& h, std::uint32_t e, bool back, const std::vector<std::uint8_t>& back_surface) const {
+  /// `cells` x `cells` cell centres; a leaf found partly buried is sampled again at
+  /// kFineExposure x kFineExposure (update_exposure()): its values are its open part's (the
+  /// irradiance over its exposure), which a quarter's resolution would make up to twice too
+  /// bright or too dark.
+  float sample_exposure(const PatchHierarchy& h, std::uint32_t e, bool back, const std::vector<std::uint8_t>& back_surface,
+                        int cells) const {
     const glm::vec3 n = back ? -h.normal(e) : h.normal(e);
-    const Frame frame(n);
-    constexpr float kSin = 0.8660254f, kCos = 0.5f;  // 60 degrees
-    const std::array<glm::vec3, 4> directions{frame.to_world(glm::vec3(0.0f, 0.0f, 1.0f)),
-                                              frame.to_world(glm::vec3(kSin, 0.0f, kCos)),
-                                              frame.to_world(glm::vec3(-0.5f * kSin, 0.8660254f * kSin, kCos)),
-                                              frame.to_world(glm::vec3(-0.5f * kSin, -0.8660254f * kSin, kCos))};
-    constexpr std::array<float, 2> kCells{0.25f, 0.75f};
+    const std::array<glm::vec3, 4> directions = burial_directions(n);
+    auto sealed = [&](const RayScene::Hit& hit, const glm::vec3& d) {
+      return glm::dot(d, hit.geometric_normal) > 0.0f && !back_surface[hit.id];
+    };
     int exposed = 0;
-    for (const float u : kCells)
-      for (const float v : kCells) {
-        const glm::vec3 x = h.sample_point(e, glm::vec2(u, v)) + ray_epsilon * n;
-        bool buried = true;
-        for (const glm::vec3& d : directions) {
-          const std::optional<RayScene::Hit> hit = occluders.intersect(x, d, 0.0f, std::numeric_limits<float>::infinity());
-          const bool sealed = hit && glm::dot(d, hit->geometric_normal) > 0.0f && !back_surface[hit->id];
-          if (!sealed) {
-            buried = false;
-            break;
-          }
-        }
-        exposed += buried ? 0 : 1;
+    for (int i = 0; i < cells; ++i)
+      for (int k = 0; k < cells; ++k) {
+        const glm::vec2 uv((static_cast<float>(i) + 0.5f) / static_cast<float>(cells),
+                           (static_cast<float>(k) + 0.5f) / static_cast<float>(cells));
+        exposed += buried(occluders, h.sample_point(e, uv) + ray_epsilon * n, directions, sealed) ? 0 : 1;
       }
-    return static_cast<float>(exposed) / 4.0f;
+    return static_cast<float>(exposed) / static_cast<float>(cells * cells);
   }
+  static constexpr int kFineExposure = 8;
 
   /// exposure, open_index and open_moments for the elements as they stand: new leaves sampled, inner
   /// elements and clusters aggregated. After refinement, which may split elements.
@@ -1190,8 +1193,26 @@ struct LinkHierarchy::Impl {
     parallel_for(threads, todo.size(), 256, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t e = todo[i];
-        exposure[2 * std::size_t{e}] = sample_exposure(h, e, false, back_surface);
-        exposure[2 * std::size_t{e} + 1] = has_back[h.element(e).patch] ? sample_exposure(h, e, true, back_surface) : 1.0f;
+        exposure[2 * std::size_t{e}] = sample_exposure(h, e, false, back_surface, 2);
+        exposure[2 * std::size_t{e} + 1] = has_back[h.element(e).patch] ? sample_exposure(h, e, true, back_surface, 2) : 1.0f;
+      }
+    });
+    // Finer where it matters: the new leaves of a polygon where some leaf was found buried,
+    // partly or wholly (a block's edge may cross a leaf between its four points).
+    std::vector<std::uint8_t> touched(scene.polygons().size(), 0);
+    for (const std::uint32_t e : todo)
+      if (exposure[2 * std::size_t{e}] < 1.0f || exposure[2 * std::size_t{e} + 1] < 1.0f)
+        touched[patches[h.element(e).patch].polygon] = 1;
+    std::vector<std::uint32_t> fine;
+    for (const std::uint32_t e : todo)
+      if (touched[patches[h.element(e).patch].polygon]) fine.push_back(e);
+    parallel_for(threads, fine.size(), 16, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t e = fine[i];
+        for (std::size_t side = 0; side < (has_back[h.element(e).patch] ? 2u : 1u); ++side) {
+          float& x = exposure[2 * std::size_t{e} + side];
+          x = sample_exposure(h, e, side == 1, back_surface, kFineExposure);
+        }
       }
     });
     for (std::uint32_t e = static_cast<std::uint32_t>(count); e-- > 0;) {  // children before parents
@@ -1207,6 +1228,10 @@ struct LinkHierarchy::Impl {
         exposure[2 * std::size_t{e} + side] = area > 0.0 ? static_cast<float>(open / area) : 1.0f;
       }
     }
+    any_buried = false;
+    for (std::uint32_t e = 0; e < count && !any_buried; ++e)
+      if (h.element(e).is_leaf())
+        any_buried = leaf_exposure(e, false) < 1.0f || (has_back[h.element(e).patch] && leaf_exposure(e, true) < 1.0f);
     // The clusters' exposed area moments, only where something below is buried.
     const std::uint32_t C = cluster_count();
     open_index.assign(C, kNone);
@@ -1231,6 +1256,46 @@ struct LinkHierarchy::Impl {
       open_moments.push_back(open);
     }
   }
+  /// The exposure by which a leaf side's irradiance is divided for its open part's
+  /// (effective_exposure(): a sliver is left as it is, a wholly buried side at 0).
+  float leaf_exposure(std::uint32_t e, bool back) const { return effective_exposure(element_exposure(e, back)); }
+  /// Per unknown, leaf_exposure() of its side; empty when every side is open.
+  std::vector<float> unknown_exposure(const RadiositySystem& sys) const {
+    if (!any_buried) return {};
+    std::vector<float> x(sys.unknowns());
+    for (std::size_t u = 0; u < x.size(); ++u) x[u] = leaf_exposure(sys.element(u), u >= sys.fronts());
+    return x;
+  }
+  /// H per unknown (a mean over the side's whole area, its buried part receiving nothing) to
+  /// its open part's.
+  static void to_open(std::vector<Rgb>& H, const std::vector<float>& x) {
+    for (std::size_t u = 0; u < x.size(); ++u)
+      if (x[u] > 0.0f && x[u] < 1.0f) H[u] /= x[u];
+  }
+  /// hierarchy.aggregate() weighted by open area (leaf_values()).
+  void aggregate_open(const PatchHierarchy& h, std::vector<Rgb>& values, bool back) const {
+    std::vector<double> weight(values.size(), 0.0);
+    for (std::size_t e = values.size(); e-- > 0;) {  // children before parents
+      const Element& el = h.element(static_cast<std::uint32_t>(e));
+      if (el.is_leaf()) {
+        weight[e] = static_cast<double>(el.area) * static_cast<double>(leaf_exposure(static_cast<std::uint32_t>(e), back));
+        continue;
+      }
+      glm::dvec3 sum(0.0), open_sum(0.0);
+      double area = 0.0, open = 0.0;
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const std::uint32_t c = el.first_child + k;
+        const double a = h.element(c).area;
+        sum += a * glm::dvec3(values[c]);
+        open_sum += weight[c] * glm::dvec3(values[c]);
+        area += a;
+        open += weight[c];
+      }
+      weight[e] = open;
+      values[e] = open > 0.0 ? Rgb(open_sum / open) : area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
+    }
+  }
+
   /// What a node's irradiance is multiplied by as it is pushed to a part below it: the part's
   /// exposure over the node's (power kept: the node's is the parts' area-weighted mean).
   static float exposure_ratio(float part, float node) { return node > 0.0f ? part / node : 0.0f; }
@@ -1880,7 +1945,10 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
   const RadiositySystem& sys = ctx.system;
   const std::size_t n = sys.unknowns();
   SolverResult result;
-  const std::vector<Rgb>& start = B0.empty() ? sys.source : B0;
+  // Leaves partly buried: their values are their open parts' (SolverResult::exposure).
+  result.exposure = m.unknown_exposure(sys);
+  const std::vector<Rgb> source = sys.exposed_source(result.exposure);
+  const std::vector<Rgb>& start = B0.empty() ? source : B0;
   result.B = start;
   result.H.assign(n, Rgb(0.0f));
   result.form_factor_bytes = bytes();
@@ -1906,10 +1974,11 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
     m.node_values(ctx.hierarchy, sys, B_sent, values);
     m.gather(ctx.hierarchy, sys, values, result.H, hold);
     if (hold) Impl::cap_delivered_power(sys, result.B, result.H);
+    Impl::to_open(result.H, result.exposure);
     // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp), from the previous sweep's values.
     double change = 0.0;
     for (std::size_t u = 0; u < n; ++u) {
-      Rgb b = sys.source[u] + sys.reflectance[u] * result.H[u];
+      Rgb b = source[u] + sys.reflectance[u] * result.H[u];
       if (sys.twin[u] != kNone) b += sys.transmittance[u] * result.H[sys.twin[u]];
       next[u] = b;
       change += sys.area[u] * channel_l1(b - result.B[u]);
@@ -1941,6 +2010,7 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
   impl_->node_values(hierarchy, system, impl_->sent(system, B, scaled), values);
   impl_->gather(hierarchy, system, values, H, hold);
   if (hold) Impl::cap_delivered_power(system, B, H);
+  Impl::to_open(H, impl_->unknown_exposure(system));
   return H;
 }
 

@@ -97,7 +97,8 @@ class LinkHierarchy {
 
   /// The irradiance per unknown that radiosity `B` (per unknown) sends along the links: one
   /// gather and push (`hold`: held to the maximum principle, as solve() holds it). With B = the
-  /// emission it is the direct irradiance from the emitters.
+  /// emission it is the direct irradiance from the emitters. Onto each side's open part where
+  /// it is partly buried, as solve()'s H and B (SolverResult::exposure).
   std::vector<Rgb> irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
                               const std::vector<Rgb>& B, bool hold = false) const;
 
