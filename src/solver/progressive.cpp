@@ -17,6 +17,7 @@
 #include <cmath>
 
 #include "core/parallel.hpp"
+#include "solver/exposure.hpp"
 #include "solver/system.hpp"
 
 namespace radiosity::detail {
@@ -31,12 +32,20 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   const RadiositySystem& sys = ctx.system;
   const std::size_t m = sys.unknowns(), n = sys.patches();
   SolverResult result;
-  result.B = sys.source;
+  // Monte Carlo columns are means over each receiving side's whole area, its buried part
+  // receiving nothing (under a block standing on it): measured by points, so that a side's
+  // values are its open part's and a patch sends its open part's mean (RadiositySystem::
+  // Weights). The other estimators keep to their own (the hemicube's is its centre's).
+  if (ctx.options.form_factors.method == FormFactorMethod::monte_carlo)
+    result.exposure = unknown_exposure(ctx.scene, ctx.hierarchy, sys, ctx.options.threads);
+  const RadiositySystem::Weights weights = sys.weights(result.exposure);
+  const std::vector<Rgb> source = sys.exposed_source(result.exposure);
+  result.B = source;
   result.H.assign(m, Rgb(0.0f));
 
   // Unshot radiosity per patch starts as the patch's mean emission (with the lights' first shot).
   std::vector<Rgb> unshot;
-  sys.patch_means(sys.source, unshot);
+  sys.patch_means(source, unshot, weights);
 
   // Columns are kept once computed while they fit the memory budget: a patch is usually shot
   // several times, and recomputing its column is the whole cost of a step.
@@ -67,7 +76,7 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   // interreflection factor (Cohen et al. 1988, eqs. 5-6). For display only; it tends to 0.
   auto ambient = [&] {
     glm::dvec3 sum(0.0);
-    for (std::size_t j = 0; j < n; ++j) sum += static_cast<double>(sys.patch_area[j]) * glm::dvec3(unshot[j]);
+    for (std::size_t j = 0; j < n; ++j) sum += weights.target[j] * glm::dvec3(unshot[j]);
     return Rgb(sum / sys.total_area) * sys.interreflection;
   };
   auto report = [&](Progress p, bool force) {
@@ -84,7 +93,7 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   // so choosing the shooter is a scan of one array. Its sum (the residual's numerator) is
   // recomputed in that scan, so no error accumulates.
   std::vector<double> power(n);
-  for (std::size_t j = 0; j < n; ++j) power[j] = sum3(unshot[j]) * sys.patch_area[j];
+  for (std::size_t j = 0; j < n; ++j) power[j] = sum3(unshot[j]) * weights.target[j];
   for (int step = 1;; ++step) {
     // Four independent partial sums and maxima keep the scan from waiting on one add chain;
     // ties go to the lowest index, as in a plain scan.
@@ -178,20 +187,22 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
       result.seconds_form_factors += seconds_since(tf);
     }
 
+    auto exposed = [&](std::uint32_t u) { return !result.exposure.empty() && result.exposure[u] > 0.0f; };
     const Rgb shot = unshot[shooter];
     unshot[shooter] = Rgb(0.0f);
     power[shooter] = 0.0;
     auto receive = [&](std::uint32_t u, const Rgb& dB) {
       result.B[u] += dB;
       const std::uint32_t p = sys.patch[u];
-      unshot[p] += (sys.area[u] / sys.patch_area[p]) * dB;
-      power[p] = sum3(unshot[p]) * sys.patch_area[p];
+      unshot[p] += static_cast<float>(weights.side[u] / weights.target[p]) * dB;
+      power[p] = sum3(unshot[p]) * weights.target[p];
     };
     F->for_each([&](std::size_t k, float f) {
       if (f <= 0.0f) return;
       const std::uint32_t u = sys.column_unknown(k);
       if (u == kNone) return;
-      const Rgb incident = shot * f;  // irradiance arriving at side u from this shot
+      // Irradiance arriving at side u from this shot (onto its open part).
+      const Rgb incident = shot * (exposed(u) ? f / result.exposure[u] : f);
       result.H[u] += incident;
       receive(u, sys.reflectance[u] * incident);
       if (sys.twin[u] != kNone) receive(sys.twin[u], sys.transmittance[u] * incident);

@@ -484,15 +484,34 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       H_back.resize(count, Rgb(0.0f));
     }
   };
+  // Kept per element side (2 e + 1 for its back), as unknowns are renumbered when leaves split;
+  // empty when the solver has none.
+  std::vector<float> side_exposure;
+  // Per unknown of the system as it stands, from side_exposure (empty: every side open).
+  auto current_exposure = [&] {
+    std::vector<float> x;
+    if (side_exposure.empty()) return x;
+    x.resize(system->unknowns());
+    for (std::size_t u = 0; u < x.size(); ++u) {
+      const std::size_t k = 2 * std::size_t{system->element(u)} + (u < system->fronts() ? 0 : 1);
+      x[u] = k < side_exposure.size() ? side_exposure[k] : 1.0f;
+    }
+    return x;
+  };
   // Side u's values, per element id.
   auto B_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? B_elements : B_back)[system->element(u)]; };
   auto H_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? H_elements : H_back)[system->element(u)]; };
   // Per unknown, the share of it that is not buried, where the solver has it (the matrix
   // methods over Monte Carlo rows: RadiositySystem::Weights); B and H are the open parts'.
-  std::vector<float> exposure;
   auto keep = [&](const detail::SolverResult& res) {
     resize();
-    exposure = res.exposure;
+    side_exposure.clear();
+    if (!res.exposure.empty()) {
+      side_exposure.assign(2 * hierarchy.elements().size(), 1.0f);
+      for (std::size_t u = 0; u < system->unknowns(); ++u)
+        side_exposure[2 * std::size_t{system->element(u)} + (u < system->fronts() ? 0 : 1)] = res.exposure[u];
+    }
+    const std::vector<float>& exposure = res.exposure;
     // The solvers' irradiance is from surfaces; the lights' first shot arrives as well.
     for (std::size_t i = 0; i < system->unknowns(); ++i) {
       B_of(i) = res.B[i];
@@ -630,6 +649,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     // gathers -> 7).
     if (solved) {
       const std::vector<Rgb> H = links->irradiance(hierarchy, *system, current_B(), held);
+      const std::vector<float> exposure = current_exposure();
       for (std::size_t i = 0; i < system->unknowns(); ++i)
         H_of(i) = system->light.empty() ? H[i] : H[i] + system->exposed_light(i, exposure);
     }
@@ -679,10 +699,6 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
         // Progressive: substructuring's gather. Each new element takes its radiosity from the
         // target radiosities it sees, B_c = E_c + rho_c H_c (+ tau_c H_c' with a back), with
         // H_c = sum_t F_ct B_t over its front row (and H_c' over its back row); no matrix is kept.
-        std::vector<Rgb> patch_B;
-        std::vector<Rgb> B_now(system->unknowns());
-        for (std::size_t i = 0; i < system->unknowns(); ++i) B_now[i] = B_of(i);
-        system->patch_means(B_now, patch_B);
         std::vector<SparseFactors> rows, back_rows;
         std::vector<std::uint32_t> backs;
         if (translucency)
@@ -693,27 +709,44 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
         estimator->sparse_element_rows(created, rows);
         if (!backs.empty()) estimator->sparse_back_rows(backs, back_rows);
         report.seconds_form_factors += seconds_since(tf);
-        auto gather = [&](const SparseFactors& row) {
+        // Where the solve measured exposure, the new leaves' comes from their rows, and their
+        // values are their open parts' (RadiositySystem::Weights).
+        if (!side_exposure.empty()) {
+          side_exposure.resize(2 * hierarchy.elements().size(), 1.0f);
+          for (std::size_t k = 0; k < created.size(); ++k)
+            side_exposure[2 * std::size_t{created[k]}] = detail::effective_exposure(rows[k].exposed);
+          for (std::size_t k = 0; k < backs.size(); ++k)
+            side_exposure[2 * std::size_t{backs[k]} + 1] = detail::effective_exposure(back_rows[k].exposed);
+        }
+        const std::vector<float> exposure = current_exposure();
+        const std::vector<Rgb> source = system->exposed_source(exposure);
+        std::vector<Rgb> patch_B;
+        std::vector<Rgb> B_now(system->unknowns());
+        for (std::size_t i = 0; i < system->unknowns(); ++i) B_now[i] = B_of(i);
+        system->patch_means(B_now, patch_B, system->weights(exposure));
+        auto gather = [&](const SparseFactors& row, std::size_t u) {
           Rgb h(0.0f);
           for (std::size_t k = 0; k < row.index.size(); ++k) h += row.value[k] * patch_B[row.index[k]];
-          return h;
+          return !exposure.empty() && exposure[u] > 0.0f ? h / exposure[u] : h;
         };
-        for (std::size_t k = 0; k < created.size(); ++k) H_elements[created[k]] = gather(rows[k]);
-        for (std::size_t k = 0; k < backs.size(); ++k) H_back[backs[k]] = gather(back_rows[k]);
+        for (std::size_t k = 0; k < created.size(); ++k)
+          H_elements[created[k]] = gather(rows[k], hierarchy.leaf_index(created[k]));
+        for (std::size_t k = 0; k < backs.size(); ++k)
+          H_back[backs[k]] = gather(back_rows[k], system->twin[hierarchy.leaf_index(backs[k])]);
         // The system's source is E_c (with the lights' first shot, rho and tau of it).
         for (std::uint32_t c : created) {
           const std::uint32_t u = hierarchy.leaf_index(c);
-          B_elements[c] = system->source[u] + system->reflectance[u] * H_elements[c];
+          B_elements[c] = source[u] + system->reflectance[u] * H_elements[c];
         }
         for (std::uint32_t c : backs) {
           const std::uint32_t u = hierarchy.leaf_index(c), back = system->twin[u];
           B_elements[c] += system->transmittance[u] * H_back[c];
-          B_back[c] = system->source[back] + system->reflectance[back] * H_back[c] +
-                      system->transmittance[back] * H_elements[c];
+          B_back[c] = source[back] + system->reflectance[back] * H_back[c] + system->transmittance[back] * H_elements[c];
         }
         if (!system->light.empty()) {
-          for (std::uint32_t c : created) H_elements[c] += system->light[hierarchy.leaf_index(c)];
-          for (std::uint32_t c : backs) H_back[c] += system->light[system->twin[hierarchy.leaf_index(c)]];
+          for (std::uint32_t c : created) H_elements[c] += system->exposed_light(hierarchy.leaf_index(c), exposure);
+          for (std::uint32_t c : backs)
+            H_back[c] += system->exposed_light(system->twin[hierarchy.leaf_index(c)], exposure);
         }
       }
     }
@@ -727,6 +760,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // where it lands, so it is not absorbed at the specular surface, on either side (pass1_* are
   // channel means).
   // The lights count as emitted with the power they put onto the sides (docs/LIGHTS.md).
+  const std::vector<float> final_exposure = current_exposure();
   glm::dvec3 emitted(0.0), absorbed(0.0), lit(0.0);
   for (std::size_t i = 0; i < system->unknowns(); ++i) {
     const double a = system->area[i];
@@ -741,7 +775,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       passed_on = static_cast<double>(detail::pass1_mirror(m) + detail::pass1_window(m) + detail::pass1_glass(m));
     }
     // Over the open part only: H_of is its irradiance.
-    const double open = exposure.empty() ? a : a * static_cast<double>(exposure[i]);
+    const double open = final_exposure.empty() ? a : a * static_cast<double>(final_exposure[i]);
     absorbed += open *
                 glm::max(glm::dvec3(1.0 - passed_on) - glm::dvec3(system->reflectance[i]) -
                              glm::dvec3(system->transmittance[i]),
@@ -756,9 +790,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // fronts from the solver, inner nodes their children's area-weighted mean; empty when the
   // solver has none. Inner nodes' values are then their open parts' means, as the leaves' are.
   std::vector<float> element_exposure;
-  if (!exposure.empty()) {
+  if (!final_exposure.empty()) {
     element_exposure.assign(hierarchy.elements().size(), 1.0f);
-    for (std::size_t u = 0; u < system->fronts(); ++u) element_exposure[system->leaves[u]] = exposure[u];
+    for (std::size_t u = 0; u < system->fronts(); ++u) element_exposure[system->leaves[u]] = final_exposure[u];
     for (std::size_t e = element_exposure.size(); e-- > 0;) {  // children before parents
       const Element& el = hierarchy.element(static_cast<std::uint32_t>(e));
       if (el.is_leaf()) continue;
@@ -801,9 +835,9 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       direct = links->irradiance(hierarchy, *system, system->emission);
       direct.resize(system->fronts());
       if (!system->light.empty())
-        for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->exposed_light(u, exposure);
+        for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->exposed_light(u, final_exposure);
     } else {
-      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes, exposure);
+      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes, final_exposure);
     }
     H_direct.assign(hierarchy.elements().size(), Rgb(0.0f));
     for (std::size_t u = 0; u < system->fronts(); ++u) H_direct[system->leaves[u]] = direct[u];

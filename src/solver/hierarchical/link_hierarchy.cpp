@@ -29,7 +29,7 @@
 #include "core/rng.hpp"
 #include "core/streams.hpp"
 #include "form_factors/estimators.hpp"
-#include "geometry/burial.hpp"
+#include "solver/exposure.hpp"
 
 namespace radiosity::detail {
 namespace {
@@ -1151,33 +1151,6 @@ struct LinkHierarchy::Impl {
 
   // ---- Buried parts ------------------------------------------------------------------------
 
-  /// The share of element side (e, back)'s area that is not buried: of 4 points (2 x 2 cell
-  /// centres), those that geometry/burial.hpp's test finds open. Rays and hemicubes find
-  /// buried points by themselves (docs/FORM_FACTORS.md, "Touching ... geometry"), as do the
-  /// links' shadow rays from a receiver's points; light pushed down from a receiving cluster or
-  /// a larger element does not, and this share is what the push gives each part.
-  /// `cells` x `cells` cell centres; a leaf found partly buried is sampled again at
-  /// kFineExposure x kFineExposure (update_exposure()): its values are its open part's (the
-  /// irradiance over its exposure), which a quarter's resolution would make up to twice too
-  /// bright or too dark.
-  float sample_exposure(const PatchHierarchy& h, std::uint32_t e, bool back, const std::vector<std::uint8_t>& back_surface,
-                        int cells) const {
-    const glm::vec3 n = back ? -h.normal(e) : h.normal(e);
-    const std::array<glm::vec3, 4> directions = burial_directions(n);
-    auto sealed = [&](const RayScene::Hit& hit, const glm::vec3& d) {
-      return glm::dot(d, hit.geometric_normal) > 0.0f && !back_surface[hit.id];
-    };
-    int exposed = 0;
-    for (int i = 0; i < cells; ++i)
-      for (int k = 0; k < cells; ++k) {
-        const glm::vec2 uv((static_cast<float>(i) + 0.5f) / static_cast<float>(cells),
-                           (static_cast<float>(k) + 0.5f) / static_cast<float>(cells));
-        exposed += buried(occluders, h.sample_point(e, uv) + ray_epsilon * n, directions, sealed) ? 0 : 1;
-      }
-    return static_cast<float>(exposed) / static_cast<float>(cells * cells);
-  }
-  static constexpr int kFineExposure = 8;
-
   /// exposure, open_index and open_moments for the elements as they stand: new leaves sampled, inner
   /// elements and clusters aggregated. After refinement, which may split elements.
   void update_exposure(const PatchHierarchy& h) {
@@ -1187,34 +1160,15 @@ struct LinkHierarchy::Impl {
     std::vector<std::uint8_t> back_surface(scene.polygons().size(), 0);
     for (std::size_t p = 0; p < patches.size(); ++p)
       if (has_back[p]) back_surface[patches[p].polygon] = 1;
+    // New leaves measured (solver/exposure.hpp). Rays and hemicubes find buried points by
+    // themselves (docs/FORM_FACTORS.md, "Touching ... geometry"), as do the links' shadow rays
+    // from a receiver's points; light pushed down from a receiving cluster or a larger element
+    // does not, and the exposure is what the push gives each part. A leaf's own values are its
+    // open part's (unknown_exposure()).
     std::vector<std::uint32_t> todo;
     for (std::uint32_t e = 0; e < count; ++e)
       if (h.element(e).is_leaf() && exposure[2 * std::size_t{e}] < 0.0f) todo.push_back(e);
-    parallel_for(threads, todo.size(), 256, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t e = todo[i];
-        exposure[2 * std::size_t{e}] = sample_exposure(h, e, false, back_surface, 2);
-        exposure[2 * std::size_t{e} + 1] = has_back[h.element(e).patch] ? sample_exposure(h, e, true, back_surface, 2) : 1.0f;
-      }
-    });
-    // Finer where it matters: the new leaves of a polygon where some leaf was found buried,
-    // partly or wholly (a block's edge may cross a leaf between its four points).
-    std::vector<std::uint8_t> touched(scene.polygons().size(), 0);
-    for (const std::uint32_t e : todo)
-      if (exposure[2 * std::size_t{e}] < 1.0f || exposure[2 * std::size_t{e} + 1] < 1.0f)
-        touched[patches[h.element(e).patch].polygon] = 1;
-    std::vector<std::uint32_t> fine;
-    for (const std::uint32_t e : todo)
-      if (touched[patches[h.element(e).patch].polygon]) fine.push_back(e);
-    parallel_for(threads, fine.size(), 16, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t e = fine[i];
-        for (std::size_t side = 0; side < (has_back[h.element(e).patch] ? 2u : 1u); ++side) {
-          float& x = exposure[2 * std::size_t{e} + side];
-          x = sample_exposure(h, e, side == 1, back_surface, kFineExposure);
-        }
-      }
-    });
+    measure_exposure(h, occluders, ray_epsilon, back_surface, has_back, todo, threads, exposure);
     for (std::uint32_t e = static_cast<std::uint32_t>(count); e-- > 0;) {  // children before parents
       const Element& el = h.element(e);
       if (el.is_leaf()) continue;

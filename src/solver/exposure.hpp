@@ -1,0 +1,40 @@
+// Exposure: the share of each leaf element side that is not buried, i.e. not inside a solid
+// standing on it (the floor under a block resting on it, the part of a prop sunk into the floor;
+// geometry/burial.hpp). The solvers take a partly buried element's values as its open part's and
+// weight its targets by open area (RadiositySystem::Weights, docs/ARCHITECTURE.md, "Contact and
+// light leaks"). The Monte Carlo rows measure it with their own rays (SparseFactors::exposed);
+// this measures it by points for the solvers that have no rows: hierarchical and progressive.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry/ray_scene.hpp"
+#include "radiosity/mesh.hpp"
+#include "radiosity/scene.hpp"
+#include "solver/system.hpp"
+
+namespace radiosity::detail {
+
+/// Measures exposure[2 e] (front) and exposure[2 e + 1] (back) of the leaves `leaves` of `h`:
+/// the share of 2 x 2 cell centres that the burial test finds open, then of 8 x 8 for every
+/// leaf of a polygon where one was found buried, partly or wholly (a block's edge may cross a
+/// leaf between its four points; the values of a partly buried leaf are divided by its
+/// exposure, which a quarter's resolution would make up to twice too bright or too dark).
+/// `occluders`: the scene's polygons (ids are polygon ids); `back_surface[polygon]`: its back
+/// is a surface (two-sided or translucent), so a ray that meets it is not sealed;
+/// `has_back[patch]`: the patch has a back side of its own (else its back exposure is 1);
+/// `epsilon`: how far the points are lifted off their surface. `exposure` must hold 2 values
+/// per element; others are not touched. Cost: one ray per open point, four per buried one.
+/// Deterministic; runs on `threads` threads.
+void measure_exposure(const PatchHierarchy& h, const RayScene& occluders, float epsilon,
+                      const std::vector<std::uint8_t>& back_surface, const std::vector<std::uint8_t>& has_back,
+                      const std::vector<std::uint32_t>& leaves, unsigned threads, std::vector<float>& exposure);
+
+/// Per unknown of `system` (meshed as `h` from `scene`): effective_exposure() of its side, by
+/// measure_exposure() over every leaf (backs where the system has them); empty when every side
+/// is open. Builds a BVH of the scene's polygons for it.
+std::vector<float> unknown_exposure(const Scene& scene, const PatchHierarchy& h, const RadiositySystem& system,
+                                    unsigned threads);
+
+}  // namespace radiosity::detail
