@@ -5,7 +5,9 @@
 // against the reference path tracer, which treats backs the same way.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,32 +21,143 @@ namespace rad = radiosity;
 
 namespace {
 
-/// A 2 x 2 x 2 room (inward walls, rho 0.6) with a ceiling lamp; on its floor a box
-/// [0.3, 0.9] x [0, 0.6] x [0.9, 1.5] resting on the floor with its bottom face, and a sphere of
-/// radius 0.35 centred 0.15 below the floor at (1.4, -0.15, 0.8) (its lower part is below the
-/// floor, outside the room).
-rad::Scene props_on_floor() {
-  rad::Material wall, lamp, prop;
+/// A 2 x 2 x 2 room (inward walls of reflectance `rho`) with a ceiling lamp; `prop` is set to
+/// the material (rho 0.7, 0.5, 0.3) for what stands in it.
+rad::Scene lit_room(float rho, rad::MaterialId& prop) {
+  rad::Material wall, lamp, props;
   wall.name = "wall";
-  wall.reflectance = rad::Rgb(0.6f);
+  wall.reflectance = rad::Rgb(rho);
   lamp.name = "lamp";
   lamp.emission = rad::Rgb(25.0f);
   lamp.reflectance = rad::Rgb(0.0f);
-  prop.name = "prop";
-  prop.reflectance = rad::Rgb(0.7f, 0.5f, 0.3f);
+  props.name = "prop";
+  props.reflectance = rad::Rgb(0.7f, 0.5f, 0.3f);
   const rad::Scene room = test::closed_box(wall, glm::vec3(2.0f));
   rad::Scene scene;
-  const rad::MaterialId w = scene.add_material(wall), l = scene.add_material(lamp), p = scene.add_material(prop);
+  const rad::MaterialId w = scene.add_material(wall), l = scene.add_material(lamp);
+  prop = scene.add_material(props);
   for (const rad::Polygon& poly : room.polygons()) scene.add_polygon(poly.vertices, w, room.groups()[poly.group]);
   rad::add_quad(scene, {0.7f, 1.99f, 0.7f}, {0.6f, 0, 0}, {0, 0, 0.6f}, l, "lamp");  // facing down
+  return scene;
+}
+
+/// lit_room(0.6) with a box [0.3, 0.9] x [0, 0.6] x [0.9, 1.5] resting on the floor with its
+/// bottom face, and a sphere of radius 0.35 centred 0.15 below the floor at (1.4, -0.15, 0.8)
+/// (its lower part is below the floor, outside the room).
+rad::Scene props_on_floor() {
+  rad::MaterialId p = 0;
+  rad::Scene scene = lit_room(0.6f, p);
   rad::add_box(scene, {0.3f, 0.0f, 0.9f}, {0.9f, 0.6f, 1.5f}, p, "box");
   rad::add_sphere(scene, {1.4f, -0.15f, 0.8f}, 0.35f, p, "ball", 24);
+  return scene;
+}
+
+/// lit_room(0.8) with a box [side, side + 0.6] x [0, 0.6] x [0.85, 1.45] resting on the floor
+/// with its bottom face (or without it): its -x side at x = `side` cuts floor elements as a
+/// user's box placed anywhere does.
+rad::Scene box_across_elements(float side, bool with_box = true) {
+  rad::MaterialId p = 0;
+  rad::Scene scene = lit_room(0.8f, p);
+  if (with_box) rad::add_box(scene, {side, 0.0f, 0.85f}, {side + 0.6f, 0.6f, 1.45f}, p, "box");
   return scene;
 }
 
 }  // namespace
 
 TEST_SUITE("solver") {
+  TEST_CASE("a box whose sides cut the floor's elements: no light lost under it, and the floor beside it as the path "
+            "tracer sees it" * test::release_only) {
+    // A floor element half under the box gathers, by every estimator, nothing on its buried
+    // half: its mean is half its open half's light. Before the exposure (session 21) the
+    // solvers took that mean for the element's radiosity, showed a dark band around the box
+    // (the user's room: -55 % beside it) and sent the element's light from its buried half as
+    // well, which a closed room lost (escaped, measured below). Now its values are its open
+    // half's and its targets weigh it by its open area (docs/ARCHITECTURE.md, "Contact and
+    // light leaks").
+    // The mesher grids the 2 m floor into 22 x 22 elements at 10 cm (2 / 22 m each): the box's
+    // side at 3.5 of them cuts a column of elements in half.
+    const float side = 3.5f * 2.0f / 22.0f;
+    const rad::Scene scene = box_across_elements(side);
+    const double pi = 3.14159265358979323846;
+    rad::SolveOptions o;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    o.mesh.max_patch_area = 0.04f;
+    o.mesh.max_element_area = 0.01f;
+    o.tolerance = 1e-4;
+    struct Case {
+      const char* name;
+      rad::SolverMethod method;
+    };
+    std::optional<double> strip_path;
+    for (const Case& c : {Case{"gauss-seidel", rad::SolverMethod::gauss_seidel},
+                          Case{"progressive", rad::SolverMethod::progressive},
+                          Case{"hierarchical", rad::SolverMethod::hierarchical}}) {
+      CAPTURE(std::string(c.name));
+      o.method = c.method;
+      const rad::Solution sol = rad::solve(scene, o);
+      REQUIRE(sol.status() == rad::SolveStatus::converged);
+      // A closed room: what escapes (what the lamp's back takes from the ceiling 1 cm above it,
+      // which the balance does not count as absorbed: 0.4-0.5 %) is the same with the box.
+      auto escaped = [](const rad::Solution& s) { return s.report().escaped_power.x / s.report().emitted_power.x; };
+      const double lost = escaped(sol) - escaped(rad::solve(box_across_elements(side, false), o));
+      // The floor elements that the box's side cuts, along its middle (z in [1, 1.3]), each with
+      // the share of it outside the box.
+      const rad::PatchHierarchy& h = sol.hierarchy();
+      double cut = 0.0, area = 0.0, low = 1.0, high = 0.0, near = 1e9, far = -1e9;
+      int count = 0;
+      for (std::uint32_t leaf : h.leaves()) {
+        const rad::Element& e = h.element(leaf);
+        if (scene.polygons()[h.patches()[e.patch].polygon].group != *scene.find_group("y0")) continue;
+        if (e.centroid.z < 1.0f || e.centroid.z > 1.3f) continue;
+        float x0 = 1e9f, x1 = -1e9f, z0 = 1e9f, z1 = -1e9f;
+        for (int k = 0; k < e.corner_count(); ++k) {
+          const glm::vec3 v = h.vertices()[e.corners[static_cast<std::size_t>(k)]];
+          x0 = std::min(x0, v.x), x1 = std::max(x1, v.x), z0 = std::min(z0, v.z), z1 = std::max(z1, v.z);
+        }
+        if (!(x0 < side - 0.01f && x1 > side + 0.01f)) continue;
+        const float x = sol.exposure().empty() ? 1.0f : sol.exposure()[leaf];
+        CHECK(x == doctest::Approx((side - x0) / (x1 - x0)).epsilon(0.06));
+        cut += e.area * sol.radiosity()[leaf].x;
+        area += e.area;
+        low = std::min(low, double{x0}), near = std::min(near, double{z0}), far = std::max(far, double{z1});
+        high = std::max(high, double{x1});
+        ++count;
+      }
+      REQUIRE(count >= 2);
+      cut /= area;
+      if (!strip_path) {
+        // The path tracer on the open parts of those elements, from above.
+        rad::PathTraceOptions view;
+        const double width = side - low, length = far - near;
+        view.width = 4;
+        view.height = static_cast<int>(std::lround(4.0 * length / width));
+        view.spp = 1024;
+        view.camera = rad::Camera{{static_cast<float>(low + 0.5 * width), 1.0f, static_cast<float>(0.5 * (near + far))},
+                                  {static_cast<float>(low + 0.5 * width), 0.0f, static_cast<float>(0.5 * (near + far))},
+                                  {0, 0, 1},
+                                  static_cast<float>(2.0 * std::atan(0.5 * length) * 180.0 / pi)};
+        const rad::Image img = rad::render_path_traced(scene, view);
+        double sum = 0.0;
+        for (const rad::Rgb& px : img.pixels) sum += px.x;
+        strip_path = pi * sum / static_cast<double>(img.pixels.size());
+      }
+      MESSAGE(std::string(c.name) << ": lost to the box " << lost << ", the " << count << " cut elements' radiosity " << cut
+                     << " (path tracer on their open parts " << *strip_path << ")");
+      // Measured (session 21): Gauss-Seidel +1.8 % against the path tracer and -0.02 % of the
+      // power lost to the box, progressive +5.5 % and 0.00 %. Before, the box cost 0.4-0.5 % of
+      // the power (1.2 % escaped against 0.8 % without it) and the cut elements showed their
+      // area mean, about half. Hierarchical: +16.5 %, and the room gains 0.55 % with the box;
+      // its floor along a box's side is too bright with or without anything buried (with the
+      // box's side on an element border: +8 % against Gauss-Seidel one element away, before and
+      // after this; docs/HIERARCHICAL.md, "Buried parts"), so it is held to 20 % here.
+      const bool hierarchical = c.method == rad::SolverMethod::hierarchical;
+      CHECK(std::fabs(lost) < (hierarchical ? 0.008 : 0.003));
+      CHECK(cut > 0.9 * *strip_path);
+      CHECK(cut < (hierarchical ? 1.2 : 1.1) * *strip_path);
+    }
+  }
+
+
   TEST_CASE("a box resting on the floor and a sphere sunk into it are lit as the path tracer lights them"
             * test::release_only) {
     const rad::Scene scene = props_on_floor();
