@@ -15,23 +15,49 @@ namespace {
 constexpr int kCoarseCells = 2;
 constexpr int kFineCells = 8;
 
-/// The share of `cells` x `cells` cell centres of leaf side (e, back) that are not buried.
-float open_share(const PatchHierarchy& h, const RayScene& occluders, float epsilon,
-                 const std::vector<std::uint8_t>& back_surface, std::uint32_t e, bool back, int cells) {
-  const glm::vec3 n = back ? -h.normal(e) : h.normal(e);
-  const std::array<glm::vec3, 4> directions = burial_directions(n);
-  auto sealed = [&](const RayScene::Hit& hit, const glm::vec3& d) {
-    return glm::dot(d, hit.geometric_normal) > 0.0f && !back_surface[hit.id];
-  };
-  int open = 0;
-  for (int i = 0; i < cells; ++i)
-    for (int k = 0; k < cells; ++k) {
-      const glm::vec2 uv((static_cast<float>(i) + 0.5f) / static_cast<float>(cells),
-                         (static_cast<float>(k) + 0.5f) / static_cast<float>(cells));
-      open += buried(occluders, h.sample_point(e, uv) + epsilon * n, directions, sealed) ? 0 : 1;
-    }
-  return static_cast<float>(open) / static_cast<float>(cells * cells);
-}
+/// The burial test at points of leaf side (e, back), by their (u, v) in the leaf.
+class SidePoints {
+ public:
+  SidePoints(const PatchHierarchy& h, const RayScene& occluders, float epsilon,
+             const std::vector<std::uint8_t>& back_surface, std::uint32_t e, bool back)
+      : h_(h), occluders_(occluders), back_surface_(back_surface), e_(e),
+        lift_(epsilon * (back ? -h.normal(e) : h.normal(e))),
+        directions_(burial_directions(back ? -h.normal(e) : h.normal(e))) {}
+
+  bool open(glm::vec2 uv) const {
+    auto sealed = [&](const RayScene::Hit& hit, const glm::vec3& d) {
+      return glm::dot(d, hit.geometric_normal) > 0.0f && !back_surface_[hit.id];
+    };
+    return !buried(occluders_, h_.sample_point(e_, uv) + lift_, directions_, sealed);
+  }
+  /// The share of `cells` x `cells` cell centres that are open.
+  float share(int cells) const {
+    int count = 0;
+    for (int i = 0; i < cells; ++i)
+      for (int k = 0; k < cells; ++k)
+        count += open(glm::vec2((static_cast<float>(i) + 0.5f) / static_cast<float>(cells),
+                                (static_cast<float>(k) + 0.5f) / static_cast<float>(cells)))
+                     ? 1
+                     : 0;
+    return static_cast<float>(count) / static_cast<float>(cells * cells);
+  }
+  /// Whether the leaf's four corners (a hair inside it) are all `open`, or all buried.
+  bool corners_are(bool want_open) const {
+    constexpr float kIn = 0.01f;
+    for (const glm::vec2 uv : {glm::vec2(kIn, kIn), glm::vec2(1.0f - kIn, kIn), glm::vec2(kIn, 1.0f - kIn),
+                               glm::vec2(1.0f - kIn, 1.0f - kIn)})
+      if (open(uv) != want_open) return false;
+    return true;
+  }
+
+ private:
+  const PatchHierarchy& h_;
+  const RayScene& occluders_;
+  const std::vector<std::uint8_t>& back_surface_;
+  std::uint32_t e_;
+  glm::vec3 lift_;
+  std::array<glm::vec3, 4> directions_;
+};
 
 }  // namespace
 
@@ -41,17 +67,25 @@ void measure_exposure(const PatchHierarchy& h, const RayScene& occluders, float 
   RADIOSITY_ASSERT(exposure.size() >= 2 * h.elements().size());
   const std::vector<Patch>& patches = h.patches();
   auto sides = [&](std::uint32_t e) { return has_back[h.element(e).patch] ? 2u : 1u; };
-  auto measure = [&](const std::vector<std::uint32_t>& todo, int cells, std::size_t grain) {
+  // `fine`: the coarse share stands where the leaf's corners agree with it (all open, or all
+  // buried: a block's footprint is convex), else the fine one is taken.
+  auto measure = [&](const std::vector<std::uint32_t>& todo, bool fine, std::size_t grain) {
     parallel_for(threads, todo.size(), grain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t e = todo[i];
-        for (unsigned side = 0; side < sides(e); ++side)
-          exposure[2 * std::size_t{e} + side] = open_share(h, occluders, epsilon, back_surface, e, side == 1, cells);
+        for (unsigned side = 0; side < sides(e); ++side) {
+          const SidePoints points(h, occluders, epsilon, back_surface, e, side == 1);
+          float& x = exposure[2 * std::size_t{e} + side];
+          if (!fine)
+            x = points.share(kCoarseCells);
+          else if (!((x == 0.0f || x == 1.0f) && points.corners_are(x == 1.0f)))
+            x = points.share(kFineCells);
+        }
       }
     });
   };
   for (const std::uint32_t e : leaves) exposure[2 * std::size_t{e} + 1] = 1.0f;
-  measure(leaves, kCoarseCells, 256);
+  measure(leaves, false, 256);
   std::vector<std::uint8_t> touched(back_surface.size(), 0);
   for (const std::uint32_t e : leaves)
     if (exposure[2 * std::size_t{e}] < 1.0f || exposure[2 * std::size_t{e} + 1] < 1.0f)
@@ -59,7 +93,7 @@ void measure_exposure(const PatchHierarchy& h, const RayScene& occluders, float 
   std::vector<std::uint32_t> fine;
   for (const std::uint32_t e : leaves)
     if (touched[patches[h.element(e).patch].polygon]) fine.push_back(e);
-  measure(fine, kFineCells, 16);
+  measure(fine, true, 16);
 }
 
 std::vector<float> unknown_exposure(const Scene& scene, const PatchHierarchy& h, const RadiositySystem& system,

@@ -17,10 +17,11 @@
 namespace radiosity::detail {
 
 /// Measures exposure[2 e] (front) and exposure[2 e + 1] (back) of the leaves `leaves` of `h`:
-/// the share of 2 x 2 cell centres that the burial test finds open, then of 8 x 8 for every
-/// leaf of a polygon where one was found buried, partly or wholly (a block's edge may cross a
-/// leaf between its four points; the values of a partly buried leaf are divided by its
-/// exposure, which a quarter's resolution would make up to twice too bright or too dark).
+/// the share of 2 x 2 cell centres that the burial test finds open, then of 8 x 8 for the
+/// leaves of a polygon where one was found buried, partly or wholly: those found partly
+/// buried, and those whose four corners do not all agree with their centres (a block's edge
+/// may cross a leaf between its four centres; the values of a partly buried leaf are divided
+/// by its exposure, which a quarter's resolution would make up to twice too bright or too dark).
 /// `occluders`: the scene's polygons (ids are polygon ids); `back_surface[polygon]`: its back
 /// is a surface (two-sided or translucent), so a ray that meets it is not sealed;
 /// `has_back[patch]`: the patch has a back side of its own (else its back exposure is 1);
