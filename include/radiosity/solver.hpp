@@ -220,11 +220,13 @@ class RADIOSITY_API Solution {
   const std::vector<Rgb>& radiosity() const { return radiosity_; }
   /// Per element id, the share of its area that is not buried: not inside a solid standing on
   /// it, such as the floor under a block resting on it (docs/ARCHITECTURE.md, "Contact and
-  /// light leaks"); inner nodes the area-weighted mean of their children. Empty when the solve
-  /// did not measure it (it does for the matrix methods over FormFactorMethod::monte_carlo
-  /// rows): every element taken as open. Where an element is partly buried, its values
-  /// (radiosity, irradiance) are those of its open part, which is what shows (a floor element
-  /// half under a block is not shown at half its light), and it sends area x exposure x
+  /// light leaks"); inner nodes the area-weighted mean of their children. Empty when nothing is
+  /// buried or the solve did not measure it (every method does but those over
+  /// FormFactorMethod::analytic, which sees no occlusion): every element taken as open. Where an
+  /// element is partly buried, its values (radiosity, irradiance) are those of its open part,
+  /// which is what shows (a floor element half under a block is not shown at half its light;
+  /// over the hemicube, whose rows are their element's centre's, where the centre is open),
+  /// and it sends area x exposure x
   /// radiosity; group_radiosity() and mesh_triangle_values() weight by that, so that they
   /// stay power over area, a buried part counting as dark.
   const std::vector<float>& exposure() const { return exposure_; }

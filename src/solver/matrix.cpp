@@ -12,6 +12,7 @@
 #include "core/assert.hpp"
 #include "core/color.hpp"
 #include "core/parallel.hpp"
+#include "solver/exposure.hpp"
 #include "solver/system.hpp"
 
 namespace radiosity::detail {
@@ -116,6 +117,20 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
   }
   store.exposure.resize(store.rows.size(), 1.0f);
 
+  // Exposure by points where the rows do not measure it (solver/exposure.hpp): a ray-cast row
+  // is a mean over its element as a Monte Carlo row is, so it is divided as that one is; a
+  // hemicube row is its centre's, so the exposure only weighs it in its target's mean.
+  const FormFactorMethod method = ctx.options.form_factors.method;
+  const bool probe = !missing.empty() && method != FormFactorMethod::monte_carlo && method != FormFactorMethod::analytic;
+  const std::vector<float> probed =
+      probe ? unknown_exposure(ctx.scene, ctx.hierarchy, sys, ctx.options.threads) : std::vector<float>{};
+  auto keep_exposure = [&](std::size_t u, float reported, FactorVector& r) {
+    const float x = probed.empty() ? (probe ? 1.0f : effective_exposure(reported)) : probed[u];
+    if (x > 0.0f && x < 1.0f && method != FormFactorMethod::hemicube)
+      for (float& v : r.value) v /= x;
+    return x;
+  };
+
   // Form factors, in chunks so that progress is reported and cancel is honoured: about 15 ms
   // each (BlockSizer; a row does not depend on its chunk), from 8 to 16384 rows.
   auto t0 = std::chrono::steady_clock::now();
@@ -141,10 +156,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         r.index.shrink_to_fit();
         r.value.shrink_to_fit();
         // The open part's factors (RadiositySystem::Weights).
-        const float x = effective_exposure(from.exposed);
-        if (x > 0.0f && x < 1.0f)
-          for (float& v : r.value) v /= x;
-        store.exposure[slots[k]] = x;
+        store.exposure[slots[k]] = keep_exposure(missing[k], from.exposed, r);
         slot_of(missing[k]) = slots[k];
       }
     } else {
@@ -154,7 +166,7 @@ SolverResult solve_matrix(const SolverContext& ctx, bool gauss_seidel, MatrixSto
         FactorVector& r = store.rows[slots[k]];
         r.index.clear();
         r.value.assign(buffer.data() + (k - begin) * n, buffer.data() + (k - begin + 1) * n);
-        store.exposure[slots[k]] = 1.0f;
+        store.exposure[slots[k]] = keep_exposure(missing[k], 1.0f, r);
         slot_of(missing[k]) = slots[k];
       }
     }

@@ -32,12 +32,15 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
   const RadiositySystem& sys = ctx.system;
   const std::size_t m = sys.unknowns(), n = sys.patches();
   SolverResult result;
-  // Monte Carlo columns are means over each receiving side's whole area, its buried part
-  // receiving nothing (under a block standing on it): measured by points, so that a side's
-  // values are its open part's and a patch sends its open part's mean (RadiositySystem::
-  // Weights). The other estimators keep to their own (the hemicube's is its centre's).
-  if (ctx.options.form_factors.method == FormFactorMethod::monte_carlo)
+  // Monte Carlo and ray-cast columns are means over each receiving side's whole area, its
+  // buried part receiving nothing (under a block standing on it): measured by points, so that
+  // a side's values are its open part's (the columns divided by it) and a patch sends its open
+  // part's mean (RadiositySystem::Weights). A hemicube column is the receiver's centre's: only
+  // weighted. The analytic estimator sees no occlusion.
+  const FormFactorMethod method = ctx.options.form_factors.method;
+  if (method != FormFactorMethod::analytic)
     result.exposure = unknown_exposure(ctx.scene, ctx.hierarchy, sys, ctx.options.threads);
+  const bool divide = method != FormFactorMethod::hemicube;
   const RadiositySystem::Weights weights = sys.weights(result.exposure);
   const std::vector<Rgb> source = sys.exposed_source(result.exposure);
   result.B = source;
@@ -187,7 +190,7 @@ SolverResult solve_progressive(const SolverContext& ctx, ColumnStore& store) {
       result.seconds_form_factors += seconds_since(tf);
     }
 
-    auto exposed = [&](std::uint32_t u) { return !result.exposure.empty() && result.exposure[u] > 0.0f; };
+    auto exposed = [&](std::uint32_t u) { return divide && !result.exposure.empty() && result.exposure[u] > 0.0f; };
     const Rgb shot = unshot[shooter];
     unshot[shooter] = Rgb(0.0f);
     power[shooter] = 0.0;

@@ -35,11 +35,12 @@ using detail::seconds_since;
 /// columns, from `columns` when it holds them for these leaves, else from the estimator.
 /// Split among processes (Jacobi), each has the rows of its block of unknowns
 /// (solve_matrix()): each computes its block, and the blocks are gathered. `exposure` as
-/// SolverResult::exposure: the open parts' irradiance.
+/// SolverResult::exposure: the open parts' irradiance (the columns divided by it when
+/// `divide_columns`, as solve_progressive() divides them).
 std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const FormFactorEstimator& estimator,
                                    bool progressive, const detail::MatrixStore& store,
                                    const detail::ColumnStore& columns, const detail::Communicator* split,
-                                   const std::vector<float>& exposure) {
+                                   const std::vector<float>& exposure, bool divide_columns) {
   std::vector<Rgb> patch_E;
   sys.patch_means(sys.emission, patch_E, sys.weights(exposure));
   std::vector<Rgb> out(sys.fronts(), Rgb(0.0f));
@@ -61,10 +62,14 @@ std::vector<Rgb> direct_irradiance(const detail::RadiositySystem& sys, const For
   }
   const bool kept = columns.leaf_count == sys.fronts() && columns.columns.size() == sys.patches();
   std::vector<std::uint32_t> missing;
+  // Columns are means over each receiver, as the progressive solve divides them (but the
+  // hemicube's, its centre's).
   auto add = [&](std::uint32_t target, const detail::FactorVector& column) {
     column.for_each([&](std::size_t k, float f) {
       const std::uint32_t u = sys.column_unknown(k);
-      if (u < sys.fronts()) out[u] += f * patch_E[target];
+      if (u >= sys.fronts()) return;
+      const bool open = divide_columns && !exposure.empty() && exposure[u] > 0.0f;
+      out[u] += (open ? f / exposure[u] : f) * patch_E[target];
     });
   };
   for (std::uint32_t t = 0; t < sys.patches(); ++t) {
@@ -837,7 +842,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       if (!system->light.empty())
         for (std::size_t u = 0; u < system->fronts(); ++u) direct[u] += system->exposed_light(u, final_exposure);
     } else {
-      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes, final_exposure);
+      direct = direct_irradiance(*system, *estimator, progressive, store, columns, processes, final_exposure,
+                                 o.form_factors.method != FormFactorMethod::hemicube);
     }
     H_direct.assign(hierarchy.elements().size(), Rgb(0.0f));
     for (std::size_t u = 0; u < system->fronts(); ++u) H_direct[system->leaves[u]] = direct[u];
