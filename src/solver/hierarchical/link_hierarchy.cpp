@@ -463,7 +463,7 @@ struct LinkHierarchy::Impl {
     leaf_values(hierarchy, v, true);
   }
   /// The rest of node_values() from the leaves' values already in v.front and v.back. With
-  /// `open`, the leaves' values are their open parts' (unknown_exposure()) and each inner
+  /// `open`, the leaves' values are their open parts' (side_exposures()) and each inner
   /// element takes its children's mean weighted by their open area: the links' factors see a
   /// source's buried part as hidden, so a source sends its open part's radiosity. Without, area
   /// means (the balancing's unit values).
@@ -1164,7 +1164,7 @@ struct LinkHierarchy::Impl {
     // themselves (docs/FORM_FACTORS.md, "Touching ... geometry"), as do the links' shadow rays
     // from a receiver's points; light pushed down from a receiving cluster or a larger element
     // does not, and the exposure is what the push gives each part. A leaf's own values are its
-    // open part's (unknown_exposure()).
+    // open part's (side_exposures()).
     std::vector<std::uint32_t> todo;
     for (std::uint32_t e = 0; e < count; ++e)
       if (h.element(e).is_leaf() && exposure[2 * std::size_t{e}] < 0.0f) todo.push_back(e);
@@ -1214,7 +1214,7 @@ struct LinkHierarchy::Impl {
   /// (effective_exposure(): a sliver is left as it is, a wholly buried side at 0).
   float leaf_exposure(std::uint32_t e, bool back) const { return effective_exposure(element_exposure(e, back)); }
   /// Per unknown, leaf_exposure() of its side; empty when every side is open.
-  std::vector<float> unknown_exposure(const RadiositySystem& sys) const {
+  std::vector<float> side_exposures(const RadiositySystem& sys) const {
     if (!any_buried) return {};
     std::vector<float> x(sys.unknowns());
     for (std::size_t u = 0; u < x.size(); ++u) x[u] = leaf_exposure(sys.element(u), u >= sys.fronts());
@@ -1900,7 +1900,7 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
   const std::size_t n = sys.unknowns();
   SolverResult result;
   // Leaves partly buried: their values are their open parts' (SolverResult::exposure).
-  result.exposure = m.unknown_exposure(sys);
+  result.exposure = m.side_exposures(sys);
   const std::vector<Rgb> source = sys.exposed_source(result.exposure);
   const std::vector<Rgb>& start = B0.empty() ? source : B0;
   result.B = start;
@@ -1964,7 +1964,7 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
   impl_->node_values(hierarchy, system, impl_->sent(system, B, scaled), values);
   impl_->gather(hierarchy, system, values, H, hold);
   if (hold) Impl::cap_delivered_power(system, B, H);
-  Impl::to_open(H, impl_->unknown_exposure(system));
+  Impl::to_open(H, impl_->side_exposures(system));
   return H;
 }
 
