@@ -506,8 +506,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   // Side u's values, per element id.
   auto B_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? B_elements : B_back)[system->element(u)]; };
   auto H_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? H_elements : H_back)[system->element(u)]; };
-  // Per unknown, the share of it that is not buried, where the solver has it (the matrix
-  // methods over Monte Carlo rows: RadiositySystem::Weights); B and H are the open parts'.
+  // Per unknown, the share of it that is not buried, where the solver has it (every method but
+  // over analytic rows: RadiositySystem::Weights); B and H are the open parts'.
   auto keep = [&](const detail::SolverResult& res) {
     resize();
     side_exposure.clear();

@@ -68,8 +68,9 @@ struct RadiositySystem {
   void patch_means(const std::vector<Rgb>& B, std::vector<Rgb>& patch_B) const;
 
   /// Exposure: per unknown, the share of its area that is not buried (inside a solid standing
-  /// on it: geometry/burial.hpp), from the Monte Carlo rows (SparseFactors::exposed); empty
-  /// when the solver does not have it (every side taken as exposed). The rows' factors are
+  /// on it: geometry/burial.hpp), from the Monte Carlo rows (SparseFactors::exposed) or by
+  /// points (solver/exposure.hpp); empty when the solver does not have it (every side taken as
+  /// exposed). The rows' factors are
   /// means over the whole element, so a floor element half under a block gathers half of what
   /// its open half receives; divided by the exposure they are the open part's (solve_matrix()).
   /// And a target's radiosity, as the rays that reach its open part see it, is the mean of its
