@@ -645,7 +645,6 @@ class MonteCarloEstimator final : public FormFactorEstimator {
     std::uint32_t probed = 0;  // sealed first hits tested, all found buried so far
     bool assume_buried = false;
     auto count_buried = [&](std::uint32_t r) {
-      if (!buried_rays) return false;
       if (!assume_buried) {
         if (!buried(rays.scene, scratch.origin[r], burial, sealed)) {
           probed = kBurialProbes + 1;  // an open point among them: keep testing
@@ -660,7 +659,7 @@ class MonteCarloEstimator final : public FormFactorEstimator {
       if (!scratch.found[r]) continue;  // escaped (an open scene)
       glm::vec3 x = scratch.origin[r], w = scratch.dir[r];
       std::optional<RayScene::Hit> h = scratch.hits[r];
-      if (sealed(*h, w) && count_buried(r)) continue;
+      if (buried_rays && sealed(*h, w) && count_buried(r)) continue;
       // The common case, fast: one-sided surfaces absorb at their back, and a hit on the
       // source's own plane is rounding. (Per-triangle arrays and Embree's normal, because the
       // hierarchy's structs would be cache misses.)

@@ -14,6 +14,7 @@
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
 #include "form_factors/pass1_material.hpp"
+#include "solver/exposure.hpp"
 #include "solver/hierarchical/link_hierarchy.hpp"
 #include "solver/light_groups.hpp"
 #include "solver/light_shot.hpp"
@@ -811,26 +812,12 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     }
   }
   auto aggregate = [&](std::vector<Rgb>& values) {
-    if (element_exposure.empty()) {
+    if (element_exposure.empty())
       hierarchy.aggregate(values);
-      return;
-    }
-    for (std::size_t e = values.size(); e-- > 0;) {
-      const Element& el = hierarchy.element(static_cast<std::uint32_t>(e));
-      if (el.is_leaf()) continue;
-      glm::dvec3 sum(0.0), open_sum(0.0);
-      double area = 0.0, open = 0.0;
-      for (std::uint32_t k = 0; k < 4; ++k) {
-        const std::uint32_t c = el.first_child + k;
-        const double a = hierarchy.element(c).area, w = a * static_cast<double>(element_exposure[c]);
-        sum += a * glm::dvec3(values[c]);
-        open_sum += w * glm::dvec3(values[c]);
-        area += a;
-        open += w;
-      }
-      values[e] = open > 0.0 ? Rgb(open_sum / open) : area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
-    }
+    else
+      detail::aggregate_open(hierarchy, values, [&](std::uint32_t e) { return element_exposure[e]; });
   };
+
   // What arrived straight from the emitters; not for a cancelled solve, which may lack rows.
   std::vector<Rgb> H_direct;
   if (status != SolveStatus::cancelled) {

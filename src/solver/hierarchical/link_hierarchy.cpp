@@ -469,8 +469,8 @@ struct LinkHierarchy::Impl {
   /// means (the balancing's unit values).
   void leaf_values(const PatchHierarchy& hierarchy, Values& v, bool open = false) const {
     if (open && any_buried) {
-      aggregate_open(hierarchy, v.front, false);
-      if (!v.back.empty()) aggregate_open(hierarchy, v.back, true);
+      aggregate_open(hierarchy, v.front, [&](std::uint32_t e) { return leaf_exposure(e, false); });
+      if (!v.back.empty()) aggregate_open(hierarchy, v.back, [&](std::uint32_t e) { return leaf_exposure(e, true); });
     } else {
       hierarchy.aggregate(v.front);
       if (!v.back.empty()) hierarchy.aggregate(v.back);
@@ -1226,30 +1226,6 @@ struct LinkHierarchy::Impl {
     for (std::size_t u = 0; u < x.size(); ++u)
       if (x[u] > 0.0f && x[u] < 1.0f) H[u] /= x[u];
   }
-  /// hierarchy.aggregate() weighted by open area (leaf_values()).
-  void aggregate_open(const PatchHierarchy& h, std::vector<Rgb>& values, bool back) const {
-    std::vector<double> weight(values.size(), 0.0);
-    for (std::size_t e = values.size(); e-- > 0;) {  // children before parents
-      const Element& el = h.element(static_cast<std::uint32_t>(e));
-      if (el.is_leaf()) {
-        weight[e] = static_cast<double>(el.area) * static_cast<double>(leaf_exposure(static_cast<std::uint32_t>(e), back));
-        continue;
-      }
-      glm::dvec3 sum(0.0), open_sum(0.0);
-      double area = 0.0, open = 0.0;
-      for (std::uint32_t k = 0; k < 4; ++k) {
-        const std::uint32_t c = el.first_child + k;
-        const double a = h.element(c).area;
-        sum += a * glm::dvec3(values[c]);
-        open_sum += weight[c] * glm::dvec3(values[c]);
-        area += a;
-        open += weight[c];
-      }
-      weight[e] = open;
-      values[e] = open > 0.0 ? Rgb(open_sum / open) : area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
-    }
-  }
-
   /// What a node's irradiance is multiplied by as it is pushed to a part below it: the part's
   /// exposure over the node's (power kept: the node's is the parts' area-weighted mean).
   static float exposure_ratio(float part, float node) { return node > 0.0f ? part / node : 0.0f; }
