@@ -16,7 +16,7 @@
 //   SolveOptions::memory_budget_bytes (default: the library's 4 GiB). --city-only builds the city
 //   and prints its facets without solving. --sky-rays sets SolveOptions::sky_rays.
 //   --make-reference FILE solves the city with 16 times the rays of the configuration
-//   (form factors and sky; Gauss-Seidel to a tolerance of 1e-5) and writes its element radiosity;
+//   (form factors and sky; Gauss-Seidel to a tolerance of 1e-5) and writes its element radiosity (times exposure: power over area);
 //   --reference FILE then prints every solve's element RMS relative difference to it, and with
 //   --elements PREFIX writes PREFIX.monte-carlo.csv / PREFIX.hierarchical.csv, one line per element.
 // Prints the city (facets per group, buildings, time to build it), then per configuration the
@@ -88,20 +88,27 @@ std::vector<float> read_values(const std::string& path) {
   std::fclose(f);
   return v;
 }
-std::vector<float> mean_channel(const std::vector<rad::Rgb>& B) {
+/// What --make-reference writes and --reference compares per element: the mean channel of its
+/// power over its whole area, radiosity() x exposure(). Where a wall cuts a ground facet, a
+/// solve's radiosity() is its open part's, over an exposure it estimated itself (the Monte Carlo
+/// rows from their rays, the hierarchical solver by points): a sliver 1/8 open can differ by
+/// several times between two solves that agree on its power.
+std::vector<float> element_values(const rad::Solution& sol) {
+  const std::vector<rad::Rgb>& B = sol.radiosity();
+  const std::vector<float>& x = sol.exposure();
   std::vector<float> v(B.size());
-  for (std::size_t i = 0; i < B.size(); ++i) v[i] = (B[i].x + B[i].y + B[i].z) / 3.0f;
+  for (std::size_t i = 0; i < B.size(); ++i) v[i] = (B[i].x + B[i].y + B[i].z) / 3.0f * (x.empty() ? 1.0f : x[i]);
   return v;
 }
 
-/// --elements: one line per element (group, centroid, normal, mean-channel radiosity, the
+/// --elements: one line per element (group, centroid, normal, element_values(), the
 /// reference's), for finding where a solve's differences lie (docs/HIERARCHICAL.md).
 bool write_elements(const std::string& path, const rad::Solution& sol, const std::vector<std::uint32_t>& group,
                     const std::vector<float>& ref) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) return false;
   std::fprintf(f, "group,x,y,z,nx,ny,nz,radiosity,reference\n");
-  const std::vector<float> B = mean_channel(sol.radiosity());
+  const std::vector<float> B = element_values(sol);
   for (std::size_t e = 0; e < B.size() && e < ref.size(); ++e) {
     const auto id = static_cast<std::uint32_t>(e);
     const glm::vec3 c = sol.hierarchy().element(id).centroid, n = sol.hierarchy().normal(id);
@@ -233,7 +240,7 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
                 100.0 * channel_sum(r.absorbed_power) / emitted, 100.0 * channel_sum(r.escaped_power) / emitted);
     for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
     if (!a.make_reference.empty()) {
-      if (!write_values(a.make_reference, mean_channel(sol.radiosity()))) {
+      if (!write_values(a.make_reference, element_values(sol))) {
         std::printf("  could not write %s\n", a.make_reference.c_str());
         return kFailed;
       }
@@ -247,7 +254,7 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
       std::vector<std::uint32_t> group(sol.radiosity().size(), 0);
       for (std::size_t e = 0; e < group.size(); ++e)
         group[e] = sol.hierarchy().patches()[sol.hierarchy().element(static_cast<std::uint32_t>(e)).patch].group;
-      compare(mean_channel(sol.radiosity()), ref, group, city.scene.groups());
+      compare(element_values(sol), ref, group, city.scene.groups());
       if (!a.elements.empty() && !write_elements(a.elements + (hierarchical ? ".hierarchical.csv" : ".monte-carlo.csv"),
                                                   sol, group, ref))
         std::printf("  could not write the elements to %s.*.csv\n", a.elements.c_str());
