@@ -156,6 +156,10 @@ struct LinkHierarchy::Impl {
   /// cluster's surface by area.
   std::vector<double> cumulative_area;
   std::vector<glm::vec3> cluster_centroid;  ///< per cluster: the area centroid of its patches
+  /// The linear push's shares in the last gather (gather_sides()): per cluster, of its parent's
+  /// irradiance; per element side (2 e + side), of its parent element's. The balancing's adjoint
+  /// (adjoint_delivery()) pushes back by them, so that it stays gather()'s transpose.
+  mutable std::vector<float> push_share_cluster, push_share;
   /// Per position of tree.order(): the power (mean channel of B A, both sides) of the patches
   /// before it, from the radiosity of the current refine() pass.
   std::vector<double> cumulative_power;
@@ -1519,6 +1523,8 @@ struct LinkHierarchy::Impl {
   /// link sums' transpose, the cluster moments' transpose, the pull's transpose). For a leaf,
   /// delivered / area is the fraction of the power it sends that arrives. One serial pass over
   /// the links: the same sums in the same order at any thread count.
+  /// The linear push's share of a child element side (2 e + side) in the last gather.
+  double share_of(std::size_t side) const { return side < push_share.size() ? push_share[side] : 1.0; }
   void adjoint_delivery(const PatchHierarchy& h, bool backs, const std::vector<float>& weight,
                         std::vector<double>& delivered) const {
     const std::uint32_t elements = linked_elements;
@@ -1533,8 +1539,8 @@ struct LinkHierarchy::Impl {
           w = static_cast<double>(el.area) * weight[2 * std::size_t{e} + side];
           continue;
         }
-        for (std::uint32_t k = 0; k < 4; ++k)  // the push's transpose, its exposure ratios too
-          w += W[2 * std::size_t{el.first_child + k} + side] *
+        for (std::uint32_t k = 0; k < 4; ++k)  // the push's transpose, its shares and exposure ratios too
+          w += W[2 * std::size_t{el.first_child + k} + side] * share_of(2 * std::size_t{el.first_child + k} + side) *
                exposure_ratio(element_exposure(el.first_child + k, side == 1), element_exposure(e, side == 1));
       }
     }
@@ -1545,7 +1551,12 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t i = C; i-- > 0;) {
       const ClusterNode& c = tree.node(i);
       if (!c.is_leaf()) {
-        for (const std::uint32_t child : c.children) push_exposed_transpose(Q[child], child, Q[i], i);
+        for (const std::uint32_t child : c.children) {
+          std::array<double, 6> shared = Q[child];
+          const double f = child < push_share_cluster.size() ? push_share_cluster[child] : 1.0f;
+          for (double& q : shared) q *= f;
+          push_exposed_transpose(shared, child, Q[i], i);
+        }
         continue;
       }
       const std::uint32_t p = tree.order()[c.first];
@@ -1669,6 +1680,56 @@ struct LinkHierarchy::Impl {
 
   // ---- Sweeps -------------------------------------------------------------------------------
 
+  /// The relative gradient (1/m) of a link's irradiance over its receiver, at the receiver's
+  /// centroid x (normal nr; zero for a cluster, whose members face many ways) from a source at y
+  /// (normal ns; zero for a cluster): the gradient of ln(cos_r cos_s / d^2), in the receiver's
+  /// plane for an element. At most 1 / `radius` long, so that the linear push (push_factor())
+  /// stays within [0, 2] over the receiver: near grazing (cos_s -> 0) the gradient is unbounded.
+  static glm::vec3 irradiance_slope(const glm::vec3& x, const glm::vec3& nr, const glm::vec3& y, const glm::vec3& ns,
+                                    float radius) {
+    const glm::vec3 u = x - y;
+    const float d2 = glm::dot(u, u);
+    if (!(d2 > 0.0f)) return glm::vec3(0.0f);
+    const float d = std::sqrt(d2);
+    glm::vec3 g = -2.0f * u / d2;  // 1 / d^2
+    if (ns != glm::vec3(0.0f)) {
+      const float cos_s = glm::dot(ns, u) / d;
+      if (cos_s > 1e-3f) g += ns / (d * cos_s) - u / d2;
+    }
+    if (nr != glm::vec3(0.0f)) {
+      g -= u / d2;  // cos_r, whose other term lies along nr
+      g -= nr * glm::dot(nr, g);
+    }
+    const float length = glm::length(g);
+    if (radius > 0.0f && length * radius > 1.0f) g *= 1.0f / (length * radius);
+    return g;
+  }
+  /// The share of a node's irradiance a child at `offset` from the node's centroid takes: 1 plus
+  /// the node's irradiance-weighted mean relative gradient along the offset (`slope` as
+  /// gather_sides() sums it), within [0, 2]. A node's children's area-weighted centroids are
+  /// its centroid, so the shares keep its power (clamping aside).
+  static float push_factor(const glm::vec4& slope, const glm::vec3& offset) {
+    if (!(slope.w > 0.0f)) return 1.0f;
+    return std::clamp(1.0f + glm::dot(glm::vec3(slope) / slope.w, offset), 0.0f, 2.0f);
+  }
+
+  /// Scales the `n` children's shares so that their area-weighted mean is 1: the linear push
+  /// then moves a node's irradiance among its children and keeps its power exactly (clamped
+  /// shares, and cluster members that take moments by their normals, would not), so the
+  /// balancing's adjoint, which pushes uniformly, still gives each source's delivered power.
+  static void keep_power(float* share, const float* area, int n) {
+    float weighted = 0.0f, total = 0.0f;
+    for (int k = 0; k < n; ++k) {
+      weighted += area[k] * share[k];
+      total += area[k];
+    }
+    if (!(weighted > 0.0f)) {
+      for (int k = 0; k < n; ++k) share[k] = 1.0f;
+      return;
+    }
+    for (int k = 0; k < n; ++k) share[k] *= total / weighted;
+  }
+
   /// Gather and push: the irradiance per unknown from the links with node values `v`.
   /// With `hold`, each unknown's irradiance is then held to the discrete maximum principle: at
   /// most, per channel, the largest radiosity among the sources of the links that reach it (its
@@ -1712,6 +1773,12 @@ struct LinkHierarchy::Impl {
     auto source_max = [&](NodeHandle s) -> const Rgb& {
       return is_cluster(s) ? v.cluster_max[handle_index(s)] : (is_back(s) ? v.back : v.front)[element_of(s)];
     };
+    // The linear push: per node, the sum over the links into it of each link's irradiance (mean
+    // channel) times its relative gradient (xyz), and the sum of those irradiances (w).
+    std::vector<glm::vec4> slope_cluster(C, glm::vec4(0.0f)), slope_front(elements, glm::vec4(0.0f)),
+        slope_back(backs ? elements : 0, glm::vec4(0.0f));
+    push_share_cluster.assign(C, 1.0f);
+    push_share.assign(2 * std::size_t{elements}, 1.0f);
     const std::uint64_t receivers = offsets.size() - 1;
     parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -1725,25 +1792,40 @@ struct LinkHierarchy::Impl {
         if (is_cluster(r)) {
           if (hold) bound_cluster[handle_index(r)] = bound;
           Moments& E = received[handle_index(r)];
+          glm::vec4& slope = slope_cluster[handle_index(r)];
+          const float radius_r = radius(hierarchy, r);
           for (std::uint64_t k = first; k < last; ++k) {
             const NodeHandle s = sources[k];
-            const glm::vec3 w = glm::normalize(cr - centroid(hierarchy, s));
-            add_irradiance(E, bases.of(handle_index(r)), -w, std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w));
+            const glm::vec3 cs = centroid(hierarchy, s);
+            const glm::vec3 w = glm::normalize(cr - cs);
+            const Rgb flux = std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w);
+            add_irradiance(E, bases.of(handle_index(r)), -w, flux);
+            const glm::vec3 ns = is_cluster(s) ? glm::vec3(0.0f) : side_normal(hierarchy, s);
+            slope += mean(flux) * glm::vec4(irradiance_slope(cr, glm::vec3(0.0f), cs, ns, radius_r), 1.0f);
           }
           continue;
         }
         const glm::vec3 nr = side_normal(hierarchy, r);
         Rgb sum(0.0f);
+        glm::vec4 slope(0.0f);
+        const float radius_r = radius(hierarchy, r);
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
+          const glm::vec3 cs = centroid(hierarchy, s);
+          Rgb brought;
+          glm::vec3 ns(0.0f);
           if (!is_cluster(s)) {
-            sum += std::abs(coefficients[k]) * (is_back(s) ? v.back : v.front)[element_of(s)];
-            continue;
+            brought = std::abs(coefficients[k]) * (is_back(s) ? v.back : v.front)[element_of(s)];
+            ns = side_normal(hierarchy, s);
+          } else {
+            const glm::vec3 w = glm::normalize(cr - cs);
+            brought = (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
           }
-          const glm::vec3 w = glm::normalize(cr - centroid(hierarchy, s));
-          sum += (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
+          sum += brought;
+          slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, cs, ns, radius_r), 1.0f);
         }
         (is_back(r) ? back : front)[element_of(r)] = sum;
+        (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
         if (hold) (is_back(r) ? bound_back : bound_front)[element_of(r)] = bound;
       }
     });
@@ -1752,8 +1834,22 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t c = 0; c < C; ++c) {
       const ClusterNode& node = tree.node(c);
       if (!node.is_leaf()) {
-        for (std::uint32_t child : node.children) {
-          push_exposed(received[c], c, received[child], child);
+        std::array<float, 2> share{}, area{};
+        for (std::size_t k = 0; k < 2; ++k) {
+          const std::uint32_t child = node.children[k];
+          share[k] = push_factor(slope_cluster[c], cluster_centroid[child] - cluster_centroid[c]);
+          const ClusterNode& cn = tree.node(child);
+          area[k] = static_cast<float>(cumulative_area[cn.first + cn.count] - cumulative_area[cn.first]);
+        }
+        keep_power(share.data(), area.data(), 2);
+        for (std::size_t k = 0; k < 2; ++k) {
+          const std::uint32_t child = node.children[k];
+          const float f = share[k];
+          push_share_cluster[child] = f;
+          Moments pushed{};
+          push_exposed(received[c], c, pushed, child);
+          for (std::size_t q = 0; q < pushed.size(); ++q) received[child][q] += f * pushed[q];
+          slope_cluster[child] += f * slope_cluster[c];
           if (hold) bound_cluster[child] = glm::max(bound_cluster[child], bound_cluster[c]);
         }
         continue;
@@ -1763,6 +1859,9 @@ struct LinkHierarchy::Impl {
       const SideDirection front_side = bases.front(p, patch.normal), back_side = bases.back(p, patch.normal);
       front[patch.root] += element_irradiance(received[c], bases.of(c), front_side) *
                            exposure_ratio(element_exposure(patch.root, false), cluster_exposure_toward(c, front_side));
+      // A one-patch cluster's centroid is its patch's: the root element takes the slope whole.
+      slope_front[patch.root] += slope_cluster[c];
+      if (!back.empty() && has_back[p]) slope_back[patch.root] += slope_cluster[c];
       if (hold) bound_front[patch.root] = glm::max(bound_front[patch.root], bound_cluster[c]);
       if (!back.empty() && has_back[p]) {
         back[patch.root] += element_irradiance(received[c], bases.of(c), back_side) *
@@ -1773,10 +1872,27 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t e = 0; e < elements; ++e) {
       const Element& el = hierarchy.element(e);
       if (el.is_leaf()) continue;
+      std::array<float, 4> share_front{}, share_back{}, area{};
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const Element& child = hierarchy.element(el.first_child + k);
+        area[k] = child.area;
+        share_front[k] = push_factor(slope_front[e], child.centroid - el.centroid);
+        share_back[k] = back.empty() ? 1.0f : push_factor(slope_back[e], child.centroid - el.centroid);
+      }
+      keep_power(share_front.data(), area.data(), 4);
+      keep_power(share_back.data(), area.data(), 4);
       for (std::uint32_t k = 0; k < 4; ++k) {
         const std::uint32_t child = el.first_child + k;
-        front[child] += front[e] * exposure_ratio(element_exposure(child, false), element_exposure(e, false));
-        if (!back.empty()) back[child] += back[e] * exposure_ratio(element_exposure(child, true), element_exposure(e, true));
+        const float ff = share_front[k];
+        push_share[2 * std::size_t{child}] = ff;
+        slope_front[child] += ff * slope_front[e];
+        front[child] += ff * front[e] * exposure_ratio(element_exposure(child, false), element_exposure(e, false));
+        if (!back.empty()) {
+          const float fb = share_back[k];
+          push_share[2 * std::size_t{child} + 1] = fb;
+          slope_back[child] += fb * slope_back[e];
+          back[child] += fb * back[e] * exposure_ratio(element_exposure(child, true), element_exposure(e, true));
+        }
         if (!hold) continue;
         bound_front[el.first_child + k] = glm::max(bound_front[el.first_child + k], bound_front[e]);
         if (!back.empty())
