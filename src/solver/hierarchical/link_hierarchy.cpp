@@ -156,10 +156,12 @@ struct LinkHierarchy::Impl {
   /// cluster's surface by area.
   std::vector<double> cumulative_area;
   std::vector<glm::vec3> cluster_centroid;  ///< per cluster: the area centroid of its patches
-  /// The linear push's shares in the last gather (gather_sides()): per cluster, of its parent's
-  /// irradiance; per element side (2 e + side), of its parent element's. The balancing's adjoint
+  /// The linear push's shares in the last gather (gather_sides()), kept only while the
+  /// balancing runs (keep_shares; update_scales()): per cluster, of its parent's irradiance;
+  /// per element side (2 e + side), of its parent element's. The balancing's adjoint
   /// (adjoint_delivery()) pushes back by them, so that it stays gather()'s transpose.
   mutable std::vector<float> push_share_cluster, push_share;
+  mutable bool keep_shares = false;
   /// Per position of tree.order(): the power (mean channel of B A, both sides) of the patches
   /// before it, from the radiosity of the current refine() pass.
   std::vector<double> cumulative_power;
@@ -1458,6 +1460,16 @@ struct LinkHierarchy::Impl {
     // The balancing's rounds each cost a gather and a pass over the links: not for a few
     // enclosed corners of an open scene (16 of the 22k city's sides).
     if (!(enclosed_area >= kBalanceMinShare * total_area)) return;
+    // The rounds' gathers keep their push shares for adjoint_delivery(); dropped at the end.
+    struct KeepShares {
+      const Impl& m;
+      explicit KeepShares(const Impl& impl) : m(impl) { m.keep_shares = true; }
+      ~KeepShares() {
+        m.keep_shares = false;
+        m.push_share_cluster = {};
+        m.push_share = {};
+      }
+    } keep(*this);
     // Polygon sides all of whose leaves are enclosed, and the sides that see only those.
     std::vector<std::uint8_t> closed_polygon = receives;
     for (std::uint32_t e = 0; e < elements; ++e) {
@@ -1774,11 +1786,15 @@ struct LinkHierarchy::Impl {
       return is_cluster(s) ? v.cluster_max[handle_index(s)] : (is_back(s) ? v.back : v.front)[element_of(s)];
     };
     // The linear push: per node, the sum over the links into it of each link's irradiance (mean
-    // channel) times its relative gradient (xyz), and the sum of those irradiances (w).
-    std::vector<glm::vec4> slope_cluster(C, glm::vec4(0.0f)), slope_front(elements, glm::vec4(0.0f)),
-        slope_back(backs ? elements : 0, glm::vec4(0.0f));
-    push_share_cluster.assign(C, 1.0f);
-    push_share.assign(2 * std::size_t{elements}, 1.0f);
+    // channel) times its relative gradient (xyz), and the sum of those irradiances (w). Only
+    // nodes with children use theirs: where no element has children (one element per patch, as
+    // the benchmark city) the elements keep none, 16 bytes an element less while the gather runs
+    // (the 1M city's peak memory is its first gather's).
+    const bool inner_elements = hierarchy.leaves().size() < elements;
+    std::vector<glm::vec4> slope_cluster(C, glm::vec4(0.0f)), slope_front(inner_elements ? elements : 0, glm::vec4(0.0f)),
+        slope_back(inner_elements && backs ? elements : 0, glm::vec4(0.0f));
+    push_share_cluster.assign(keep_shares ? C : 0, 1.0f);
+    push_share.assign(keep_shares ? 2 * std::size_t{elements} : 0, 1.0f);
     const std::uint64_t receivers = offsets.size() - 1;
     parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -1793,6 +1809,10 @@ struct LinkHierarchy::Impl {
           if (hold) bound_cluster[handle_index(r)] = bound;
           Moments& E = received[handle_index(r)];
           glm::vec4& slope = slope_cluster[handle_index(r)];
+          const ClusterNode& node = tree.node(handle_index(r));
+          // A one-patch cluster's slope goes to its patch's root element: used if that has children.
+          const bool has_children =
+              !node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf();
           const float radius_r = radius(hierarchy, r);
           for (std::uint64_t k = first; k < last; ++k) {
             const NodeHandle s = sources[k];
@@ -1800,6 +1820,7 @@ struct LinkHierarchy::Impl {
             const glm::vec3 w = glm::normalize(cr - cs);
             const Rgb flux = std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w);
             add_irradiance(E, bases.of(handle_index(r)), -w, flux);
+            if (!has_children) continue;
             const glm::vec3 ns = is_cluster(s) ? glm::vec3(0.0f) : side_normal(hierarchy, s);
             slope += mean(flux) * glm::vec4(irradiance_slope(cr, glm::vec3(0.0f), cs, ns, radius_r), 1.0f);
           }
@@ -1808,6 +1829,7 @@ struct LinkHierarchy::Impl {
         const glm::vec3 nr = side_normal(hierarchy, r);
         Rgb sum(0.0f);
         glm::vec4 slope(0.0f);
+        const bool has_children = !hierarchy.element(element_of(r)).is_leaf();
         const float radius_r = radius(hierarchy, r);
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
@@ -1822,10 +1844,10 @@ struct LinkHierarchy::Impl {
             brought = (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
           }
           sum += brought;
-          slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, cs, ns, radius_r), 1.0f);
+          if (has_children) slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, cs, ns, radius_r), 1.0f);
         }
         (is_back(r) ? back : front)[element_of(r)] = sum;
-        (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
+        if (has_children) (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
         if (hold) (is_back(r) ? bound_back : bound_front)[element_of(r)] = bound;
       }
     });
@@ -1845,7 +1867,7 @@ struct LinkHierarchy::Impl {
         for (std::size_t k = 0; k < 2; ++k) {
           const std::uint32_t child = node.children[k];
           const float f = share[k];
-          push_share_cluster[child] = f;
+          if (keep_shares) push_share_cluster[child] = f;
           Moments pushed{};
           push_exposed(received[c], c, pushed, child);
           for (std::size_t q = 0; q < pushed.size(); ++q) received[child][q] += f * pushed[q];
@@ -1860,8 +1882,10 @@ struct LinkHierarchy::Impl {
       front[patch.root] += element_irradiance(received[c], bases.of(c), front_side) *
                            exposure_ratio(element_exposure(patch.root, false), cluster_exposure_toward(c, front_side));
       // A one-patch cluster's centroid is its patch's: the root element takes the slope whole.
-      slope_front[patch.root] += slope_cluster[c];
-      if (!back.empty() && has_back[p]) slope_back[patch.root] += slope_cluster[c];
+      if (!hierarchy.element(patch.root).is_leaf()) {
+        slope_front[patch.root] += slope_cluster[c];
+        if (!back.empty() && has_back[p]) slope_back[patch.root] += slope_cluster[c];
+      }
       if (hold) bound_front[patch.root] = glm::max(bound_front[patch.root], bound_cluster[c]);
       if (!back.empty() && has_back[p]) {
         back[patch.root] += element_irradiance(received[c], bases.of(c), back_side) *
@@ -1884,12 +1908,12 @@ struct LinkHierarchy::Impl {
       for (std::uint32_t k = 0; k < 4; ++k) {
         const std::uint32_t child = el.first_child + k;
         const float ff = share_front[k];
-        push_share[2 * std::size_t{child}] = ff;
+        if (keep_shares) push_share[2 * std::size_t{child}] = ff;
         slope_front[child] += ff * slope_front[e];
         front[child] += ff * front[e] * exposure_ratio(element_exposure(child, false), element_exposure(e, false));
         if (!back.empty()) {
           const float fb = share_back[k];
-          push_share[2 * std::size_t{child} + 1] = fb;
+          if (keep_shares) push_share[2 * std::size_t{child} + 1] = fb;
           slope_back[child] += fb * slope_back[e];
           back[child] += fb * back[e] * exposure_ratio(element_exposure(child, true), element_exposure(e, true));
         }
