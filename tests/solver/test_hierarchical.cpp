@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -160,20 +161,26 @@ TEST_SUITE("solver") {
   TEST_CASE("hierarchical: parallel and perpendicular plates match Howell C-11 and C-14, closer as epsilon shrinks") {
     // 16 x 16 leaves per plate; each receiver leaf's irradiance against the exact mean over
     // it of the point-to-polygon closed form (whose integral over the plate is Howell's
-    // factor). Measured RMS over the leaves: 7.6 %, 6.2 %, 3.1 %, 2.2 % (parallel) and 12.6 %,
-    // 9.8 %, 5.1 %, 2.0 % (perpendicular) at epsilon 0.5, 0.1, 0.02, 0.004; plate means
-    // within 0.13 % at every epsilon.
+    // factor). Measured RMS over the leaves at epsilon 0.5, 0.1, 0.02, 0.004: 1.17, 0.67, 0.15,
+    // 0.085 % (parallel) and 1.66, 0.96, 0.35, 0.14 % (perpendicular), plate means within
+    // 0.5 %; with the push uniform within each node (before session 22's linear push) 7.6, 6.2,
+    // 3.1, 2.2 % and 12.6, 9.8, 5.1, 2.0 %. Held to about twice the measured figures.
+    const std::array<float, 4> epsilons = {0.5f, 0.1f, 0.02f, 0.004f};
+    const std::array<double, 4> rms_at_most = {0.035, 0.02, 0.007, 0.003};
     for (bool perpendicular : {false, true}) {
       CAPTURE(perpendicular);
       double previous = 1.0;
-      for (float eps : {0.5f, 0.1f, 0.02f, 0.004f}) {
+      for (std::size_t k = 0; k < epsilons.size(); ++k) {
+        const float eps = epsilons[k];
         CAPTURE(eps);
         const PlateError e = plate_error(perpendicular, eps);
+        MESSAGE("plates, perpendicular " << perpendicular << ", epsilon " << eps << ": leaf RMS " << e.rms << ", mean "
+                                         << e.mean << ", links " << e.links);
         CHECK(e.rms <= previous);
+        CHECK(e.rms < rms_at_most[k]);
         CHECK(std::abs(e.mean) < 0.005);
         previous = e.rms;
       }
-      CHECK(previous < 0.025);
     }
     // The plate means are Howell's factors (the exact leaf means above integrate to them).
     const double F[2] = {test::parallel_rectangles(1, 1, 1), test::perpendicular_rectangles(1, 1, 1)};
@@ -256,8 +263,8 @@ TEST_SUITE("solver") {
     // mean radiosity from its visible half too, an error of the reference of up to 40 % on the
     // leaves next to the blocks (measured). The group means averaged over four seeds (one seed's
     // scatter by about 1 %, which hid the bias); measured worst group and channel at 100 mm
-    // elements: 1.04 % at epsilon 0.05 (the short block, the ceiling 1.03 %), 0.97 % at 0.005 (the
-    // short block; session 22).
+    // elements: 0.91 % at epsilon 0.05 (the ceiling), 0.86 % at 0.005 (the short block; session
+    // 22, after the oracle near grazing and the linear push; before them 1.04 % and 0.97 %).
     // The goal is 0.5 %: not met yet (docs/HIERARCHICAL.md, "Where it stands").
     const rad::Scene scene = rad::cornell_box();
     const rad::Solution gs = gauss_seidel_reference(scene, 10000.0f);  // 100 mm
@@ -271,7 +278,7 @@ TEST_SUITE("solver") {
         CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
       }
       // The open front lets out about 31 % of the light in both.
-      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.015 : 0.01, 0.01);
+      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.012 : 0.01, 0.01);
     }
   }
 
