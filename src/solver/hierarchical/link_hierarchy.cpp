@@ -156,12 +156,6 @@ struct LinkHierarchy::Impl {
   /// cluster's surface by area.
   std::vector<double> cumulative_area;
   std::vector<glm::vec3> cluster_centroid;  ///< per cluster: the area centroid of its patches
-  /// The linear push's shares in the last gather (gather_sides()), kept only while the
-  /// balancing runs (keep_shares; update_scales()): per cluster, of its parent's irradiance;
-  /// per element side (2 e + side), of its parent element's. The balancing's adjoint
-  /// (adjoint_delivery()) pushes back by them, so that it stays gather()'s transpose.
-  mutable std::vector<float> push_share_cluster, push_share;
-  mutable bool keep_shares = false;
   /// Per position of tree.order(): the power (mean channel of B A, both sides) of the patches
   /// before it, from the radiosity of the current refine() pass.
   std::vector<double> cumulative_power;
@@ -214,6 +208,14 @@ struct LinkHierarchy::Impl {
   std::vector<std::array<float, 6>> open_moments;
 
   /// Node radiosity for the oracle and the sweeps.
+  /// The linear push's shares in one gather (gather_sides()): per cluster, of its parent's
+  /// irradiance; per element side (2 e + side), of its parent element's. 1 where not recorded.
+  struct PushShares {
+    std::vector<float> cluster, side;
+    double of_cluster(std::uint32_t c) const { return c < cluster.size() ? cluster[c] : 1.0; }
+    double of_side(std::size_t k) const { return k < side.size() ? side[k] : 1.0; }
+  };
+
   struct Values {
     std::vector<Rgb> front, back;   ///< per element id (inner nodes: area-weighted means)
     std::vector<Moments> sending;   ///< per cluster
@@ -1460,16 +1462,6 @@ struct LinkHierarchy::Impl {
     // The balancing's rounds each cost a gather and a pass over the links: not for a few
     // enclosed corners of an open scene (16 of the 22k city's sides).
     if (!(enclosed_area >= kBalanceMinShare * total_area)) return;
-    // The rounds' gathers keep their push shares for adjoint_delivery(); dropped at the end.
-    struct KeepShares {
-      const Impl& m;
-      explicit KeepShares(const Impl& impl) : m(impl) { m.keep_shares = true; }
-      ~KeepShares() {
-        m.keep_shares = false;
-        m.push_share_cluster = {};
-        m.push_share = {};
-      }
-    } keep(*this);
     // Polygon sides all of whose leaves are enclosed, and the sides that see only those.
     std::vector<std::uint8_t> closed_polygon = receives;
     for (std::uint32_t e = 0; e < elements; ++e) {
@@ -1497,27 +1489,30 @@ struct LinkHierarchy::Impl {
     std::vector<float> r_closed(rows ? sides : 0, 0.0f);
     Values v;
     std::vector<Rgb> front, back, unused_front, unused_back;
+    PushShares shares;
     for (int round = 0; round < rounds; ++round) {
+      // The gather from radiosity g on the enclosed sides: the rows, and the linear push's
+      // shares, which the adjoint pushes back by.
+      v.front.assign(elements, Rgb(0.0f));
+      v.back.assign(backs ? elements : 0, Rgb(0.0f));
+      for (std::size_t k = 0; k < sides; ++k)
+        if (enclosed[k]) (k % 2 == 0 ? v.front : v.back)[k / 2] = Rgb(g[k]);
+      leaf_values(h, v);
+      gather_sides(h, v, backs, false, front, back, unused_front, unused_back, &shares);
       if (rows) {
-        v.front.assign(elements, Rgb(0.0f));
-        v.back.assign(backs ? elements : 0, Rgb(0.0f));
-        for (std::size_t k = 0; k < sides; ++k)
-          if (enclosed[k]) (k % 2 == 0 ? v.front : v.back)[k / 2] = Rgb(g[k]);
-        leaf_values(h, v);
-        gather_sides(h, v, backs, false, front, back, unused_front, unused_back);
         for (std::size_t k = 0; k < sides; ++k) {
           if (!closed[k]) continue;
           const float gathered = (k % 2 == 0 ? front : back)[k / 2].x;
           if (gathered > 0.0f) r[k] = std::clamp(1.0f / gathered, 0.5f, kMaxBalance);
         }
       }
-      adjoint_delivery(h, backs, r, delivered);
+      adjoint_delivery(h, backs, r, shares, delivered);
       if (rows) {
         // A closed side's light lands on closed sides only: what the links take to other sides
         // (through the walls, to a two-sided room's outer faces, through receiving clusters
         // that hold both) is their error, and counting it as delivered would leave it lost.
         for (std::size_t k = 0; k < sides; ++k) r_closed[k] = closed[k] ? r[k] : 0.0f;
-        adjoint_delivery(h, backs, r_closed, delivered_closed);
+        adjoint_delivery(h, backs, r_closed, shares, delivered_closed);
       }
       for (std::size_t k = 0; k < sides; ++k) {
         if (!enclosed[k]) continue;
@@ -1531,14 +1526,13 @@ struct LinkHierarchy::Impl {
 
   /// Per element side (2 e + 1 for its back), the power the links deliver to every leaf side
   /// (each weighted by `weight`, per element side: receive_scale's part) per unit of that
-  /// side's value: the adjoint of leaf_values() and gather_sides() (the push's transpose, the
-  /// link sums' transpose, the cluster moments' transpose, the pull's transpose). For a leaf,
+  /// side's value: the adjoint of leaf_values() and gather_sides() (the push's transpose, by
+  /// the linear push's `shares` of the round's gather, which depend on the values gathered;
+  /// the link sums' transpose, the cluster moments' transpose, the pull's transpose). For a leaf,
   /// delivered / area is the fraction of the power it sends that arrives. One serial pass over
   /// the links: the same sums in the same order at any thread count.
-  /// The linear push's share of a child element side (2 e + side) in the last gather.
-  double share_of(std::size_t side) const { return side < push_share.size() ? push_share[side] : 1.0; }
   void adjoint_delivery(const PatchHierarchy& h, bool backs, const std::vector<float>& weight,
-                        std::vector<double>& delivered) const {
+                        const PushShares& shares, std::vector<double>& delivered) const {
     const std::uint32_t elements = linked_elements;
     const std::vector<Patch>& patches = h.patches();
     // W per element side: the weighted area of its leaves (what unit irradiance on it delivers).
@@ -1552,7 +1546,7 @@ struct LinkHierarchy::Impl {
           continue;
         }
         for (std::uint32_t k = 0; k < 4; ++k)  // the push's transpose, its shares and exposure ratios too
-          w += W[2 * std::size_t{el.first_child + k} + side] * share_of(2 * std::size_t{el.first_child + k} + side) *
+          w += W[2 * std::size_t{el.first_child + k} + side] * shares.of_side(2 * std::size_t{el.first_child + k} + side) *
                exposure_ratio(element_exposure(el.first_child + k, side == 1), element_exposure(e, side == 1));
       }
     }
@@ -1565,8 +1559,7 @@ struct LinkHierarchy::Impl {
       if (!c.is_leaf()) {
         for (const std::uint32_t child : c.children) {
           std::array<double, 6> shared = Q[child];
-          const double f = child < push_share_cluster.size() ? push_share_cluster[child] : 1.0f;
-          for (double& q : shared) q *= f;
+          for (double& q : shared) q *= shares.of_cluster(child);
           push_exposed_transpose(shared, child, Q[i], i);
         }
         continue;
@@ -1726,9 +1719,8 @@ struct LinkHierarchy::Impl {
   }
 
   /// Scales the `n` children's shares so that their area-weighted mean is 1: the linear push
-  /// then moves a node's irradiance among its children and keeps its power exactly (clamped
-  /// shares, and cluster members that take moments by their normals, would not), so the
-  /// balancing's adjoint, which pushes uniformly, still gives each source's delivered power.
+  /// then moves a node's irradiance among its children and keeps its power (clamped shares
+  /// would not).
   static void keep_power(float* share, const float* area, int n) {
     float weighted = 0.0f, total = 0.0f;
     for (int k = 0; k < n; ++k) {
@@ -1770,8 +1762,10 @@ struct LinkHierarchy::Impl {
   }
   /// gather()'s work: the irradiance per element side (`back` empty without `backs`), pushed
   /// down to every leaf, and with `hold` the maximum principle's bound per element side.
+  /// With `shares`, also the linear push's shares (the balancing's adjoint pushes back by them).
   void gather_sides(const PatchHierarchy& hierarchy, const Values& v, bool backs, bool hold, std::vector<Rgb>& front,
-                    std::vector<Rgb>& back, std::vector<Rgb>& bound_front, std::vector<Rgb>& bound_back) const {
+                    std::vector<Rgb>& back, std::vector<Rgb>& bound_front, std::vector<Rgb>& bound_back,
+                    PushShares* shares = nullptr) const {
     const std::uint32_t elements = linked_elements;
     RADIOSITY_ASSERT(hierarchy.elements().size() == elements);
     const std::uint32_t C = cluster_count();
@@ -1793,8 +1787,10 @@ struct LinkHierarchy::Impl {
     const bool inner_elements = hierarchy.leaves().size() < elements;
     std::vector<glm::vec4> slope_cluster(C, glm::vec4(0.0f)), slope_front(inner_elements ? elements : 0, glm::vec4(0.0f)),
         slope_back(inner_elements && backs ? elements : 0, glm::vec4(0.0f));
-    push_share_cluster.assign(keep_shares ? C : 0, 1.0f);
-    push_share.assign(keep_shares ? 2 * std::size_t{elements} : 0, 1.0f);
+    if (shares) {
+      shares->cluster.assign(C, 1.0f);
+      shares->side.assign(2 * std::size_t{elements}, 1.0f);
+    }
     const std::uint64_t receivers = offsets.size() - 1;
     parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
@@ -1867,7 +1863,7 @@ struct LinkHierarchy::Impl {
         for (std::size_t k = 0; k < 2; ++k) {
           const std::uint32_t child = node.children[k];
           const float f = share[k];
-          if (keep_shares) push_share_cluster[child] = f;
+          if (shares) shares->cluster[child] = f;
           Moments pushed{};
           push_exposed(received[c], c, pushed, child);
           for (std::size_t q = 0; q < pushed.size(); ++q) received[child][q] += f * pushed[q];
@@ -1908,12 +1904,12 @@ struct LinkHierarchy::Impl {
       for (std::uint32_t k = 0; k < 4; ++k) {
         const std::uint32_t child = el.first_child + k;
         const float ff = share_front[k];
-        if (keep_shares) push_share[2 * std::size_t{child}] = ff;
+        if (shares) shares->side[2 * std::size_t{child}] = ff;
         slope_front[child] += ff * slope_front[e];
         front[child] += ff * front[e] * exposure_ratio(element_exposure(child, false), element_exposure(e, false));
         if (!back.empty()) {
           const float fb = share_back[k];
-          if (keep_shares) push_share[2 * std::size_t{child} + 1] = fb;
+          if (shares) shares->side[2 * std::size_t{child} + 1] = fb;
           slope_back[child] += fb * slope_back[e];
           back[child] += fb * back[e] * exposure_ratio(element_exposure(child, true), element_exposure(e, true));
         }
