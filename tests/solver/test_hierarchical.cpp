@@ -509,13 +509,14 @@ TEST_SUITE("solver") {
 
   TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there") {
     // A room as an exporter writes it (outward winding, Kd 1 clamped to 0.99), made two-sided,
-    // a lamp panel 0.2 m under the ceiling: closed, so no light can leave. Without the balancing
-    // of closed regions the links lose some (measured: 6.7 % of the emitted power, 9.3 % of the
-    // green; Gauss-Seidel 0.2 %), which rho = 0.99 turns into a green channel 9 % low, and the
-    // solve says so. The open Cornell box (31 % leaves through its front) and Gauss-Seidel on
-    // the room do not warn. Balanced (the default), the loss is under 1 % (measured -0.02 %) and
-    // the room and the crate within 5 % of Gauss-Seidel (green -3.4 % and -3.3 %; unbalanced -9 %
-    // and -16 %).
+    // a lamp panel 0.2 m under the ceiling: closed, so no light can leave, and rho = 0.99 turns
+    // every 0.1 % the links lose or gain per bounce into about 10 % of the power. Without the
+    // balancing of closed regions the links lost 8.7 % of the emitted power here (6.7 % in
+    // session 15), and the solve said so; since session 22 keeps zero links for the next pass
+    // ("Zero links" in docs/HIERARCHICAL.md) they gain 1.2 % instead (measured; held to 5 %), so
+    // the warning must stay silent, as it must for the open Cornell box (31 % leaves through its
+    // front) and for Gauss-Seidel on the room. Balanced (the default), the loss is under 1 %
+    // (measured -0.02 %) and the room and the crate within 5 % of Gauss-Seidel (measured 3.0 % low).
     auto warned = [](const rad::Solution& sol) {
       for (const std::string& w : sol.report().warnings)
         if (w.find("unaccounted for") != std::string::npos) return true;
@@ -529,8 +530,8 @@ TEST_SUITE("solver") {
     REQUIRE(sol.status() == rad::SolveStatus::converged);
     const double escaped = sol.report().escaped_power.y / sol.report().emitted_power.y;
     MESSAGE("closed room, hierarchical: escaped " << escaped);
-    CHECK(escaped > 0.01);
-    CHECK(warned(sol));
+    CHECK(std::abs(escaped) < 0.05);
+    CHECK(warned(sol) == (escaped > 0.01));  // the warning says a loss over 1 %, and only that
     const rad::Solution open = rad::solve(rad::cornell_box(), hierarchical(0.05f));
     CHECK(open.report().escaped_power.y > 0.2f * open.report().emitted_power.y);
     CHECK_FALSE(warned(open));
