@@ -2007,14 +2007,13 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
       }
     });
     // refine[k]: 1 to refine, 2 to drop (a zero link not refined).
-    std::size_t refined = 0, leaving = 0;
-    for (std::uint8_t f : refine) {
-      refined += f == 1;
-      leaving += f != 0;
-    }
+    std::size_t refined = 0;
+    for (std::uint8_t f : refine) refined += f == 1;
     // The links to refine or drop leave the arrays, which close up in place (kept links keep
-    // their order); they are kept aside to be put back if this pass is cancelled.
-    replaced.reserve(leaving);
+    // their order); those refined are kept aside to be put back if this pass is cancelled (the
+    // dropped zero links are not: at 12 bytes each they would raise the 1M city's peak, and a
+    // cancelled pass losing them costs only their next look).
+    replaced.reserve(refined);
     frontier.reserve(refined);
     std::uint64_t write = 0, first = m.offsets[0];
     for (std::uint64_t i = 0; i < receivers; ++i) {
@@ -2022,10 +2021,10 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
       const std::uint64_t last = m.offsets[i + 1];
       m.offsets[i] = write;
       for (std::uint64_t k = first; k < last; ++k) {
-        if (refine[k]) {
-          if (refine[k] == 1) frontier.push_back({r, m.sources[k]});
+        if (refine[k] == 1) {
+          frontier.push_back({r, m.sources[k]});
           replaced.push_back({r, m.sources[k], m.coefficients[k]});
-        } else {
+        } else if (refine[k] == 0) {
           m.sources[write] = m.sources[k];
           m.coefficients[write] = m.coefficients[k];
           ++write;
