@@ -1841,18 +1841,19 @@ struct LinkHierarchy::Impl {
         const float radius_r = radius(hierarchy, r);
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
-          const glm::vec3 cs = centroid(hierarchy, s);
           Rgb brought;
-          glm::vec3 ns(0.0f);
           if (!is_cluster(s)) {
             brought = std::abs(coefficients[k]) * (is_back(s) ? v.back : v.front)[element_of(s)];
-            ns = side_normal(hierarchy, s);
           } else {
-            const glm::vec3 w = glm::normalize(cr - cs);
+            const glm::vec3 w = glm::normalize(cr - centroid(hierarchy, s));
             brought = (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w))) * source_intensity(hierarchy, v, s, w);
           }
           sum += brought;
-          if (has_children) slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, cs, ns, radius_r), 1.0f);
+          // Leaves (most receivers) push nothing: no slope, and no look-up of an element
+          // source's centroid and normal, which the sum alone does not need.
+          if (!has_children) continue;
+          const glm::vec3 ns = is_cluster(s) ? glm::vec3(0.0f) : side_normal(hierarchy, s);
+          slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, centroid(hierarchy, s), ns, radius_r), 1.0f);
         }
         (is_back(r) ? back : front)[element_of(r)] = sum;
         if (has_children) (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
