@@ -79,10 +79,10 @@ struct PlateError {
   double rms = 0.0, mean = 0.0;
   std::size_t links = 0;
 };
-PlateError plate_error(bool perpendicular, float epsilon) {
+PlateError plate_error(bool perpendicular, float epsilon, float patch_area = 0.25f) {
   const rad::Scene scene = plates(perpendicular);
   rad::SolveOptions o = hierarchical(epsilon);
-  o.mesh.max_patch_area = 0.25f;
+  o.mesh.max_patch_area = patch_area;
   o.mesh.max_element_area = 1.0f / 256.0f;  // 16 x 16 leaves per plate
   const rad::Solution sol = rad::solve(scene, o);
   const rad::PatchHierarchy& h = sol.hierarchy();
@@ -192,6 +192,31 @@ TEST_SUITE("solver") {
       const rad::Solution sol = rad::solve(scene, o);
       const rad::Rgb b = sol.group_radiosity("receiver");
       CHECK(relative(b.x, 0.5 * F[k]) < 0.005);
+    }
+  }
+
+  TEST_CASE("hierarchical: plates of one patch per leaf - a cluster tree above them - match the closed form per leaf") {
+    // As the test above, with each leaf its own patch: the links join clusters of patches, and
+    // the linear push within a cluster takes the gradient from the moments' directions
+    // (directional_q()). Measured leaf RMS at epsilon 0.5, 0.1, 0.02, 0.004: 0.85, 0.80, 0.34,
+    // 0.16 % (parallel) and 1.92, 1.50, 1.00, 0.42 % (perpendicular); with the clusters'
+    // directions left out of the gradient (before session 23: a wall cluster's light taken as
+    // falling off only as 1 / d^2, so a floor beside it got it alike up to the contact, the
+    // first row of leaves 6 % too bright) 2.88, 2.90, 2.11, 1.12 % and 4.29, 3.50, 2.11, 0.83 %.
+    // Held to about twice the new figures.
+    const std::array<float, 4> epsilons = {0.5f, 0.1f, 0.02f, 0.004f};
+    const std::array<std::array<double, 4>, 2> rms_at_most = {{{0.02, 0.016, 0.007, 0.0035}, {0.04, 0.03, 0.02, 0.009}}};
+    for (bool perpendicular : {false, true}) {
+      CAPTURE(perpendicular);
+      for (std::size_t k = 0; k < epsilons.size(); ++k) {
+        const float eps = epsilons[k];
+        CAPTURE(eps);
+        const PlateError e = plate_error(perpendicular, eps, 1.0f / 256.0f);
+        MESSAGE("one patch per leaf, perpendicular " << perpendicular << ", epsilon " << eps << ": leaf RMS " << e.rms
+                                                      << ", mean " << e.mean << ", links " << e.links);
+        CHECK(e.rms < rms_at_most[perpendicular ? 1 : 0][k]);
+        CHECK(std::abs(e.mean) < 0.005);
+      }
     }
   }
 
@@ -454,7 +479,10 @@ TEST_SUITE("solver") {
     CHECK_THROWS_AS(rad::solve(scene, o), rad::Error);
   }
 
-  TEST_CASE("hierarchical: links that gain energy are held to the maximum principle and converge, with a warning") {
+  // Not under ThreadSanitizer (60 s there): the sweeps' and the hold's parallel loops are the
+  // ones the lighter hierarchical tests run there; the Release and ASan builds run this one.
+  TEST_CASE("hierarchical: links that gain energy are held to the maximum principle and converge, with a warning" *
+            test::not_under_thread_sanitizer) {
     // Outward winding, Kd 1 (clamped to 0.99), a degenerate face, a box resting on the floor (its
     // bottom face on the floor: coincident surfaces, which a receiver inside the box sees twice):
     // made two-sided, a closed room of reflectance 0.99 whose links pass on more light than they
@@ -507,7 +535,9 @@ TEST_SUITE("solver") {
     CHECK(relative(balanced.group_back_radiosity("box").y, ref.group_back_radiosity("box").y) < 0.6);
   }
 
-  TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there") {
+  // Not under ThreadSanitizer (44 s there), for the same reason as the test above.
+  TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there" *
+            test::not_under_thread_sanitizer) {
     // A room as an exporter writes it (outward winding, Kd 1 clamped to 0.99), made two-sided,
     // a lamp panel 0.2 m under the ceiling: closed, so no light can leave, and rho = 0.99 turns
     // every 0.1 % the links lose or gain per bounce into about 10 % of the power. Without the

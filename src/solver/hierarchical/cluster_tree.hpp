@@ -243,6 +243,23 @@ T directional_sum(const std::array<T, 6>& m, const MomentBasis& b, const glm::ve
   return sum;
 }
 
+/// The gradient of directional_sum() with respect to the direction `w` (of one-channel
+/// moments): sum_a sign(w_a) m[sign(w_a) a] e_a on the axes, sum_k m_k u_k over the moments that
+/// face w otherwise. The sum is homogeneous of degree one in w, so w . gradient = the sum
+/// (Euler): gradient / sum is the moments' counterpart of an element's n / (n . w).
+inline glm::vec3 directional_gradient(const std::array<float, 6>& m, const MomentBasis& b, const glm::vec3& w) {
+  glm::vec3 g(0.0f);
+  if (b.axes) {
+    for (int a = 0; a < 3; ++a)
+      g[a] = w[a] >= 0.0f ? m[static_cast<std::size_t>(2 * a)] : -m[static_cast<std::size_t>(2 * a + 1)];
+    return g;
+  }
+  for (int k = 0; k < b.count; ++k)
+    if (glm::dot(b.directions[static_cast<std::size_t>(k)], w) > 0.0f)
+      g += m[static_cast<std::size_t>(k)] * b.directions[static_cast<std::size_t>(k)];
+  return g;
+}
+
 /// Radiant intensity (W/sr) of sending moments toward the unit direction `w`:
 /// I(w) = (1/pi) sum_k P_k max(0, u_k . w). Its integral over the sphere is the sum of the six
 /// moments, and it is exact for an explicit basis and for sides along the axes.

@@ -1698,28 +1698,54 @@ struct LinkHierarchy::Impl {
   // ---- Sweeps -------------------------------------------------------------------------------
 
   /// The relative gradient (1/m) of a link's irradiance over its receiver, at the receiver's
-  /// centroid x (normal nr; zero for a cluster, whose members face many ways) from a source at y
-  /// (normal ns; zero for a cluster): the gradient of ln(cos_r cos_s / d^2), in the receiver's
-  /// plane for an element. At most 1 / `radius` long, so that the linear push (push_factor())
-  /// stays within [0, 2] over the receiver: near grazing (cos_s -> 0) the gradient is unbounded.
-  static glm::vec3 irradiance_slope(const glm::vec3& x, const glm::vec3& nr, const glm::vec3& y, const glm::vec3& ns,
-                                    float radius) {
+  /// centroid x from a source at y: the gradient of ln(f_s(w) f_r(-w) / d^2), w = (x - y) / d,
+  /// where f_s is what the source shows toward w (an element side: A cos_s; a cluster: its
+  /// sending moments' directional sum) and f_r what the receiver shows toward the source. Each
+  /// end is given by `q` = grad f / f at its direction (directional_q(); zero: taken as
+  /// uniform), which, f being homogeneous of degree one, gives grad_x ln f_s = (q_s - w) / d and
+  /// grad_x ln f_r = -(q_r + w) / d. An element receiver (normal `nr`, non-zero) keeps the
+  /// part in its plane, where its children lie. At most 1 / `radius` long, so that the linear
+  /// push (push_factor()) stays within [0, 2] over the receiver: near grazing (cos_s -> 0) the
+  /// gradient is unbounded.
+  static glm::vec3 irradiance_slope(const glm::vec3& x, const glm::vec3& nr, const glm::vec3& q_r, const glm::vec3& y,
+                                    const glm::vec3& q_s, float radius) {
     const glm::vec3 u = x - y;
     const float d2 = glm::dot(u, u);
     if (!(d2 > 0.0f)) return glm::vec3(0.0f);
     const float d = std::sqrt(d2);
-    glm::vec3 g = -2.0f * u / d2;  // 1 / d^2
-    if (ns != glm::vec3(0.0f)) {
-      const float cos_s = glm::dot(ns, u) / d;
-      if (cos_s > 1e-3f) g += ns / (d * cos_s) - u / d2;
-    }
+    const glm::vec3 w = u / d;
+    glm::vec3 g = -2.0f * w / d;  // 1 / d^2
+    if (q_s != glm::vec3(0.0f)) g += (q_s - w) / d;
     if (nr != glm::vec3(0.0f)) {
-      g -= u / d2;  // cos_r, whose other term lies along nr
+      g -= w / d;  // cos_r, whose other term lies along nr
       g -= nr * glm::dot(nr, g);
+    } else if (q_r != glm::vec3(0.0f)) {
+      g -= (q_r + w) / d;
     }
     const float length = glm::length(g);
     if (radius > 0.0f && length * radius > 1.0f) g *= 1.0f / (length * radius);
     return g;
+  }
+  /// grad f / f of what node `n` shows toward the unit direction `w` (irradiance_slope()'s q):
+  /// its sending moments' (`sending`) or, for a receiver, its area moments' directional sum
+  /// for a cluster; n / (n . w) for an element side. Zero where it shows nothing that way (or
+  /// next to nothing: an element seen within 0.06 degrees of its plane).
+  glm::vec3 directional_q(const PatchHierarchy& h, const Values* sending, NodeHandle n, const glm::vec3& w) const {
+    if (!is_cluster(n)) {
+      const glm::vec3 normal = side_normal(h, n);
+      const float cosine = glm::dot(normal, w);
+      return cosine > 1e-3f ? normal / cosine : glm::vec3(0.0f);
+    }
+    const std::uint32_t c = handle_index(n);
+    std::array<float, 6> m{};
+    if (sending) {
+      for (std::size_t k = 0; k < 6; ++k) m[k] = mean(sending->sending[c][k]);
+    } else {
+      m = area_moments[c];
+    }
+    const MomentBasis& b = bases.of(c);
+    const float sum = directional_sum(m, b, w);
+    return sum > 0.0f ? directional_gradient(m, b, w) / sum : glm::vec3(0.0f);
   }
   /// The share of a node's irradiance a child at `offset` from the node's centroid takes: 1 plus
   /// the node's irradiance-weighted mean relative gradient along the offset (`slope` as
@@ -1829,8 +1855,9 @@ struct LinkHierarchy::Impl {
             const Rgb flux = std::abs(coefficients[k]) * source_intensity(hierarchy, v, s, w);
             add_irradiance(E, bases.of(handle_index(r)), -w, flux);
             if (!has_children) continue;
-            const glm::vec3 ns = is_cluster(s) ? glm::vec3(0.0f) : side_normal(hierarchy, s);
-            slope += mean(flux) * glm::vec4(irradiance_slope(cr, glm::vec3(0.0f), cs, ns, radius_r), 1.0f);
+            slope += mean(flux) * glm::vec4(irradiance_slope(cr, glm::vec3(0.0f), directional_q(hierarchy, nullptr, r, -w), cs,
+                                                             directional_q(hierarchy, &v, s, w), radius_r),
+                                            1.0f);
           }
           continue;
         }
@@ -1852,8 +1879,10 @@ struct LinkHierarchy::Impl {
           // Leaves (most receivers) push nothing: no slope, and no look-up of an element
           // source's centroid and normal, which the sum alone does not need.
           if (!has_children) continue;
-          const glm::vec3 ns = is_cluster(s) ? glm::vec3(0.0f) : side_normal(hierarchy, s);
-          slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, centroid(hierarchy, s), ns, radius_r), 1.0f);
+          const glm::vec3 cs = centroid(hierarchy, s);
+          slope += mean(brought) * glm::vec4(irradiance_slope(cr, nr, glm::vec3(0.0f), cs,
+                                                              directional_q(hierarchy, &v, s, glm::normalize(cr - cs)), radius_r),
+                                             1.0f);
         }
         (is_back(r) ? back : front)[element_of(r)] = sum;
         if (has_children) (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
