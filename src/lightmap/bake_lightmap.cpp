@@ -46,7 +46,7 @@ namespace {
 
 constexpr std::uint64_t kMaxTexels = std::uint64_t{1} << 28;  // 16384^2: about 10 GB of working memory
 
-void bad_option(const std::string& problem) { throw Error(ErrorCode::invalid_argument, "LightmapOptions: " + problem); }
+void bad_lightmap_option(const std::string& problem) { throw Error(ErrorCode::invalid_argument, "LightmapOptions: " + problem); }
 
 /// Where a covered texel reads the surface: a triangle of one of the baked meshes and the
 /// barycentric coordinates of the point nearest to the texel centre.
@@ -235,7 +235,7 @@ Rgb interpolate(const std::vector<Rgb>& field, const FieldPoint& f) {
 }
 
 /// An emitting polygon of the scene, as the final gather sees it.
-struct Emitter {
+struct LightmapEmitter {
   PolygonId polygon = 0;
   Rgb emission{0.0f};
   bool two_sided = false;
@@ -343,7 +343,7 @@ class FinalGather {
     };
     std::vector<Candidate> candidates;
     for (std::uint32_t k = 0; k < emitters_.size(); ++k) {
-      const Emitter& L = emitters_[k];
+      const LightmapEmitter& L = emitters_[k];
       const Polygon& poly = scene_.polygons()[L.polygon];
       // The side of the emitter's plane that x is on must emit.
       const float side = glm::dot(poly.normal, x - poly.vertices[0]);
@@ -365,7 +365,7 @@ class FinalGather {
     const detail::ShadowBudget budget{{rays, 1}, {4 * rays, 1}, detail::ShadowPairing::shuffled};
     for (std::size_t i = 0; i < keep; ++i) {
       const Candidate& c = candidates[i];
-      const Emitter& L = emitters_[c.emitter];
+      const LightmapEmitter& L = emitters_[c.emitter];
       exact.push_back(L.polygon);
       auto from = [&x](glm::vec2) { return x; };
       auto to = [&L](glm::vec2 uv) { return L.fan.sample(uv); };
@@ -385,7 +385,7 @@ class FinalGather {
   float epsilon_;
   std::vector<Rgb> front_, back_;  ///< pass 1's radiosity per hierarchy vertex
   std::vector<Rgb> emission_;      ///< per polygon: its emission at its weight
-  std::vector<Emitter> emitters_;
+  std::vector<LightmapEmitter> emitters_;
   detail::SceneLights lights_;
 };
 
@@ -427,27 +427,27 @@ void dilate(Lightmap& map, int rings) {
 
 void validate(const LightmapOptions& options) {
   if (options.width <= 0 || options.height <= 0)
-    bad_option("width and height must be > 0, got " + std::to_string(options.width) + "x" +
+    bad_lightmap_option("width and height must be > 0, got " + std::to_string(options.width) + "x" +
                std::to_string(options.height));
   const std::uint64_t texels = static_cast<std::uint64_t>(options.width) * static_cast<std::uint64_t>(options.height);
   if (texels > kMaxTexels)
-    bad_option(std::to_string(options.width) + "x" + std::to_string(options.height) + " texels would need about " +
+    bad_lightmap_option(std::to_string(options.width) + "x" + std::to_string(options.height) + " texels would need about " +
                std::to_string(texels * (sizeof(TexelSample) + sizeof(Rgb) + 1) >> 20) +
                " MiB of working memory; at most 16384x16384 texels are baked at once");
-  if (options.gather_rays < 1) bad_option("gather_rays must be >= 1, got " + std::to_string(options.gather_rays));
-  if (options.shadow_rays < 1) bad_option("shadow_rays must be >= 1, got " + std::to_string(options.shadow_rays));
+  if (options.gather_rays < 1) bad_lightmap_option("gather_rays must be >= 1, got " + std::to_string(options.gather_rays));
+  if (options.shadow_rays < 1) bad_lightmap_option("shadow_rays must be >= 1, got " + std::to_string(options.shadow_rays));
   if (options.exact_emitters < 0)
-    bad_option("exact_emitters must be >= 0, got " + std::to_string(options.exact_emitters));
-  if (options.dilation < 0) bad_option("dilation must be >= 0, got " + std::to_string(options.dilation));
+    bad_lightmap_option("exact_emitters must be >= 0, got " + std::to_string(options.exact_emitters));
+  if (options.dilation < 0) bad_lightmap_option("dilation must be >= 0, got " + std::to_string(options.dilation));
   if (options.light_group < -1)
-    bad_option("light_group must be >= -1 (-1 = all), got " + std::to_string(options.light_group));
+    bad_lightmap_option("light_group must be >= -1 (-1 = all), got " + std::to_string(options.light_group));
   switch (options.quantity) {
     case Quantity::radiosity:
     case Quantity::irradiance:
     case Quantity::direct_irradiance:
     case Quantity::indirect_irradiance: return;
   }
-  bad_option("quantity is not a Quantity");
+  bad_lightmap_option("quantity is not a Quantity");
 }
 
 Lightmap bake_lightmap(const Scene& scene, const Solution& solution, MeshId mesh, const LightmapOptions& options) {

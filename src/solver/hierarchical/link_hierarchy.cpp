@@ -798,12 +798,12 @@ struct LinkHierarchy::Impl {
     float bound, spread;
   };
   LinkError link_error(const RoundContext& rc, NodeHandle r, NodeHandle s) const {
-    constexpr float kInf = std::numeric_limits<float>::infinity();
+    constexpr float infinite = std::numeric_limits<float>::infinity();
     const glm::vec3 cr = centre(rc.hierarchy, r), cs = centre(rc.hierarchy, s);
     const float d = glm::length(cr - cs);
     const float reach = radius(rc.hierarchy, r) + radius(rc.hierarchy, s);
     const float gap = d - reach;
-    if (!(gap > 0.0f)) return {kInf, kInf};
+    if (!(gap > 0.0f)) return {infinite, infinite};
     const glm::vec3 w = (cr - cs) / d;
     const float transport = mean(source_intensity(rc.hierarchy, rc.values, s, w));
     const float widest = intensity_bound(rc.hierarchy, rc.values, s, w, std::min(1.0f, reach / d));
