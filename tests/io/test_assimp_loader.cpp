@@ -412,6 +412,23 @@ TEST_CASE("Assimp broken 3DS: an animation track whose key count its chunk canno
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.3ds").polygons().size() > 0);
 }
 
+TEST_CASE("Assimp broken FBX: a text FBX Layer element without its index is refused before Assimp reads it") {
+  // Found by radiosity_fuzz_fbx (session 23, in the README's test command's 10 s run): the
+  // exported room with one `Layer: 0 {` made `Layer:   {`. Assimp 5.2's FBX reader takes the
+  // index without checking it is there: a segmentation fault (`radiosity check` died with
+  // signal 11).
+  const fs::path found = fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "fbx" / "layer_without_index.fbx";
+  const Error e = load_error(found);
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "layer_without_index.fbx:303:3: a Layer element has no index (its first value)"));
+  // A minute's run later the same crash from `Layer:LayerElementMaterial: 0 {`: a Layer key
+  // followed by another key, no value between.
+  const Error next = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "fbx" / "layer_before_a_key.fbx");
+  CHECK(contains(next.what(), "layer_before_a_key.fbx:172:3: a Layer element has no index (its first value)"));
+  // The exported room has every index and still loads.
+  CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
+}
+
 TEST_CASE("Assimp broken COLLADA: primitives whose index lists do not match their counts are refused before Assimp aborts") {
   // Found by radiosity_fuzz_dae (session 20): the exported room with one <polylist>'s index list
   // (<p>) erased. Assimp 5.2's parser asserts that a primitive element read as many primitives

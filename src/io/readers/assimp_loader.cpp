@@ -336,6 +336,48 @@ void check_collada(const fs::path& path) {
   check_collada_primitives(text, fail);
 }
 
+/// What Assimp 5.2's FBX reader trusts and should not: in a text FBX, a mesh's `Layer:`
+/// element names its index as its first value, and the reader takes that value without
+/// checking there is one (it reads the first of an empty token list): a `Layer:` whose next
+/// token is a `{` or another key (`Layer:   {`, `Layer:LayerElementMaterial: 0 {`, both found by
+/// radiosity_fuzz_fbx in session 23) crashes the process with a segmentation fault. Refused
+/// here first, with its line: the token after every `Layer:` key (outside strings and `;`
+/// comments) must be an integer. Binary FBX files are not checked.
+void check_fbx_text(const fs::path& path) {
+  const std::string text = read_file(path, "FBX file");
+  if (text.rfind("Kaydara FBX Binary", 0) == 0) return;
+  auto name_char = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '|';
+  };
+  for (std::size_t at = 0; at < text.size(); ++at) {
+    const char c = text[at];
+    if (c == '"') {  // a string: skipped whole
+      const std::size_t close = text.find('"', at + 1);
+      if (close == std::string::npos) return;  // Assimp says what is wrong
+      at = close;
+      continue;
+    }
+    if (c == ';') {  // a comment, to the end of the line
+      const std::size_t eol = text.find('\n', at);
+      if (eol == std::string::npos) return;
+      at = eol;
+      continue;
+    }
+    if (!name_char(c) || (at > 0 && name_char(text[at - 1]))) continue;
+    std::size_t end = at;
+    while (end < text.size() && name_char(text[end])) ++end;
+    if (end < text.size() && text[end] == ':' && text.compare(at, end - at, "Layer") == 0) {
+      std::size_t value = end + 1;
+      while (value < text.size() && blank(text[value])) ++value;
+      if (value < text.size() && (text[value] == '-' || text[value] == '+')) ++value;
+      if (value >= text.size() || text[value] < '0' || text[value] > '9')
+        throw Error(ErrorCode::parse_error, path.string() + ":" + line_column(text, at) +
+                                                ": a Layer element has no index (its first value)");
+    }
+    at = end - 1;
+  }
+}
+
 glm::dmat4 to_glm(const aiMatrix4x4& m) {
   // Assimp's matrices are row-major (a1..a4 the first row), GLM's column-major.
   const ai_real* r = &m.a1;
@@ -762,6 +804,7 @@ Scene load_assimp(const fs::path& path, const LoadOptions& options) {
   if (lower_extension(path) == ".ply") check_ply_header(path);
   if (lower_extension(path) == ".dae") check_collada(path);
   if (lower_extension(path) == ".3ds") check_3ds_tracks(path);
+  if (lower_extension(path) == ".fbx") check_fbx_text(path);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
   if (!scene) throw Error(ErrorCode::parse_error, path.string() + ": " + importer.GetErrorString());
