@@ -429,6 +429,33 @@ TEST_CASE("Assimp broken FBX: a text FBX Layer element without its index is refu
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
 }
 
+TEST_CASE("Assimp broken FBX: a model property of a type Assimp cannot keep as metadata is refused before it aborts") {
+  // Found by radiosity_fuzz_fbx (session 23, 522 376 inputs into its long run): a model without a
+  // Properties70 block takes the Model property template as its own table, and the fuzzed
+  // template held a KTime property (TimeSpanStart). Assimp 5.2's converter copies a model's
+  // unread properties into node metadata and asserts on a KTime: abort(), exit status 134.
+  const fs::path found = fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "fbx" / "model_property_ktime.fbx";
+  const Error e = load_error(found);
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "model_property_ktime.fbx:96:3: a model's property of type KTime"));
+  // The same on a model's own table (without this check both abort), and for ColorAndAlpha.
+  const std::string room = read_text(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx");
+  REQUIRE(contains(room, "\"KTime\""));
+  const std::size_t model = room.find("\tModel: ");
+  REQUIRE(model != std::string::npos);
+  const std::size_t table = room.find("Properties70:  {", model);
+  REQUIRE(table != std::string::npos);
+  const std::size_t after = room.find('\n', table) + 1;
+  std::string ktime = room;
+  ktime.insert(after, "\t\t\tP: \"Baked\", \"KTime\", \"Time\", \"\", 0\n");
+  CHECK(contains(load_error(write("model_ktime.fbx", ktime)).what(), "a model's property of type KTime"));
+  std::string rgba = room;
+  rgba.insert(after, "\t\t\tP: \"Tint\", \"ColorAndAlpha\", \"\", \"A\", 1, 1, 1, 1\n");
+  CHECK(contains(load_error(write("model_rgba.fbx", rgba)).what(), "a model's property of type ColorAndAlpha"));
+  // The room itself, with GlobalSettings' two KTime properties outside any model, still loads.
+  CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
+}
+
 TEST_CASE("Assimp broken COLLADA: primitives whose index lists do not match their counts are refused before Assimp aborts") {
   // Found by radiosity_fuzz_dae (session 20): the exported room with one <polylist>'s index list
   // (<p>) erased. Assimp 5.2's parser asserts that a primitive element read as many primitives

@@ -342,19 +342,51 @@ void check_collada(const fs::path& path) {
 /// token is a `{` or another key (`Layer:   {`, `Layer:LayerElementMaterial: 0 {`, both found by
 /// radiosity_fuzz_fbx in session 23) crashes the process with a segmentation fault. Refused
 /// here first, with its line: the token after every `Layer:` key (outside strings and `;`
-/// comments) must be an integer. Binary FBX files are not checked.
+/// comments) must be an integer.
+///
+/// The converter then copies every property of a model (`Model:` object) it did not read itself
+/// into the node's metadata, and asserts when one's type is none it has metadata for: `KTime`
+/// (a 64-bit integer) and `ColorAndAlpha` (a colour with alpha) abort the process (Debian keeps
+/// assertions; found by radiosity_fuzz_fbx in session 23: a model without a `Properties70`
+/// block takes the property template of `ObjectType: "Model"` as its own table, and the fuzzed
+/// template held GlobalSettings' `TimeSpanStart`, a KTime). No exporter writes either type on a
+/// node, so a `P:` of one of these types inside a `Model:` object or the Model property template
+/// is refused, with its line. The scopes are followed by their braces, as Assimp's parser does.
+/// Binary FBX files are not checked.
 void check_fbx_text(const fs::path& path) {
   const std::string text = read_file(path, "FBX file");
   if (text.rfind("Kaydara FBX Binary", 0) == 0) return;
   auto name_char = [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '|';
   };
+  auto fail = [&](std::size_t at, const std::string& what) {
+    throw Error(ErrorCode::parse_error, path.string() + ":" + line_column(text, at) + ": " + what);
+  };
+  // The open scopes, each by the key before its `{`, and whether it is a model's (a `Model:`
+  // object or `ObjectType: "Model"`'s template); the key last read and its first string value.
+  std::vector<bool> scope_in_model;
+  std::string last_key;
+  std::string last_key_value;
+  bool key_has_value = false;
   for (std::size_t at = 0; at < text.size(); ++at) {
     const char c = text[at];
     if (c == '"') {  // a string: skipped whole
       const std::size_t close = text.find('"', at + 1);
       if (close == std::string::npos) return;  // Assimp says what is wrong
+      if (!key_has_value) last_key_value = text.substr(at + 1, close - at - 1);
+      key_has_value = true;
       at = close;
+      continue;
+    }
+    if (c == '{') {
+      const bool parent = !scope_in_model.empty() && scope_in_model.back();
+      scope_in_model.push_back(parent || last_key == "Model" || (last_key == "ObjectType" && last_key_value == "Model"));
+      last_key.clear();
+      continue;
+    }
+    if (c == '}') {
+      if (!scope_in_model.empty()) scope_in_model.pop_back();
+      last_key.clear();
       continue;
     }
     if (c == ';') {  // a comment, to the end of the line
@@ -366,15 +398,36 @@ void check_fbx_text(const fs::path& path) {
     if (!name_char(c) || (at > 0 && name_char(text[at - 1]))) continue;
     std::size_t end = at;
     while (end < text.size() && name_char(text[end])) ++end;
-    if (end < text.size() && text[end] == ':' && text.compare(at, end - at, "Layer") == 0) {
+    const bool key = end < text.size() && text[end] == ':';
+    if (!key) {
+      key_has_value = true;
+      at = end - 1;
+      continue;
+    }
+    last_key.assign(text, at, end - at);
+    last_key_value.clear();
+    key_has_value = false;
+    if (last_key == "Layer") {
       std::size_t value = end + 1;
       while (value < text.size() && blank(text[value])) ++value;
       if (value < text.size() && (text[value] == '-' || text[value] == '+')) ++value;
       if (value >= text.size() || text[value] < '0' || text[value] > '9')
-        throw Error(ErrorCode::parse_error, path.string() + ":" + line_column(text, at) +
-                                                ": a Layer element has no index (its first value)");
+        fail(at, "a Layer element has no index (its first value)");
     }
-    at = end - 1;
+    if (last_key == "P" && !scope_in_model.empty() && scope_in_model.back()) {
+      // The type is the second value: `P: "name", "type", ...`.
+      const std::size_t name_open = text.find_first_not_of(" \t", end + 1);
+      const std::size_t name_close = name_open != std::string::npos && text[name_open] == '"' ? text.find('"', name_open + 1)
+                                                                                           : std::string::npos;
+      const std::size_t type_open = name_close == std::string::npos ? name_close : text.find_first_not_of(" \t,", name_close + 1);
+      if (type_open != std::string::npos && text[type_open] == '"') {
+        const std::size_t type_close = text.find('"', type_open + 1);
+        const std::string type = text.substr(type_open + 1, type_close == std::string::npos ? 0 : type_close - type_open - 1);
+        if (type == "KTime" || type == "ColorAndAlpha")
+          fail(at, "a model's property of type " + type + " (Assimp 5.2 cannot keep it as node metadata and aborts)");
+      }
+    }
+    at = end;
   }
 }
 
