@@ -425,6 +425,10 @@ TEST_CASE("Assimp broken FBX: a text FBX Layer element without its index is refu
   // followed by another key, no value between.
   const Error next = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "fbx" / "layer_before_a_key.fbx");
   CHECK(contains(next.what(), "layer_before_a_key.fbx:172:3: a Layer element has no index (its first value)"));
+  // Session 24's long run: `Layer: 0rial: 0 {`, whose first token starts with a digit but is a
+  // key (`0rial:`), so the element again has no value.
+  const Error key = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "fbx" / "layer_index_is_a_key.fbx");
+  CHECK(contains(key.what(), "layer_index_is_a_key.fbx:213:3: a Layer element has no index (its first value)"));
   // The exported room has every index and still loads.
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
 }

@@ -340,9 +340,10 @@ void check_collada(const fs::path& path) {
 /// element names its index as its first value, and the reader takes that value without
 /// checking there is one (it reads the first of an empty token list): a `Layer:` whose next
 /// token is a `{` or another key (`Layer:   {`, `Layer:LayerElementMaterial: 0 {`, both found by
-/// radiosity_fuzz_fbx in session 23) crashes the process with a segmentation fault. Refused
-/// here first, with its line: the token after every `Layer:` key (outside strings and `;`
-/// comments) must be an integer.
+/// radiosity_fuzz_fbx in session 23, and `Layer: 0rial: 0 {`, session 24: a key that starts with
+/// a digit) crashes the process with a segmentation fault. Refused here first, with its line:
+/// the token after every `Layer:` key (outside strings and `;` comments) must be a whole
+/// integer.
 ///
 /// The converter then copies every property of a model (`Model:` object) it did not read itself
 /// into the node's metadata, and asserts when one's type is none it has metadata for: `KTime`
@@ -411,7 +412,10 @@ void check_fbx_text(const fs::path& path) {
       std::size_t value = end + 1;
       while (value < text.size() && blank(text[value])) ++value;
       if (value < text.size() && (text[value] == '-' || text[value] == '+')) ++value;
-      if (value >= text.size() || text[value] < '0' || text[value] > '9')
+      const std::size_t digits = value;
+      while (value < text.size() && text[value] >= '0' && text[value] <= '9') ++value;
+      // A whole number: `Layer: 0rial: 0 {` starts with a digit, yet `0rial:` is a key.
+      if (value == digits || (value < text.size() && (name_char(text[value]) || text[value] == ':' || text[value] == '.')))
         fail(at, "a Layer element has no index (its first value)");
     }
     if (last_key == "P" && !scope_in_model.empty() && scope_in_model.back()) {
