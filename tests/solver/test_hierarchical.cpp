@@ -288,9 +288,10 @@ TEST_SUITE("solver") {
     // mean radiosity from its visible half too, an error of the reference of up to 40 % on the
     // leaves next to the blocks (measured). The group means averaged over four seeds (one seed's
     // scatter by about 1 %, which hid the bias); measured worst group and channel at 100 mm
-    // elements: 0.91 % at epsilon 0.05 (the ceiling), 0.86 % at 0.005 (the short block; session
-    // 22, after the oracle near grazing and the linear push; before them 1.04 % and 0.97 %).
-    // The goal is 0.5 %: not met yet (docs/HIERARCHICAL.md, "Where it stands").
+    // elements: 0.91 % at epsilon 0.05 (the ceiling), 0.50 % at 0.005 (the ceiling; session 24,
+    // the linear pull; session 22, after the oracle near grazing and the linear push, 0.91 % and
+    // 0.86 %; before them 1.04 % and 0.97 %). The goal is 0.5 % at 16 000 elements
+    // (docs/HIERARCHICAL.md, "Where it stands").
     const rad::Scene scene = rad::cornell_box();
     const rad::Solution gs = gauss_seidel_reference(scene, 10000.0f);  // 100 mm
     for (float eps : {0.05f, 0.005f}) {
@@ -303,7 +304,7 @@ TEST_SUITE("solver") {
         CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
       }
       // The open front lets out about 31 % of the light in both.
-      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.012 : 0.01, 0.01);
+      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.012 : 0.007, 0.01);
     }
   }
 
@@ -314,12 +315,12 @@ TEST_SUITE("solver") {
     // elements every group came out 6-15 % too bright (the back wall +13.9 %, the green wall
     // +15.3 %) and the upright box's blocks 8 % (measured, session 19). With one moment per
     // direction a cluster faces (MomentBasis), measured: worst group 0.92 % turned, 0.99 %
-    // upright (the short block).
+    // upright (the short block); with the linear pull (session 24) 0.60 % and 0.64 % (the ceiling).
     for (const float degrees : {0.0f, 30.0f}) {
       CAPTURE(degrees);
       const rad::Scene scene = test::turned_about_y(rad::cornell_box(), degrees, glm::vec3(278.0f, 0.0f, 280.0f));
       const rad::Solution gs = gauss_seidel_reference(scene, 2500.0f);  // 50 mm
-      check_agreement(scene, gs, hierarchical_on(scene, 2500.0f, 0.05f), 0.015, 0.005);
+      check_agreement(scene, gs, hierarchical_on(scene, 2500.0f, 0.05f), 0.009, 0.005);
     }
   }
 
@@ -616,8 +617,9 @@ TEST_SUITE("solver") {
   TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to E / (1 - rho) on every leaf") {
     // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
     // Balanced (every side of the closed box delivers what it sends and gathers 1 from uniform
-    // radiosity): measured mean 99.9992, leaves 99.92-100.41 (with the linear push; its shares
-    // left out of the balancing's adjoint, the mean was 99.38). Before the balancing the links
+    // radiosity): measured mean 99.9924, leaves 99.992-99.994 with the linear pull (session 24;
+    // before it 99.9992, 99.92-100.41; with the linear push's shares left out of the balancing's
+    // adjoint, the mean was 99.38; with the pull but without its power keeping, 99.57). Before the balancing the links
     // gained about 1 % here (absorbed / emitted 1.013 at rho 0.8), so the sweeps grew and were
     // held: mean 94.6, largest 99.9987 (before the hold: mean 159 after one pass held and the
     // next not, or divergence).
@@ -640,7 +642,7 @@ TEST_SUITE("solver") {
                                          << " (exact 100), warnings " << sol.report().warnings.size());
     CHECK(sol.report().warnings.empty());  // not held
     CHECK(std::abs(mean - 100.0) < 0.1);
-    CHECK(largest < 101.0);
-    CHECK(smallest > 99.0);
+    CHECK(largest < 100.1);
+    CHECK(smallest > 99.9);
   }
 }
