@@ -47,6 +47,15 @@ constexpr int kFirstRays = 4;
 constexpr int kPenumbraRays = 12;
 constexpr int kMaxPureRays = 64;
 constexpr int kMaxPenumbraRays = 256;
+/// A link into a cluster casts a larger pilot when it carries more: kFirstRays x sqrt(bound /
+/// threshold) rays, at most this many. A pure pilot misses a shadow over a share f of the
+/// receiving members with probability (1 - f)^n, and then the link's light reaches the shadow
+/// too (the Cornell box's floor in the blocks' shadows: +30 % of its small direct light at
+/// 4 000 elements). Measured on the Cornell box at 16 679 elements, epsilon 0.05, seeds 1-4:
+/// the floor +0.51/+0.74/+0.32/+0.41 % -> +0.39/+0.54/+0.29/+0.22 %, the other groups within
+/// 0.05 % of before; the 22k city's link rays and element RMS unchanged (its links into
+/// clusters carry little).
+constexpr int kMaxClusterPilotRays = 16;
 /// Tries per wanted ray to find a pair of points that face each other (cluster surfaces face
 /// many ways); a link with no such pair in all its tries carries nothing.
 constexpr int kTriesPerRay = 8;
@@ -1069,7 +1078,13 @@ struct LinkHierarchy::Impl {
     // decision, so it is unbiased: deciding and estimating with the same rays would favour the
     // extremes (a pilot all clear or all blocked happens with probability V^n or (1 - V)^n).
     ShadowSampler shadows(*this, h, r, s);
-    const ShadowSampler::Result pilot = shadows.draw(kFirstRays, out.rays);
+    // Into a cluster, a pilot that misses a shadow over part of its members spreads the link's
+    // light over them alike (kMaxClusterPilotRays).
+    const int pilot_rays =
+        is_cluster(r) ? static_cast<int>(std::clamp(kFirstRays * std::sqrt(error.bound / rc.threshold), float{kFirstRays},
+                                                    float{kMaxClusterPilotRays}))
+                      : kFirstRays;
+    const ShadowSampler::Result pilot = shadows.draw(pilot_rays, out.rays);
     if (pilot.cast == 0) return;  // no facing pair found: nothing passes
     const bool partly_hidden = pilot.clear > 0 && pilot.clear < pilot.cast;
     // The estimate's rays: as many as make the visible fraction's standard error (at most
