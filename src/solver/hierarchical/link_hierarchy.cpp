@@ -511,19 +511,21 @@ struct LinkHierarchy::Impl {
 
   /// Element values from side values per unknown, then the clusters' sending moments.
   void node_values(const PatchHierarchy& hierarchy, const RadiositySystem& sys, const std::vector<Rgb>& B,
-                   Values& v) const {
+                   Values& v, bool with_max = false) const {
     const std::size_t count = hierarchy.elements().size();
     v.front.assign(count, Rgb(0.0f));
     v.back.assign(sys.has_backs() ? count : 0, Rgb(0.0f));
     for (std::size_t u = 0; u < sys.unknowns(); ++u) (u < sys.fronts() ? v.front : v.back)[sys.element(u)] = B[u];
-    leaf_values(hierarchy, v, true);
+    leaf_values(hierarchy, v, true, with_max);
   }
   /// The rest of node_values() from the leaves' values already in v.front and v.back. With
   /// `open`, the leaves' values are their open parts' (side_exposures()) and each inner
   /// element takes its children's mean weighted by their open area: the links' factors see a
   /// source's buried part as hidden, so a source sends its open part's radiosity. Without, area
   /// means (the balancing's unit values).
-  void leaf_values(const PatchHierarchy& hierarchy, Values& v, bool open = false) const {
+  /// With `with_max`, also Values::cluster_max (only gather()'s hold reads it: 12 bytes a
+  /// cluster not held through the sweeps otherwise).
+  void leaf_values(const PatchHierarchy& hierarchy, Values& v, bool open = false, bool with_max = false) const {
     if (open && any_buried) {
       aggregate_open(hierarchy, v.front, [&](std::uint32_t e) { return leaf_exposure(e, false); });
       if (!v.back.empty()) aggregate_open(hierarchy, v.back, [&](std::uint32_t e) { return leaf_exposure(e, true); });
@@ -539,6 +541,10 @@ struct LinkHierarchy::Impl {
     }
     sending_moments(tree, hierarchy, bases, patch_front, patch_back, threads, v.sending);
     pull_offsets(hierarchy, v);
+    if (!with_max) {
+      std::vector<Rgb>().swap(v.cluster_max);
+      return;
+    }
     v.cluster_max.assign(tree.nodes().size(), Rgb(0.0f));
     for (std::uint32_t c = cluster_count(); c-- > 0;) {  // children after parents
       const ClusterNode& node = tree.node(c);
@@ -2064,6 +2070,7 @@ struct LinkHierarchy::Impl {
     const std::uint32_t elements = linked_elements;
     RADIOSITY_ASSERT(hierarchy.elements().size() == elements);
     const std::uint32_t C = cluster_count();
+    RADIOSITY_ASSERT(!hold || v.cluster_max.size() == C);
     std::vector<Moments> received(C, Moments{});
     front.assign(elements, Rgb(0.0f));
     back.assign(backs ? elements : 0, Rgb(0.0f));
@@ -2396,7 +2403,7 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
   std::vector<Rgb> scaled;  // result.B as sent (Impl::sent())
   for (int it = 1; it <= max_iterations; ++it) {
     const std::vector<Rgb>& B_sent = m.sent(sys, result.B, scaled);
-    m.node_values(ctx.hierarchy, sys, B_sent, values);
+    m.node_values(ctx.hierarchy, sys, B_sent, values, hold);
     m.gather(ctx.hierarchy, sys, values, result.H, hold);
     if (hold) Impl::cap_delivered_power(sys, result.B, result.H);
     Impl::to_open(result.H, result.exposure);
@@ -2432,7 +2439,7 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
   if (!impl_->linked) return H;
   Impl::Values values;
   std::vector<Rgb> scaled;
-  impl_->node_values(hierarchy, system, impl_->sent(system, B, scaled), values);
+  impl_->node_values(hierarchy, system, impl_->sent(system, B, scaled), values, hold);
   impl_->gather(hierarchy, system, values, H, hold);
   if (hold) Impl::cap_delivered_power(system, B, H);
   Impl::to_open(H, impl_->side_exposures(system));
