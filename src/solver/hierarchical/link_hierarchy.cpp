@@ -592,7 +592,8 @@ struct LinkHierarchy::Impl {
         const std::uint32_t p = tree.order()[node.first];
         const Patch& patch = h.patches()[p];
         const float front = std::max(0.0f, mean(v.front[patch.root])) * element_exposure(patch.root, false);
-        const float back = v.back.empty() || !has_back[p] ? 0.0f : std::max(0.0f, mean(v.back[patch.root])) * element_exposure(patch.root, true);
+        const float back =
+            v.back.empty() || !has_back[p] ? 0.0f : std::max(0.0f, mean(v.back[patch.root])) * element_exposure(patch.root, true);
         power[c] = (front + back) * patch.area;
         glm::vec3 offset(0.0f);
         if (!v.pull_front.empty() && front + back > 0.0f)
@@ -1917,7 +1918,8 @@ struct LinkHierarchy::Impl {
   /// each delivers from unit radiosity) keeps the source's delivered power, to first order,
   /// and with it what the balancing fitted. In an open scene part of what the pull changes is
   /// real (a bright spot nearer an opening sends more out of it), so a source's mean is taken
-  /// off in proportion to its enclosed area. Without this, the furnace of reflectance 0.99 came
+  /// off in proportion to the share of its power that leaves enclosed sides (of its area where
+  /// it sends nothing yet). Without this, the furnace of reflectance 0.99 came
   /// out at 99.57 instead of 100 (the balancing's scales no longer held). One serial pass over
   /// the links (the same sums at any thread count); the weights and the sources' directional
   /// factors are taken from area, not from the radiosity.
@@ -1955,8 +1957,8 @@ struct LinkHierarchy::Impl {
         area[c] = static_cast<double>(patch.area) * sides;
         for (int side = 0; side < sides; ++side) {
           const float q = share[C + 2 * std::size_t{patch.root} + static_cast<std::size_t>(side)];
-          const double p_side =
-              static_cast<double>(patch.area) * (side == 1 && values.back.empty() ? 0.0f : std::max(0.0f, mean((side == 0 ? values.front : values.back)[patch.root])));
+          const std::vector<Rgb>& value = side == 0 ? values.front : values.back;
+          const double p_side = value.empty() ? 0.0 : static_cast<double>(patch.area) * std::max(0.0f, mean(value[patch.root]));
           enclosed_area[c] += static_cast<double>(patch.area) * q;
           power[c] += p_side;
           enclosed_power[c] += p_side * q;
