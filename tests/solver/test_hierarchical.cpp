@@ -288,9 +288,10 @@ TEST_SUITE("solver") {
     // mean radiosity from its visible half too, an error of the reference of up to 40 % on the
     // leaves next to the blocks (measured). The group means averaged over four seeds (one seed's
     // scatter by about 1 %, which hid the bias); measured worst group and channel at 100 mm
-    // elements: 0.91 % at epsilon 0.05 (the ceiling), 0.50 % at 0.005 (the ceiling; session 24,
-    // the linear pull; session 22, after the oracle near grazing and the linear push, 0.91 % and
-    // 0.86 %; before them 1.04 % and 0.97 %). The goal is 0.5 % at 16 000 elements
+    // elements: 0.69 % at epsilon 0.05 (the ceiling), 0.31 % at 0.005 (the tall block; session
+    // 24, the linear pull and the centroid rule's curvature correction for far element pairs;
+    // with the pull alone 0.91 % and 0.50 %; session 22, after the oracle near grazing and the
+    // linear push, 0.91 % and 0.86 %; before them 1.04 % and 0.97 %). The goal is 0.5 %
     // (docs/HIERARCHICAL.md, "Where it stands").
     const rad::Scene scene = rad::cornell_box();
     const rad::Solution gs = gauss_seidel_reference(scene, 10000.0f);  // 100 mm
@@ -304,7 +305,7 @@ TEST_SUITE("solver") {
         CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
       }
       // The open front lets out about 31 % of the light in both.
-      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.012 : 0.007, 0.01);
+      check_agreement(scene, gs, seeds, eps > 0.01f ? 0.009 : 0.005, 0.01);
     }
   }
 
@@ -315,12 +316,13 @@ TEST_SUITE("solver") {
     // elements every group came out 6-15 % too bright (the back wall +13.9 %, the green wall
     // +15.3 %) and the upright box's blocks 8 % (measured, session 19). With one moment per
     // direction a cluster faces (MomentBasis), measured: worst group 0.92 % turned, 0.99 %
-    // upright (the short block); with the linear pull (session 24) 0.60 % and 0.64 % (the ceiling).
+    // upright (the short block); with the linear pull (session 24) 0.60 % and 0.64 % (the ceiling),
+    // and the centroid rule's curvature correction 0.44 % and 0.46 %.
     for (const float degrees : {0.0f, 30.0f}) {
       CAPTURE(degrees);
       const rad::Scene scene = test::turned_about_y(rad::cornell_box(), degrees, glm::vec3(278.0f, 0.0f, 280.0f));
       const rad::Solution gs = gauss_seidel_reference(scene, 2500.0f);  // 50 mm
-      check_agreement(scene, gs, hierarchical_on(scene, 2500.0f, 0.05f), 0.009, 0.005);
+      check_agreement(scene, gs, hierarchical_on(scene, 2500.0f, 0.05f), 0.0065, 0.005);
     }
   }
 

@@ -849,7 +849,7 @@ struct LinkHierarchy::Impl {
 
   /// Element-to-element factor: the point-to-polygon closed form from receiver points to the
   /// source element, averaged over an n x n grid of area-uniform cells of the receiver (n = 1:
-  /// its centroid), 0 at points behind the source's side.
+  /// its centroid, with a curvature correction), 0 at points behind the source's side.
   static float element_factor(const PatchHierarchy& h, NodeHandle r, NodeHandle s, int n) {
     const std::uint32_t re = element_of(r);
     const Element& es = h.element(element_of(s));
@@ -861,11 +861,33 @@ struct LinkHierarchy::Impl {
       return point_to_polygon_factor_fast(x, nr, polygon.data(), es.corner_count());
     };
     const Element& er = h.element(re);
-    if (n == 1) return at(er.centroid);
+    const float centre = n == 1 ? at(er.centroid) : 0.0f;
+    if (n == 1 && !(centre > 0.0f)) return centre;
     // PatchHierarchy::sample_point()'s warp, set up once for the n x n points rather than per point.
     std::array<glm::vec3, 4> receiver{};
     for (int k = 0; k < er.corner_count(); ++k) receiver[static_cast<std::size_t>(k)] = h.vertices()[er.corners[k]];
     const CellSampler cell(receiver.data(), er.corner_count());
+    if (n == 1) {
+      // The centroid rule overestimates where the factor is concave over the receiver (it
+      // peaks toward the source): corrected by the point-to-point kernel's mean over the
+      // receiver's four quarter-cell centres against its value at the centroid, a few
+      // multiplications each. Measured on the Cornell box at 248 elements (patches = elements,
+      // which nothing splits), against Gauss-Seidel over ray-cast rows at epsilon 0.005: the
+      // ceiling +0.34 % -> +0.07 %, the green wall +0.37 % -> +0.15 % (at 0.05, over four
+      // seeds, the worst group 0.91 % -> about 0.5 %); the 22k city and the Cornell box at
+      // 16 679 elements within 0.03 % of before.
+      auto kernel = [&](const glm::vec3& x) {
+        const glm::vec3 u = es.centroid - x;
+        const float d2 = glm::dot(u, u);
+        return std::max(0.0f, glm::dot(nr, u)) * std::max(0.0f, -glm::dot(ns, u)) / (d2 * d2);
+      };
+      const float kc = kernel(er.centroid);
+      if (!(kc > 0.0f)) return centre;
+      float mean4 = 0.0f;
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) mean4 += kernel(cell(glm::vec2(0.25f + 0.5f * static_cast<float>(i), 0.25f + 0.5f * static_cast<float>(j))));
+      return centre * std::clamp(0.25f * mean4 / kc, 0.5f, 2.0f);
+    }
     float sum = 0.0f;
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j)
