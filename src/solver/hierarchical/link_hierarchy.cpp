@@ -1925,10 +1925,17 @@ struct LinkHierarchy::Impl {
     // factor by less than kPullMinOffset.
     const float r_s = radius(h, s);
     if (!(glm::dot(offset, offset) >= kPullMinOffset * kPullMinOffset * r_s * r_s)) return 1.0f;
-    glm::vec3 gradient = -irradiance_slope(cr, glm::vec3(0.0f), directional_q(h, nullptr, r, -w), cs,
-                                           directional_q(h, &v, s, w), r_s);
+    glm::vec3 gradient = pull_gradient(h, &v, r, cr, s, cs, w, r_s);
     if (!pull_mean.empty()) gradient -= pull_mean[source_slot(s)];
     return std::clamp(1.0f + glm::dot(gradient, offset), kPullLow, kPullHigh);
+  }
+  /// grad_y ln K of the link (r <- s) at the source's centroid `cs` (pull_factor()), at most
+  /// 1 / `radius_s` long; the source's directional factor from `sending` moments (its area
+  /// moments when null).
+  glm::vec3 pull_gradient(const PatchHierarchy& h, const Values* sending, NodeHandle r, const glm::vec3& cr,
+                          NodeHandle s, const glm::vec3& cs, const glm::vec3& w, float radius_s) const {
+    return -irradiance_slope(cr, glm::vec3(0.0f), directional_q(h, nullptr, r, -w), cs, directional_q(h, sending, s, w),
+                             radius_s);
   }
   std::size_t source_slot(NodeHandle s) const {
     return is_cluster(s) ? handle_index(s) : cluster_count() + 2 * std::size_t{element_of(s)} + (is_back(s) ? 1 : 0);
@@ -2024,9 +2031,7 @@ struct LinkHierarchy::Impl {
           weight *= h.element(element_of(r)).area;
         }
         if (!(weight > 0.0)) continue;
-        const glm::vec3 gradient = -irradiance_slope(cr, glm::vec3(0.0f), directional_q(h, nullptr, r, -w), cs,
-                                                     directional_q(h, nullptr, s, w), radius(h, s));
-        sum_gradient[slot] += weight * glm::dvec3(gradient);
+        sum_gradient[slot] += weight * glm::dvec3(pull_gradient(h, nullptr, r, cr, s, cs, w, radius(h, s)));
         sum_weight[slot] += weight;
       }
     }
