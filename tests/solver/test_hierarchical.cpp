@@ -619,7 +619,8 @@ TEST_SUITE("solver") {
   TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to E / (1 - rho) on every leaf") {
     // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
     // Balanced (every side of the closed box delivers what it sends and gathers 1 from uniform
-    // radiosity): measured mean 99.9924, leaves 99.992-99.994 with the linear pull (session 24;
+    // radiosity): measured mean 99.988, leaves 99.9875-99.990 (session 24's end; 99.9924,
+    // 99.992-99.994 with the linear pull alone;
     // before it 99.9992, 99.92-100.41; with the linear push's shares left out of the balancing's
     // adjoint, the mean was 99.38; with the pull but without its power keeping, 99.57). Before the balancing the links
     // gained about 1 % here (absorbed / emitted 1.013 at rho 0.8), so the sweeps grew and were
