@@ -412,6 +412,87 @@ TEST_CASE("Assimp broken 3DS: an animation track whose key count its chunk canno
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.3ds").polygons().size() > 0);
 }
 
+TEST_CASE("Assimp broken PLY: a list count its line or file cannot hold - headers Assimp would read shifted") {
+  // Found by radiosity_fuzz_ply (session 25, 30 s into a fresh corpus): a face whose ASCII list
+  // count is 4444444444444444444444444444440, in a 219-byte file; Assimp 5.2 reserved for it
+  // before reading an item (7.5 GB and 15 s in `radiosity check`, then "Vertices should be
+  // declared before faces").
+  const Error e = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "ply" / "face_list_count.ply");
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "face_list_count.ply:6: PLY element 'face' 0: a list of 4.44444e+32 items, but its line "
+                           "holds 2 values after the count (a corrupted file or a wrong count)"));
+  // A minute later the same from a face count after an element line with NUL bytes in it
+  // (Assimp ends a line at a NUL, so it dropped that element and read the face from the line
+  // that was the first vertex's).
+  const Error nul = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "ply" / "header_nul_bytes.ply");
+  CHECK(contains(nul.what(), "header_nul_bytes.ply:3: the PLY header holds the byte 0x00 (column 23), which no PLY "
+                             "header has (a corrupted or cut file)"));
+
+  // The square: its face's count 4 made 40000, and 4.5; the face over two lines (Assimp reads
+  // an ASCII element from one line, and its items as zeros).
+  std::string ascii = kPly;
+  ascii.replace(ascii.find("4 0 1 2 3"), 1, "40000");
+  CHECK(contains(load_error(write("list_count.ply", ascii)).what(),
+                 "list_count.ply:15: PLY element 'face' 0: a list of 40000 items, but its line holds 4 values after the "
+                 "count (a corrupted file or a wrong count)"));
+  std::string fraction = kPly;
+  fraction.replace(fraction.find("4 0 1 2 3"), 1, "4.5");
+  CHECK(contains(load_error(write("list_fraction.ply", fraction)).what(),
+                 "list_fraction.ply:15: PLY element 'face' 0: the list count '4.5' is not a number of items"));
+  std::string split = kPly;
+  split.replace(split.find("4 0 1 2 3"), 9, "4 0 1\n2 3");
+  CHECK(contains(load_error(write("list_split.ply", split)).what(),
+                 "list_split.ply:15: PLY element 'face' 0: a list of 4 items, but its line holds 2 values"));
+  // Binary: the count type made uint; the second face's count 4e9.
+  std::string binary = binary_ply();
+  binary.replace(binary.find("list uchar int"), 14, "list uint int");
+  const std::size_t first_face = binary.find("end_header\n") + 11 + 48;
+  const std::uint32_t three = 3, huge = 4000000000u;
+  binary.replace(first_face, 1, reinterpret_cast<const char*>(&three), 4);
+  binary.replace(first_face + 16, 1, reinterpret_cast<const char*>(&huge), 4);
+  const std::string three_bytes(reinterpret_cast<const char*>(&three), 4);
+  CHECK(load(write("list_uint.ply", binary.substr(0, first_face + 16) + three_bytes + binary.substr(first_face + 20)))
+            .polygons()
+            .size() == 2);
+  CHECK(contains(load_error(write("list_huge.ply", binary)).what(),
+                 "list_huge.ply: PLY element 'face' 1: a list of 4000000000 items at byte " + std::to_string(first_face + 16) +
+                     ", but the file holds 12 bytes after it"));
+
+  // Headers that Assimp 5.2 reads otherwise than they say (each loaded as no triangles, or
+  // degenerate ones, before): a line that is no PLY header line between the properties (it
+  // dropped y and z), a property after such a line, an element it does not know before the
+  // vertices (it read that element's values as vertices).
+  std::string bogus = kPly;
+  bogus.insert(bogus.find("property float y"), "bogus line\n");
+  CHECK(contains(load_error(write("bogus.ply", bogus)).what(),
+                 "bogus.ply:6: 'bogus' begins no PLY header line (ply, format, comment, obj_info, element, property, "
+                 "end_header)"));
+  std::string orphan = kPly;
+  orphan.insert(orphan.find("element vertex"), "property float w\n");
+  CHECK(contains(load_error(write("orphan.ply", orphan)).what(),
+                 "orphan.ply:4: a PLY property line that does not follow an element's line or its properties"));
+  std::string unknown = kPly;
+  unknown.insert(unknown.find("element vertex"), "element color 2\nproperty float red\n");
+  unknown.insert(unknown.find("end_header\n") + 11, "1\n0.5\n");
+  CHECK(contains(load_error(write("unknown_first.ply", unknown)).what(),
+                 "unknown_first.ply:4: PLY element 'color' comes before the vertices or faces"));
+  // What exporters write still loads: comments (a texture's among them), obj_info, an element
+  // of its own after the faces, Windows line ends, a blank line after the header. A type name
+  // in upper case is refused (Assimp 5.2 reads none: "Vertices should be declared before faces").
+  std::string usual = kPly;
+  usual.insert(usual.find("element vertex"), "comment TextureFile wood.png\nobj_info scanned\n");
+  usual.replace(usual.find("end_header\n"), 11, "element color 1\nproperty float red\nend_header\n\n");
+  usual += "0.5\n";
+  CHECK(load(write("usual.ply", usual)).polygons().size() == 2);
+  std::string crlf;
+  for (const char c : std::string(kPly)) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  CHECK(load(write("crlf.ply", crlf)).polygons().size() == 2);
+  std::string upper = kPly;
+  upper.replace(upper.find("property float x"), 16, "property FLOAT x");
+  CHECK(contains(load_error(write("upper.ply", upper)).what(),
+                 "upper.ply:5: a PLY property of the type 'FLOAT', which is no PLY type"));
+}
+
 TEST_CASE("Assimp broken FBX: a text FBX Layer element without its index is refused before Assimp reads it") {
   // Found by radiosity_fuzz_fbx (session 23, in the README's test command's 10 s run): the
   // exported room with one `Layer: 0 {` made `Layer:   {`. Assimp 5.2's FBX reader takes the

@@ -29,11 +29,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -65,7 +67,8 @@ std::string number_text(double v) {
   return s.str();
 }
 
-/// The size in bytes of a PLY scalar type (char, uchar, ..., float64), 0 for an unknown name.
+/// The size in bytes of a PLY scalar type (char, uchar, ..., float64), 0 for another name
+/// (Assimp 5.2 does not read "FLOAT" either).
 std::size_t ply_type_size(const std::string& type) {
   if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
   if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
@@ -75,83 +78,350 @@ std::size_t ply_type_size(const std::string& type) {
   return 0;
 }
 
-/// What Assimp 5.2's PLY reader trusts and should not, looked at first:
-/// - a header that ends before its end_header line (a truncated file) makes it loop forever, so
-///   "end_header" must be on a line of its own within the first MiB;
-/// - it allocates what the element counts ask for before reading them, so a count of four
-///   billion in a 1 kB file is an allocation of tens of GB: the counts are checked against the
-///   file's size (each element needs at least its fixed-size properties in a binary file, two
-///   characters per property in an ASCII one, but the last), and a file too short for its header is refused
-///   with both figures.
-void check_ply_header(const fs::path& path) {
-  // The header is within the first megabyte (or the file is refused); no more is read, and no
-  // more than the file holds is allocated.
-  std::error_code size_error;
-  const std::uintmax_t size = fs::file_size(path, size_error);
-  std::ifstream in(path, std::ios::binary);
-  std::string head(size_error ? std::size_t{1} << 20 : static_cast<std::size_t>(std::min<std::uintmax_t>(size, 1u << 20)), '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  std::size_t body = std::string::npos;  // offset of the first byte after the header
-  for (std::size_t at = head.find("end_header"); at != std::string::npos; at = head.find("end_header", at + 1)) {
-    const bool line_start = at > 0 && (head[at - 1] == '\n' || head[at - 1] == '\r');
-    std::size_t end = at + 10;
-    if (line_start && end < head.size() && (head[end] == '\n' || head[end] == '\r' || head[end] == ' ')) {
-      while (end < head.size() && head[end] != '\n') ++end;
-      body = end + 1;
-      break;
-    }
-  }
-  if (body == std::string::npos)
-    throw Error(ErrorCode::parse_error, path.string() + ": the PLY header has no end_header line (a truncated file?)");
+/// A property of a PLY element: a scalar of `type` (`size` bytes), or a list whose count is a
+/// `type` and whose items are of `item_size` bytes.
+struct PlyProperty {
+  bool list = false;
+  std::string type;
+  std::size_t size = 0;
+  std::size_t item_size = 0;
+};
 
-  if (size_error) return;  // Assimp will say what is wrong
-  const double available = static_cast<double>(size) - static_cast<double>(std::min<std::uintmax_t>(body, size));
-  std::istringstream lines(head.substr(0, body));
+struct PlyElement {
+  std::string name;
+  std::size_t line = 0;  ///< of its header line
+  double count = 0.0;
+  std::vector<PlyProperty> properties;
+};
+
+/// A PLY header as Assimp 5.2's reader takes it, or refused where it would take it otherwise
+/// than its text says.
+struct PlyHeader {
+  bool binary = false, big_endian = false;
+  std::vector<PlyElement> elements;
+  std::size_t body = 0;       ///< the byte where Assimp starts the data
+  std::size_t body_line = 0;  ///< its line (ASCII)
+};
+
+/// Reads a file forwards from an offset, a buffer at a time (the PLY checks below).
+class ForwardReader {
+ public:
+  ForwardReader(const fs::path& path, std::size_t offset) : in_(path, std::ios::binary), offset_(offset) {
+    in_.seekg(static_cast<std::streamoff>(offset));
+  }
+  /// The next byte without taking it, or -1 at the end of the file.
+  int peek() {
+    if (at_ == end_ && !fill()) return -1;
+    return static_cast<unsigned char>(buffer_[at_]);
+  }
+  /// The next byte, or -1 at the end of the file.
+  int get() {
+    const int c = peek();
+    if (c >= 0) ++at_, ++offset_;
+    return c;
+  }
+  /// Skips n bytes; false when the file ends first.
+  bool skip(double n) {
+    while (n > 0.0) {
+      if (at_ == end_ && !fill()) return false;
+      const auto step = static_cast<std::size_t>(std::min(n, static_cast<double>(end_ - at_)));
+      at_ += step;
+      offset_ += step;
+      n -= static_cast<double>(step);
+    }
+    return true;
+  }
+  std::size_t offset() const { return offset_; }
+
+ private:
+  bool fill() {
+    in_.read(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    at_ = 0;
+    end_ = static_cast<std::size_t>(std::max<std::streamsize>(in_.gcount(), 0));
+    return end_ > 0;
+  }
+  std::ifstream in_;
+  std::vector<char> buffer_ = std::vector<char>(std::size_t{1} << 16);
+  std::size_t at_ = 0, end_ = 0, offset_ = 0;
+};
+
+/// Lines as Assimp 5.2's IOStreamBuffer::getNextLine() cuts them: at '\r' or '\n'; a line end
+/// at the start of a call is skipped through the next '\n' (so "\r\n" is one line end, and of
+/// two blank lines one is skipped and one is an empty line). The PLY reader parses an ASCII
+/// element instance from one such line, so the checks below walk the same lines.
+class PlyLines {
+ public:
+  PlyLines(ForwardReader& in, std::size_t line) : in_(in), line_(line) {}
+  /// The next line's text into `out`, its number into `number`; false at the end of the file.
+  bool next(std::string& out, std::size_t& number) {
+    int c = in_.peek();
+    if (c == '\r' || c == '\n') {
+      while ((c = in_.get()) >= 0 && c != '\n') {}
+      if (c == '\n') ++line_;
+    }
+    if (in_.peek() < 0) return false;
+    out.clear();
+    number = line_;
+    while ((c = in_.peek()) >= 0 && c != '\r' && c != '\n') out.push_back(static_cast<char>(in_.get()));
+    if (in_.get() == '\n') ++line_;
+    return true;
+  }
+
+ private:
+  ForwardReader& in_;
+  std::size_t line_;
+};
+
+/// The byte of a header or ASCII line that no PLY file holds (a control character other than
+/// tab; Assimp ends a line at NUL and form feed, so the line it reads would not be this one).
+std::size_t control_byte(const std::string& line) {
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const auto c = static_cast<unsigned char>(line[i]);
+    if ((c < 0x20 && c != '\t') || c == 0x7f) return i;
+  }
+  return std::string::npos;
+}
+
+/// Reads the header of a PLY file (refusing the forms Assimp 5.2 would read otherwise than
+/// they say: see check_ply()).
+PlyHeader read_ply_header(const fs::path& path) {
+  {
+    // A cut header first: its last line may look like anything.
+    std::ifstream file(path, std::ios::binary);
+    std::string head(std::size_t{1} << 20, '\0');
+    file.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(std::max<std::streamsize>(file.gcount(), 0)));
+    bool found = false;
+    for (std::size_t at = head.find("end_header"); at != std::string::npos && !found; at = head.find("end_header", at + 1))
+      found = at > 0 && (head[at - 1] == '\n' || head[at - 1] == '\r') && at + 10 < head.size() &&
+              (head[at + 10] == '\n' || head[at + 10] == '\r' || head[at + 10] == ' ' || head[at + 10] == '\t');
+    if (!found)
+      throw Error(ErrorCode::parse_error, path.string() + ": the PLY header has no end_header line (a truncated file?)");
+  }
+  ForwardReader in(path, 0);
+  PlyLines lines(in, 1);
+  PlyHeader header;
   std::string line;
-  bool binary = false;
-  struct Element {
-    std::string name;
-    double count = 0.0;
-    double min_bytes = 0.0;  // per element
+  std::size_t number = 0;
+  auto refuse = [&](const std::string& what) {
+    throw Error(ErrorCode::parse_error, path.string() + ":" + std::to_string(number) + ": " + what);
   };
-  std::vector<Element> elements;
-  while (std::getline(lines, line)) {
+  bool in_element = false;  // the lines since the last element line were its properties (or comments)
+  bool ended = false;
+  while (in.offset() < (std::size_t{1} << 20) && lines.next(line, number)) {
+    if (const std::size_t at = control_byte(line); at != std::string::npos) {
+      char code[8];
+      std::snprintf(code, sizeof code, "0x%02x", static_cast<unsigned>(static_cast<unsigned char>(line[at])));
+      refuse("the PLY header holds the byte " + std::string(code) + " (column " + std::to_string(at + 1) +
+             "), which no PLY header has (a corrupted or cut file)");
+    }
     std::istringstream words(line);
     std::string word;
-    words >> word;
+    if (!(words >> word)) continue;  // a blank line
+    if (word == "end_header") {
+      ended = true;
+      break;
+    }
+    if (number == 1 || word == "comment" || word == "obj_info") continue;  // line 1 is "ply" (Assimp checks it)
     if (word == "format") {
       std::string format;
       words >> format;
-      binary = format.rfind("binary", 0) == 0;
+      header.binary = format.rfind("binary", 0) == 0;
+      header.big_endian = format == "binary_big_endian";
+      in_element = false;
     } else if (word == "element") {
-      Element e;
-      std::string count;
+      PlyElement e;
+      std::string count, extra;
       words >> e.name >> count;
       char* end = nullptr;
       e.count = std::strtod(count.c_str(), &end);
-      if (count.empty() || *end != '\0' || !(e.count >= 0.0))
-        throw Error(ErrorCode::parse_error, path.string() + ": PLY element '" + e.name + "' has the count '" + count +
-                                                "', not a number of elements");
-      elements.push_back(e);
-    } else if (word == "property" && !elements.empty()) {
-      std::string type;
+      e.line = number;
+      if (count.empty() || *end != '\0' || !(e.count >= 0.0) || e.count != std::floor(e.count) || (words >> extra))
+        refuse("PLY element '" + e.name + "' has the count '" + count + "', not a number of elements");
+      header.elements.push_back(e);
+      in_element = true;
+    } else if (word == "property") {
+      // Assimp attaches only the properties that follow their element's line (comments
+      // between them); one after another line it drops, and reads the data without it.
+      if (!in_element) refuse("a PLY property line that does not follow an element's line or its properties");
+      std::string type, name;
       words >> type;
-      if (type == "list") words >> type;  // a list needs at least its count
-      elements.back().min_bytes += binary ? static_cast<double>(std::max<std::size_t>(ply_type_size(type), 1)) : 2.0;
+      PlyProperty property;
+      if (type == "list") {
+        std::string item;
+        words >> type >> item;
+        property.list = true;
+        property.item_size = ply_type_size(item);
+        if (property.item_size == 0) refuse("PLY list items of the type '" + item + "', which is no PLY type");
+      }
+      property.type = type;
+      property.size = ply_type_size(type);
+      if (property.size == 0) refuse("a PLY property of the type '" + type + "', which is no PLY type");
+      if (!(words >> name)) refuse("a PLY property without a name");
+      header.elements.back().properties.push_back(property);
+    } else {
+      refuse("'" + word + "' begins no PLY header line (ply, format, comment, obj_info, element, property, end_header)");
     }
   }
+  if (!ended)
+    throw Error(ErrorCode::parse_error,
+                path.string() + ": the PLY header has no end_header line (a truncated file?)");
+  header.body = in.offset();
+  header.body_line = number + 1;
+  // Assimp 5.2 does not know elements other than these, reads no data for them and goes on
+  // with the next element's: one before the faces shifts every vertex or face after it.
+  bool faces_after = false;
+  for (std::size_t k = header.elements.size(); k-- > 0;) {
+    const PlyElement& e = header.elements[k];
+    const bool known = e.name == "vertex" || e.name == "face" || e.name == "tristrips" || e.name == "edge" ||
+                       e.name == "material";
+    if (!known && faces_after && e.count > 0.0) {
+      number = e.line;
+      refuse("PLY element '" + e.name + "' comes before the vertices or faces, and the PLY reader (Assimp 5.2) "
+             "cannot skip an element it does not know: it would read its values as theirs. Put it after them");
+    }
+    faces_after |= e.name == "vertex" || e.name == "face" || e.name == "tristrips";
+  }
+  return header;
+}
+
+/// Refuses a PLY file that Assimp 5.2's reader would take otherwise than it says, loop on, or
+/// allocate for beyond what the file can hold, before Assimp opens it:
+/// - a header that does not end (a truncated file) makes it loop forever: "end_header" must
+///   come within the first MiB;
+/// - a header line that is none of PLY's, a control byte in it, a property after a line that
+///   is not its element's, or an element it does not know before the faces: it would read the
+///   data shifted (vertices and faces from the wrong values);
+/// - it allocates what the element counts ask for before reading them (a count of four
+///   billion in a 1 kB file is tens of GB): each element needs at least its fixed-size
+///   properties in a binary file, two characters per property in an ASCII one (but the last);
+/// - it reserves a list's count before reading its items: an ASCII face whose count was
+///   4444444444444444444444444444440 (radiosity_fuzz_ply, session 25) took 7.5 GB and 15 s from
+///   a 219-byte file. An ASCII element is one line for Assimp, so a list's items must be on its
+///   line (a NUL there ends the line for Assimp: refused too); in a binary file they must fit in
+///   the bytes left.
+void check_ply(const fs::path& path) {
+  const PlyHeader header = read_ply_header(path);
+  std::error_code size_error;
+  const std::uintmax_t size = fs::file_size(path, size_error);
+  if (size_error) return;  // Assimp will say what is wrong
+  const double available = static_cast<double>(size) - static_cast<double>(std::min<std::uintmax_t>(header.body, size));
   double needed = 0.0;
-  for (const Element& e : elements) needed += e.count * e.min_bytes;
-  if (!binary && needed > 0.0) needed -= 1.0;  // the last value may end the file without a separator
+  for (const PlyElement& e : header.elements) {
+    double per = 0.0;
+    for (const PlyProperty& p : e.properties) per += header.binary ? static_cast<double>(p.size) : 2.0;
+    needed += e.count * per;
+  }
+  if (!header.binary && needed > 0.0) needed -= 1.0;  // the last value may end the file without a separator
+  auto whole = [](double v) { return v < 1e19 ? std::to_string(static_cast<std::uint64_t>(v)) : number_text(v); };
   if (needed > available) {
     // Whole numbers in full (a count of 4000000000, not 4e+09), however large.
-    auto whole = [](double v) { return v < 1e19 ? std::to_string(static_cast<std::uint64_t>(v)) : number_text(v); };
     std::string counts;
-    for (const Element& e : elements) counts += (counts.empty() ? "" : ", ") + whole(e.count) + " " + e.name;
+    for (const PlyElement& e : header.elements) counts += (counts.empty() ? "" : ", ") + whole(e.count) + " " + e.name;
     throw Error(ErrorCode::parse_error, path.string() + ": the PLY header declares " + counts + ", which need at least " +
                                             whole(needed) + " bytes, but the file holds " + whole(available) +
                                             " after its header (a truncated file or a wrong count)");
+  }
+
+  bool any_list = false;
+  for (const PlyElement& e : header.elements)
+    for (const PlyProperty& p : e.properties) any_list |= p.list;
+  if (!any_list) return;
+  ForwardReader in(path, header.body);
+  if (header.binary) {
+    for (const PlyElement& e : header.elements) {
+      bool lists = false;
+      double fixed = 0.0;
+      for (const PlyProperty& p : e.properties) {
+        lists |= p.list;
+        fixed += static_cast<double>(p.size);
+      }
+      if (!lists) {  // every instance of the same size: no walk
+        if (!in.skip(e.count * fixed)) return;
+        continue;
+      }
+      for (double k = 0.0; k < e.count; k += 1.0)
+        for (const PlyProperty& p : e.properties) {
+          if (!p.list) {
+            if (!in.skip(static_cast<double>(p.size))) return;  // a short body is Assimp's to report
+            continue;
+          }
+          const std::size_t at = in.offset();
+          unsigned char bytes[8] = {};
+          for (std::size_t b = 0; b < p.size; ++b) {
+            const int c = in.get();
+            if (c < 0) return;
+            bytes[header.big_endian ? p.size - 1 - b : b] = static_cast<unsigned char>(c);
+          }
+          const std::string& t = p.type;
+          double count = 0.0;
+          if (t == "float" || t == "float32") {
+            float f;
+            std::memcpy(&f, bytes, 4);
+            count = f;
+          } else if (t == "double" || t == "float64") {
+            std::memcpy(&count, bytes, 8);
+          } else {
+            std::uint64_t u = 0;
+            for (std::size_t b = 0; b < p.size; ++b) u |= static_cast<std::uint64_t>(bytes[b]) << (8 * b);
+            const bool is_signed = t == "char" || t == "int8" || t == "short" || t == "int16" || t == "int" || t == "int32";
+            count = is_signed && (bytes[p.size - 1] & 0x80u) ? -1.0 : static_cast<double>(u);
+          }
+          const std::string where = path.string() + ": PLY element '" + e.name + "' " + whole(k) + ": ";
+          if (!(count >= 0.0 && count == std::floor(count)))
+            throw Error(ErrorCode::parse_error, where + "a list count of " + number_text(count) + " at byte " +
+                                                    std::to_string(at) + ", not a number of items (a corrupted file)");
+          const double left = static_cast<double>(size) - static_cast<double>(in.offset());
+          if (count * static_cast<double>(p.item_size) > left)
+            throw Error(ErrorCode::parse_error, where + "a list of " + whole(count) + " items at byte " +
+                                                    std::to_string(at) + ", but the file holds " + whole(left) +
+                                                    " bytes after it (a corrupted file or a wrong count)");
+          if (!in.skip(count * static_cast<double>(p.item_size))) return;
+        }
+    }
+    return;
+  }
+  // ASCII: one line per element instance, values separated by spaces and tabs.
+  PlyLines lines(in, header.body_line);
+  std::string line;
+  std::size_t number = 0;
+  std::vector<std::string_view> values;
+  for (const PlyElement& e : header.elements) {
+    const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.list; });
+    for (double k = 0.0; k < e.count; k += 1.0) {
+      if (!lines.next(line, number)) return;  // a short body is Assimp's to report
+      if (!lists) continue;
+      const std::string where = path.string() + ":" + std::to_string(number) + ": PLY element '" + e.name + "' " + whole(k) + ": ";
+      if (const std::size_t at = control_byte(line); at != std::string::npos)
+        throw Error(ErrorCode::parse_error, where + "a control byte (column " + std::to_string(at + 1) +
+                                                ") in ASCII data (a corrupted or binary file)");
+      values.clear();
+      for (std::size_t i = 0; i < line.size();) {
+        while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+        const std::size_t start = i;
+        while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+        if (i > start) values.emplace_back(line.data() + start, i - start);
+      }
+      std::size_t v = 0;
+      for (const PlyProperty& p : e.properties) {
+        if (v >= values.size()) break;  // a short line is Assimp's to read (as zeros)
+        if (!p.list) {
+          ++v;
+          continue;
+        }
+        const std::string count_text(values[v++]);
+        char* end = nullptr;
+        const double count = std::strtod(count_text.c_str(), &end);
+        if (*end != '\0' || !(count >= 0.0) || count != std::floor(count))
+          throw Error(ErrorCode::parse_error, where + "the list count '" + count_text.substr(0, 40) +
+                                                  "' is not a number of items");
+        const double left = static_cast<double>(values.size() - v);
+        if (count > left)
+          throw Error(ErrorCode::parse_error, where + "a list of " + whole(count) + " items, but its line holds " +
+                                                  whole(left) + " values after the count (a corrupted file or a wrong count)");
+        v += static_cast<std::size_t>(count);
+      }
+    }
   }
 }
 
@@ -858,7 +1128,7 @@ Scene load_assimp(const fs::path& path, const LoadOptions& options) {
   if (!fs::is_regular_file(path, ec))
     throw Error(ErrorCode::file_not_found, "load_scene: cannot open model file '" + path.string() +
                                                (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
-  if (lower_extension(path) == ".ply") check_ply_header(path);
+  if (lower_extension(path) == ".ply") check_ply(path);
   if (lower_extension(path) == ".dae") check_collada(path);
   if (lower_extension(path) == ".3ds") check_3ds_tracks(path);
   if (lower_extension(path) == ".fbx") check_fbx_text(path);
