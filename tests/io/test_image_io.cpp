@@ -148,6 +148,34 @@ TEST_CASE("read_exr errors name the path: missing file - not an EXR - truncated 
   CHECK(contains(no_rgb.what(), "Y"));
 }
 
+TEST_CASE("read_exr refuses a data window its file cannot hold before allocating it - a flat image at ZIP's best ratio reads") {
+  // cornell_path_64.exr (64 x 64, ZIP, 48 KB) with its dataWindow made 20 000 x 20 000: read_exr
+  // asked for 4.8 GB before OpenEXR found the pixels missing (found in session 25 by looking at
+  // the fuzz target's profile: its time went to allocating and zeroing such images).
+  std::ifstream in(kData / "cornell_path_64.exr", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+  const std::size_t at = bytes.find(key);
+  REQUIRE(at != std::string::npos);
+  const std::int32_t window[4] = {0, 0, 19999, 19999};
+  bytes.replace(at + key.size() + 4, 16, reinterpret_cast<const char*>(window), 16);
+  fs::create_directories(kTmp);
+  std::ofstream(kTmp / "huge_window.exr", std::ios::binary) << bytes;
+  const Error e = error_of([] { radiosity::read_exr(kTmp / "huge_window.exr"); });
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "huge_window.exr': its 20000 x 20000 data window (4.8e+09 bytes of pixels) cannot be in a "
+                           "file of " + std::to_string(bytes.size()) + " bytes, even at its compression's best ratio (4096 : 1)"));
+  // What compresses best, a flat image (one value everywhere), still reads: ZIP stores these
+  // 2048 x 2048 FLOAT pixels (48 MiB) in well under a thousandth of that.
+  Image flat(2048, 2048);
+  for (Rgb& p : flat.pixels) p = Rgb(0.25f);
+  radiosity::write_exr(flat, kTmp / "flat.exr");
+  CHECK(fs::file_size(kTmp / "flat.exr") * 400 < 2048u * 2048u * 12u);
+  const Image back = radiosity::read_exr(kTmp / "flat.exr");
+  CHECK(back.width == 2048);
+  CHECK(back.pixels[2048 * 1000 + 7].y == 0.25f);
+}
+
 TEST_CASE("write_exr errors name the path: unwritable location - inconsistent image") {
   const fs::path bad = kTmp / "no_such_dir" / "out.exr";
   Error unwritable = error_of([&] { radiosity::write_exr(test_image(), bad); });

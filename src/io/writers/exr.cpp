@@ -3,14 +3,18 @@
 // compositors and viewers understand). FLOAT channels keep the solver's values bit-exact;
 // OpenEXR's exceptions become radiosity::Error naming the path.
 #include <ImfChannelList.h>
+#include <ImfCompression.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <fstream>
 #include <set>
@@ -101,6 +105,52 @@ void check_exr_header(const std::filesystem::path& path) {
   }
 }
 
+/// The most a compression can shrink pixel data (raw bytes over stored bytes), with room to
+/// spare: zlib's deflate at best about 1032 : 1 (ZIP, ZIPS, PXR24 after its rounding), PIZ's
+/// Huffman runs (at most 255 repeats of a 16-bit symbol per code) about 450 : 1, RLE 64 : 1
+/// (128 bytes in 2), B44 32 : 3 (a flat 4 x 4 block of halves); DWAA/DWAB compress each 8 x 8
+/// block's coefficients with run lengths and then zlib, so a flat image can reach some
+/// 30 000 : 1, and a compression this reader does not know gets the same.
+double max_compression_ratio(Imf::Compression c) {
+  switch (c) {
+    case Imf::NO_COMPRESSION: return 1.0;
+    case Imf::RLE_COMPRESSION: return 128.0;
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION: return 64.0;
+    case Imf::ZIPS_COMPRESSION:
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PIZ_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 4096.0;
+    default: return 1e5;
+  }
+}
+
+/// Refuses a data window whose pixels the file cannot hold at its compression's best ratio,
+/// before the image is allocated: a 48 KB file that declared 20 000 x 20 000 pixels made
+/// read_exr() ask for 4.8 GB (a corrupted header; OpenEXR would only fail on reading the
+/// pixels, after the allocation).
+void check_exr_pixels(const std::filesystem::path& path, const Imf::Header& header, long long w, long long h) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return;
+  double bytes_per_pixel = 0.0;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+    const Imf::Channel& c = it.channel();
+    const double sampling = static_cast<double>(std::max(c.xSampling, 1)) * static_cast<double>(std::max(c.ySampling, 1));
+    bytes_per_pixel += (c.type == Imf::HALF ? 2.0 : 4.0) / sampling;
+  }
+  const double raw = static_cast<double>(w) * static_cast<double>(h) * bytes_per_pixel;
+  const double ratio = max_compression_ratio(header.compression());
+  if (raw > static_cast<double>(size) * ratio) {
+    char figures[160];
+    std::snprintf(figures, sizeof figures, "%lld x %lld data window (%.4g bytes of pixels)", w, h, raw);
+    throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': its " + figures +
+                                            " cannot be in a file of " + std::to_string(size) +
+                                            " bytes, even at its compression's best ratio (" +
+                                            std::to_string(static_cast<long long>(ratio)) + " : 1): a corrupted header");
+  }
+}
+
 }  // namespace
 
 void write_exr(const Image& image, const std::filesystem::path& path) {
@@ -148,6 +198,7 @@ Image read_exr(const std::filesystem::path& path) {
     if (w <= 0 || h <= 0 || w * h > (1ll << 31))
       throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': unusable data window " +
                                               std::to_string(w) + " x " + std::to_string(h));
+    check_exr_pixels(path, header, w, h);
     Image image(static_cast<int>(w), static_cast<int>(h));
 
     // Layers: every prefix P of a channel P.R, P.G or P.B (OpenEXR sorts them by name).
