@@ -616,6 +616,77 @@ TEST_SUITE("solver") {
     }
   }
 
+  TEST_CASE("hierarchical: a lamp facing a ceiling 5 cm away in a black room delivers what it emits, once") {
+    // A 4 x 3 x 4 room, everything black, a 1 m^2 lamp facing up 5 cm under the ceiling: its
+    // light lands on the ceiling (and the walls' top 5 cm) and is absorbed there. The lamp's
+    // side is enclosed and closed (its rays meet only the ceiling, a wholly enclosed polygon
+    // side); the ceiling, which also sees the floor past the lamp's back (a side that takes no
+    // light), is enclosed but not closed. The balancing counted as the lamp's delivery only
+    // what reached closed sides, 0.15 of it, and scaled the lamp up to its bound: the ceiling
+    // received 3.1 times what the lamp emits (escaped -208 %). Now 0 to rounding.
+    rad::Material black;
+    black.name = "black";
+    black.reflectance = rad::Rgb(0.0f);
+    rad::Scene room = test::closed_box(black, glm::vec3(4.0f, 3.0f, 4.0f));
+    rad::Material lamp;
+    lamp.name = "lamp";
+    lamp.emission = rad::Rgb(10.0f);
+    lamp.reflectance = rad::Rgb(0.0f);
+    const rad::MaterialId L = room.add_material(lamp);
+    room.add_polygon({{1.5f, 2.95f, 1.5f}, {1.5f, 2.95f, 2.5f}, {2.5f, 2.95f, 2.5f}, {2.5f, 2.95f, 1.5f}}, L, "lamp");
+    REQUIRE(room.polygons().back().normal.y > 0.99f);
+    const rad::Solution sol = rad::solve(room, hierarchical(0.05f));
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    const rad::SolveReport& r = sol.report();
+    MESSAGE("escaped / emitted " << r.escaped_power.y / r.emitted_power.y);
+    CHECK(std::abs(r.escaped_power.y) < 0.002f * r.emitted_power.y);
+    rad::SolveOptions gs;
+    gs.method = rad::SolverMethod::gauss_seidel;
+    const rad::Solution ref = rad::solve(room, gs);
+    // The ceiling's irradiance: a black receiver's radiosity is 0, so its power is its gather.
+    const auto ceiling = [](const rad::Solution& s) {
+      double power = 0.0;
+      for (std::uint32_t e : s.hierarchy().leaves())
+        if (s.hierarchy().patches()[s.hierarchy().element(e).patch].polygon == 3)
+          power += static_cast<double>(s.irradiance()[e].y) * s.hierarchy().element(e).area;
+      return power;
+    };
+    CHECK(relative(ceiling(sol), ceiling(ref)) < 0.01);
+  }
+
+  TEST_CASE("hierarchical: parallel plates 5 cm apart, one emitting, reflecting 0.9, agree with Gauss-Seidel") {
+    // The clusters above the two 1 m plates hold parts of both. In the first pass the reflecting
+    // plate is dark, so a cluster's points, drawn by the power its patches send, all lay on the
+    // emitting plate, coplanar with a receiver on it: no facing pair, and the pair was dropped,
+    // never to be looked at again, though the reflector sends through it later. Both plates
+    // came out 15 % dark against Gauss-Seidel (2.89 and 2.40 against 3.40 and 2.85); measured now
+    // -1.7 % and -2.1 %. The plates' own mesh (3 cm elements, 5 cm apart) keeps the two solvers
+    // apart by about that: with both plates emitting they differ by 2.5 %, before and after.
+    rad::Scene scene;
+    rad::Material lamp, plate;
+    lamp.name = "lamp";
+    lamp.emission = rad::Rgb(1.0f);
+    lamp.reflectance = rad::Rgb(0.9f);
+    plate.name = "plate";
+    plate.reflectance = rad::Rgb(0.9f);
+    const rad::MaterialId L = scene.add_material(lamp), P = scene.add_material(plate);
+    scene.add_polygon({{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, L, "emitting");
+    scene.add_polygon({{0, 0.05f, 0}, {1, 0.05f, 0}, {1, 0.05f, 1}, {0, 0.05f, 1}}, P, "reflecting");
+    REQUIRE(scene.polygons()[0].normal.y > 0.99f);
+    REQUIRE(scene.polygons()[1].normal.y < -0.99f);
+    const rad::Solution sol = rad::solve(scene, hierarchical(0.05f));
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    rad::SolveOptions gs;
+    gs.method = rad::SolverMethod::gauss_seidel;
+    gs.form_factors.method = rad::FormFactorMethod::ray_cast;
+    gs.tolerance = 1e-6;
+    const rad::Solution ref = rad::solve(scene, gs);
+    for (const char* g : {"emitting", "reflecting"}) {
+      MESSAGE(std::string(g) << ": hierarchical " << sol.group_radiosity(g).y << ", gauss-seidel " << ref.group_radiosity(g).y);
+      CHECK(relative(sol.group_radiosity(g).y, ref.group_radiosity(g).y) < 0.03);
+    }
+  }
+
   TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to E / (1 - rho) on every leaf") {
     // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
     // Balanced (every side of the closed box delivers what it sends and gathers 1 from uniform
