@@ -1149,8 +1149,8 @@ struct LinkHierarchy::Impl {
       rays = static_cast<int>(std::clamp(wanted, static_cast<float>(kPenumbraRays), static_cast<float>(kMaxPenumbraRays)));
     }
     const ShadowSampler::Result estimate = shadows.draw(rays, out.rays);
-    if (estimate.cast == 0) return;
-    if (estimate.clear == 0) {
+    // No ray cast (the pilot found facing pairs, these draws none) or none clear: a zero link.
+    if (estimate.cast == 0 || estimate.clear == 0) {
       // Kept as a zero link until the next pass looks at it (refine()): dropped, it could not be
       // refined there, while the pairs whose few rays did see through are, and refinement
       // replaces their estimates (on average above V, since they are the ones that saw
