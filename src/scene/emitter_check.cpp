@@ -1,5 +1,6 @@
 // Where the emitters' light goes: rays from the front of every emitting polygon, against every
-// polygon of the scene (either side), with Embree through RayScene.
+// polygon of the scene (either side), with Embree through RayScene; and which one-sided polygons
+// look wound the wrong way (rays from both sides: nothing in front, surfaces behind).
 // Stratified sampling as in the Monte Carlo form factors (docs/FORM_FACTORS.md): points from a
 // jittered grid on the polygon, directions from a second, shuffled grid, cosine-distributed by
 // Malley's method (a uniform disk point projected up onto the hemisphere).
@@ -7,6 +8,7 @@
 #include "scene/emission.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -188,6 +190,45 @@ std::vector<std::string> back_lit_warnings(const Scene& scene, const PatchHierar
 
 namespace radiosity {
 inline namespace v1 {
+
+std::vector<PolygonId> find_polygons_facing_outward(const Scene& scene) {
+  constexpr std::size_t kSide = 4, kRays = kSide * kSide;
+  const std::vector<Polygon>& polygons = scene.polygons();
+  std::vector<std::uint8_t> outward(polygons.size(), 0);
+  if (polygons.empty()) return {};
+  const float lift = 1e-5f * std::max(scene.bounds().diagonal(), std::numeric_limits<float>::min());
+  const detail::RayScene rays_scene = detail::RayScene::from_polygons(scene);
+  detail::parallel_for(0, polygons.size(), 256, [&](std::size_t begin, std::size_t end) {
+    std::array<glm::vec3, kRays> origin, dir;
+    std::array<std::uint8_t, kRays> hit;
+    for (std::size_t p = begin; p < end; ++p) {
+      const Polygon& polygon = polygons[p];
+      const Material& m = scene.material(polygon.material);
+      if (m.two_sided || detail::max_channel(m.diffuse_transmittance) > 0.0f || detail::max_channel(m.transmittance) > 0.0f) continue;
+      const detail::PolygonFan fan(polygon.vertices);
+      std::size_t hits[2] = {0, 0};
+      for (int side = 0; side < 2; ++side) {
+        const glm::vec3 n = side == 0 ? polygon.normal : -polygon.normal;
+        const detail::Frame frame(n);
+        detail::Rng rng(detail::kSeed, 2 * std::uint64_t{p} + static_cast<std::uint64_t>(side));
+        for (std::size_t i = 0; i < kRays; ++i) {
+          const glm::vec2 cell(static_cast<float>(i % kSide), static_cast<float>(i / kSide));
+          const glm::vec2 a = glm::min((cell + rng.uniform2()) / static_cast<float>(kSide), glm::vec2(0x1.fffffep-1f));
+          const glm::vec2 b = glm::min((cell + rng.uniform2()) / static_cast<float>(kSide), glm::vec2(0x1.fffffep-1f));
+          origin[i] = fan.sample(a) + lift * n;
+          dir[i] = frame.to_world(detail::cosine_hemisphere(b));
+        }
+        rays_scene.occluded(kRays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
+        hits[side] = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), std::uint8_t{1}));
+      }
+      outward[p] = hits[0] <= 1 && hits[1] + 1 >= kRays ? 1 : 0;
+    }
+  });
+  std::vector<PolygonId> out;
+  for (PolygonId p = 0; p < polygons.size(); ++p)
+    if (outward[p]) out.push_back(p);
+  return out;
+}
 
 std::vector<PolygonId> find_emitters_facing_away(const Scene& scene) {
   std::vector<PolygonId> out;

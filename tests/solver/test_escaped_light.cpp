@@ -1,5 +1,6 @@
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -162,5 +163,37 @@ TEST_SUITE("solver") {
     CHECK(rad::find_emitters_facing_away(scene) == away);
     const rad::Solution sol = rad::solve(scene, coarse());
     CHECK(has_warning(sol.report(), "emitter 'top' (polygon 4) faces away"));
+  }
+
+  TEST_CASE("polygons facing outward: a closed box wound outward is found whole, one wound inward or two-sided not at all") {
+    rad::Material grey;
+    grey.name = "grey";
+    grey.reflectance = rad::Rgb(0.5f);
+    const rad::Scene inward = test::closed_box(grey, glm::vec3(2.0f, 1.0f, 3.0f));
+    CHECK(rad::find_polygons_facing_outward(inward).empty());
+    // The same box with every polygon reversed: its fronts face out, its backs see the box.
+    rad::Scene outward;
+    const rad::MaterialId g = outward.add_material(grey);
+    for (const rad::Polygon& p : inward.polygons()) {
+      std::vector<glm::vec3> reversed(p.vertices.begin(), p.vertices.end());
+      std::reverse(reversed.begin(), reversed.end());
+      outward.add_polygon(reversed, g, inward.groups()[p.group]);
+    }
+    CHECK(rad::find_polygons_facing_outward(outward).size() == 6);
+    outward.make_two_sided();
+    CHECK(rad::find_polygons_facing_outward(outward).empty());
+    // A box standing on a large ground, wound outward as an exterior should be: only its roof
+    // (open sky in front, the box's inside behind) is reported, a small share of the area, which
+    // is why `radiosity check` warns only above half of it.
+    rad::Scene street;
+    const rad::MaterialId s = street.add_material(grey);
+    street.add_polygon({{-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}}, s, "ground");
+    for (const rad::Polygon& p : outward.polygons()) {
+      if (p.normal.y < -0.5f) continue;  // the box's floor lies on the ground
+      street.add_polygon(std::vector<glm::vec3>(p.vertices.begin(), p.vertices.end()), s, "building");
+    }
+    const std::vector<rad::PolygonId> found = rad::find_polygons_facing_outward(street);
+    REQUIRE(found.size() == 1);
+    CHECK(street.polygons()[found[0]].normal.y > 0.99f);
   }
 }
