@@ -1696,14 +1696,14 @@ struct LinkHierarchy::Impl {
       }
       adjoint_delivery(h, backs, r, shares, delivered);
       if (rows) {
-        // A closed side's light lands on closed sides only: what the links take to other sides
-        // (through the walls, to a two-sided room's outer faces, through receiving clusters
-        // that hold both) is their error, and counting it as delivered would leave it lost.
-        // The sides a closed side's light may land on are those of wholly enclosed polygon sides
-        // (what its rays met), closed themselves or not: a lamp facing a ceiling 5 cm away is
-        // closed, the ceiling (which also sees the rest of the room) is not, and counting only
-        // what reached closed sides put the lamp's delivery at 0.15 of its power and its scale
-        // at the bound: the ceiling received 3.2 times what the lamp emits.
+        // A closed side's light lands only on sides of wholly enclosed polygon sides (what its
+        // rays met), closed themselves or not: what the links take to other sides (through the
+        // walls, to a two-sided room's outer faces, through receiving clusters that hold both)
+        // is their error, and counting it as delivered would leave it lost. (Counting only what
+        // reached closed sides was wrong the other way: a lamp facing a ceiling 5 cm away is
+        // closed, the ceiling, which also sees the rest of the room, is not; the lamp's delivery
+        // came to 0.15 of its power, its scale to the bound, and the ceiling received 3.1 times
+        // what the lamp emits.)
         for (std::size_t k = 0; k < sides; ++k)
           r_closed[k] = closed_polygon[2 * std::size_t{patches[h.element(static_cast<std::uint32_t>(k / 2)).patch].polygon} + k % 2]
                             ? r[k]
