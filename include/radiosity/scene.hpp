@@ -418,18 +418,25 @@ RADIOSITY_API std::vector<PolygonOverlap> find_overlaps(const Scene& scene);
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API std::vector<PolygonId> find_emitters_facing_away(const Scene& scene);
 
-/// One-sided polygons (material neither two-sided nor translucent) that look wound the wrong
-/// way: their front sees no polygon while their back sees polygons all around, as every
-/// polygon of a closed room or enclosure wound outward does (a CAD solid's facets point out of
-/// the solid). In polygon order. Each side casts 16 cosine-distributed rays from stratified
-/// points (a 4 x 4 grid); a polygon is reported when at most 1 of its front's rays and at least
-/// 15 of its back's meet a polygon. An exterior seen alone (a box with nothing around it) is
-/// reported too, and so is a roof under an open sky (its back sees the building's inside), so
-/// the caller judges the share: `radiosity check` warns when the reported polygons are more than
-/// half of the one-sided area. Deterministic (a fixed seed). Cost: a BVH over the scene and 32
-/// rays per one-sided polygon. Throws Error{internal} if Embree cannot create a device.
-/// Thread safety: concurrent calls are safe.
-RADIOSITY_API std::vector<PolygonId> find_polygons_facing_outward(const Scene& scene);
+/// What find_polygons_facing_outward() found.
+struct OutwardFacing {
+  std::vector<PolygonId> polygons;  ///< in polygon order
+  double area = 0.0;                ///< theirs, scene units^2
+  double one_sided_area = 0.0;      ///< of every polygon tested (the one-sided ones)
+};
+
+/// One-sided polygons (material neither two-sided nor translucent, nor glass) that look wound
+/// the wrong way: their front sees no polygon while their back sees polygons all around, as
+/// every polygon of a closed room or enclosure wound outward does (a CAD solid's facets point
+/// out of the solid). Each side casts 16 cosine-distributed rays from stratified points (a
+/// 4 x 4 grid, directions shuffled against the points); a polygon is reported when at most 1
+/// of its front's rays and at least 15 of its back's meet a polygon. An exterior seen alone (a
+/// box with nothing around it) is reported too, and so is a roof under an open sky (its back
+/// sees the building's inside), so the caller judges the share of the one-sided area:
+/// `radiosity check` warns above half of it. Deterministic (a fixed seed). Cost: a BVH over the
+/// scene and 32 rays per one-sided polygon. Throws Error{internal} if Embree cannot create a
+/// device. Thread safety: concurrent calls are safe.
+RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene);
 
 /// Adds the parallelogram origin, origin + edge_u, origin + edge_u + edge_v, origin + edge_v,
 /// facing edge_u x edge_v (counter-clockwise seen from that side). Units are scene units.

@@ -25,6 +25,7 @@
 #include "geometry/polygon_fan.hpp"
 #include "geometry/ray_scene.hpp"
 #include "core/color.hpp"
+#include "form_factors/pass1_material.hpp"
 
 namespace radiosity::detail {
 
@@ -40,6 +41,36 @@ std::string id_list(const std::vector<PolygonId>& ids) {
   for (std::size_t k = 0; k < ids.size() && k < kShown; ++k) s += (k ? ", " : "") + std::to_string(ids[k]);
   if (ids.size() > kShown) s += " and " + std::to_string(ids.size() - kShown) + " more";
   return s;
+}
+
+/// The share of `side` x `side` rays from the side of `polygon` facing `n` that meet a polygon
+/// of `rays_scene`: points from a jittered grid on the polygon, lifted by `lift`, directions from
+/// a second grid shuffled against the first, cosine-distributed. `order`, `origin`, `dir` and
+/// `hit` are the caller's scratch (resized here), `rng` the polygon's own stream.
+double hit_fraction(const RayScene& rays_scene, const Polygon& polygon, const glm::vec3& n, std::size_t side, float lift,
+                    Rng& rng, std::vector<std::uint32_t>& order, std::vector<glm::vec3>& origin,
+                    std::vector<glm::vec3>& dir, std::vector<std::uint8_t>& hit) {
+  const std::size_t rays = side * side;
+  order.resize(rays);
+  origin.resize(rays);
+  dir.resize(rays);
+  hit.resize(rays);
+  const PolygonFan fan(polygon.vertices);
+  const Frame frame(n);
+  std::iota(order.begin(), order.end(), 0u);
+  shuffle(order.data(), rays, rng);
+  const float cell = 1.0f / static_cast<float>(side);
+  auto stratum = [&](std::size_t s) {
+    const glm::vec2 u = rng.uniform2();
+    return glm::min((glm::vec2(static_cast<float>(s % side), static_cast<float>(s / side)) + u) * cell,
+                    glm::vec2(0x1.fffffep-1f));
+  };
+  for (std::size_t i = 0; i < rays; ++i) {
+    origin[i] = fan.sample(stratum(i)) + lift * n;
+    dir[i] = frame.to_world(cosine_hemisphere(stratum(order[i])));
+  }
+  rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
+  return static_cast<double>(std::count(hit.begin(), hit.end(), std::uint8_t{1})) / static_cast<double>(rays);
 }
 
 }  // namespace
@@ -60,39 +91,21 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads, co
   }
   if (out.empty()) return out;
 
-  // A square number of rays per emitter, within the budget.
+  // A square number of rays per emitter (side x side), within the budget.
   const std::size_t wanted = std::clamp(kEmitterRayBudget / out.size(), kMinEmitterRays, kEmitterRays);
   const auto side = static_cast<std::size_t>(std::sqrt(static_cast<double>(wanted)));
-  const std::size_t rays = side * side;
   // Ray origins are lifted off the emitter as the estimators lift theirs.
   const float lift = 1e-5f * std::max(scene.bounds().diagonal(), std::numeric_limits<float>::min());
   const RayScene rays_scene = RayScene::from_polygons(scene);
 
   parallel_for(threads, out.size(), 1, [&](std::size_t begin, std::size_t end) {
-    std::vector<glm::vec3> origin(rays), dir(rays);
-    std::vector<std::uint8_t> hit(rays);
-    std::vector<std::uint32_t> order(rays);
+    std::vector<glm::vec3> origin, dir;
+    std::vector<std::uint8_t> hit;
+    std::vector<std::uint32_t> order;
     for (std::size_t k = begin; k < end; ++k) {
       const Polygon& polygon = polygons[out[k].polygon];
-      const PolygonFan fan(polygon.vertices);
-      const Frame frame(polygon.normal);
       Rng rng(kSeed, out[k].polygon);
-      std::iota(order.begin(), order.end(), 0u);
-      shuffle(order.data(), rays, rng);
-      const float cell = 1.0f / static_cast<float>(side);
-      auto stratum = [&](std::size_t s) {
-        const glm::vec2 u = rng.uniform2();
-        return glm::min((glm::vec2(static_cast<float>(s % side), static_cast<float>(s / side)) + u) * cell,
-                        glm::vec2(0x1.fffffep-1f));
-      };
-      for (std::size_t i = 0; i < rays; ++i) {
-        origin[i] = fan.sample(stratum(i)) + lift * polygon.normal;
-        const glm::vec3 d = cosine_hemisphere(stratum(order[i]));
-        dir[i] = frame.to_world(d);
-      }
-      rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
-      const std::size_t hits = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), std::uint8_t{1}));
-      out[k].hit_fraction = static_cast<double>(hits) / static_cast<double>(rays);
+      out[k].hit_fraction = hit_fraction(rays_scene, polygon, polygon.normal, side, lift, rng, order, origin, dir, hit);
     }
   });
   return out;
@@ -191,42 +204,41 @@ std::vector<std::string> back_lit_warnings(const Scene& scene, const PatchHierar
 namespace radiosity {
 inline namespace v1 {
 
-std::vector<PolygonId> find_polygons_facing_outward(const Scene& scene) {
+OutwardFacing find_polygons_facing_outward(const Scene& scene) {
   constexpr std::size_t kSide = 4, kRays = kSide * kSide;
   const std::vector<Polygon>& polygons = scene.polygons();
+  OutwardFacing out;
+  if (polygons.empty()) return out;
+  // One-sided: no back of its own (detail::pass1_has_back()) and no glass to see through.
+  auto one_sided = [&](const Material& m) { return !detail::pass1_has_back(m) && !(detail::max_channel(m.transmittance) > 0.0f); };
   std::vector<std::uint8_t> outward(polygons.size(), 0);
-  if (polygons.empty()) return {};
   const float lift = 1e-5f * std::max(scene.bounds().diagonal(), std::numeric_limits<float>::min());
   const detail::RayScene rays_scene = detail::RayScene::from_polygons(scene);
   detail::parallel_for(0, polygons.size(), 256, [&](std::size_t begin, std::size_t end) {
-    std::array<glm::vec3, kRays> origin, dir;
-    std::array<std::uint8_t, kRays> hit;
+    std::vector<glm::vec3> origin, dir;
+    std::vector<std::uint8_t> hit;
+    std::vector<std::uint32_t> order;
     for (std::size_t p = begin; p < end; ++p) {
       const Polygon& polygon = polygons[p];
-      const Material& m = scene.material(polygon.material);
-      if (m.two_sided || detail::max_channel(m.diffuse_transmittance) > 0.0f || detail::max_channel(m.transmittance) > 0.0f) continue;
-      const detail::PolygonFan fan(polygon.vertices);
-      std::size_t hits[2] = {0, 0};
+      if (!one_sided(scene.material(polygon.material))) continue;
+      double seen[2];
       for (int side = 0; side < 2; ++side) {
-        const glm::vec3 n = side == 0 ? polygon.normal : -polygon.normal;
-        const detail::Frame frame(n);
         detail::Rng rng(detail::kSeed, 2 * std::uint64_t{p} + static_cast<std::uint64_t>(side));
-        for (std::size_t i = 0; i < kRays; ++i) {
-          const glm::vec2 cell(static_cast<float>(i % kSide), static_cast<float>(i / kSide));
-          const glm::vec2 a = glm::min((cell + rng.uniform2()) / static_cast<float>(kSide), glm::vec2(0x1.fffffep-1f));
-          const glm::vec2 b = glm::min((cell + rng.uniform2()) / static_cast<float>(kSide), glm::vec2(0x1.fffffep-1f));
-          origin[i] = fan.sample(a) + lift * n;
-          dir[i] = frame.to_world(detail::cosine_hemisphere(b));
-        }
-        rays_scene.occluded(kRays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
-        hits[side] = static_cast<std::size_t>(std::count(hit.begin(), hit.end(), std::uint8_t{1}));
+        seen[side] = detail::hit_fraction(rays_scene, polygon, side == 0 ? polygon.normal : -polygon.normal, kSide, lift,
+                                          rng, order, origin, dir, hit);
       }
-      outward[p] = hits[0] <= 1 && hits[1] + 1 >= kRays ? 1 : 0;
+      // At most 1 of the front's rays and at least 15 of the back's meet a polygon.
+      outward[p] = seen[0] * kRays <= 1.0 && seen[1] * kRays + 1.0 >= kRays ? 1 : 0;
     }
   });
-  std::vector<PolygonId> out;
-  for (PolygonId p = 0; p < polygons.size(); ++p)
-    if (outward[p]) out.push_back(p);
+  for (PolygonId p = 0; p < polygons.size(); ++p) {
+    const Polygon& polygon = polygons[p];
+    if (!one_sided(scene.material(polygon.material))) continue;
+    out.one_sided_area += polygon.area;
+    if (!outward[p]) continue;
+    out.polygons.push_back(p);
+    out.area += polygon.area;
+  }
   return out;
 }
 

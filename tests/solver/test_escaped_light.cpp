@@ -170,7 +170,7 @@ TEST_SUITE("solver") {
     grey.name = "grey";
     grey.reflectance = rad::Rgb(0.5f);
     const rad::Scene inward = test::closed_box(grey, glm::vec3(2.0f, 1.0f, 3.0f));
-    CHECK(rad::find_polygons_facing_outward(inward).empty());
+    CHECK(rad::find_polygons_facing_outward(inward).polygons.empty());
     // The same box with every polygon reversed: its fronts face out, its backs see the box.
     rad::Scene outward;
     const rad::MaterialId g = outward.add_material(grey);
@@ -179,9 +179,9 @@ TEST_SUITE("solver") {
       std::reverse(reversed.begin(), reversed.end());
       outward.add_polygon(reversed, g, inward.groups()[p.group]);
     }
-    CHECK(rad::find_polygons_facing_outward(outward).size() == 6);
+    CHECK(rad::find_polygons_facing_outward(outward).polygons.size() == 6);
     outward.make_two_sided();
-    CHECK(rad::find_polygons_facing_outward(outward).empty());
+    CHECK(rad::find_polygons_facing_outward(outward).polygons.empty());
     // A box standing on a large ground, wound outward as an exterior should be: only its roof
     // (open sky in front, the box's inside behind) is reported, a small share of the area, which
     // is why `radiosity check` warns only above half of it.
@@ -192,8 +192,9 @@ TEST_SUITE("solver") {
       if (p.normal.y < -0.5f) continue;  // the box's floor lies on the ground
       street.add_polygon(std::vector<glm::vec3>(p.vertices.begin(), p.vertices.end()), s, "building");
     }
-    const std::vector<rad::PolygonId> found = rad::find_polygons_facing_outward(street);
-    REQUIRE(found.size() == 1);
-    CHECK(street.polygons()[found[0]].normal.y > 0.99f);
+    const rad::OutwardFacing found = rad::find_polygons_facing_outward(street);
+    REQUIRE(found.polygons.size() == 1);
+    CHECK(street.polygons()[found.polygons[0]].normal.y > 0.99f);
+    CHECK(found.area < 0.5 * found.one_sided_area);
   }
 }

@@ -129,17 +129,11 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   {
     // A closed model wound outward: most of the one-sided area sees nothing in front and
     // surfaces behind (a roof under an open sky does too, but it is not most of a scene).
-    const std::vector<rad::PolygonId> outward = rad::find_polygons_facing_outward(scene);
-    double one_sided = 0.0, outward_area = 0.0;
-    for (const rad::Polygon& p : scene.polygons()) {
-      const rad::Material& m = scene.material(p.material);
-      if (!m.two_sided && m.diffuse_transmittance == rad::Rgb(0.0f) && m.transmittance == rad::Rgb(0.0f)) one_sided += p.area;
-    }
-    for (const rad::PolygonId p : outward) outward_area += scene.polygons()[p].area;
-    if (one_sided > 0.0 && outward_area > 0.5 * one_sided) {
+    const rad::OutwardFacing outward = rad::find_polygons_facing_outward(scene);
+    if (outward.one_sided_area > 0.0 && outward.area > 0.5 * outward.one_sided_area) {
       char share[32];
-      std::snprintf(share, sizeof share, "%.0f", 100.0 * outward_area / one_sided);
-      r.warnings.push_back(std::to_string(outward.size()) + " of " + std::to_string(scene.polygons().size()) +
+      std::snprintf(share, sizeof share, "%.0f", 100.0 * outward.area / outward.one_sided_area);
+      r.warnings.push_back(std::to_string(outward.polygons.size()) + " of " + std::to_string(scene.polygons().size()) +
                            " polygons (" + share +
                            " % of the one-sided area) see nothing in front of them and surfaces behind: a closed "
                            "model wound outward (a CAD solid's facets point out of it)? Its inside then stays dark "
