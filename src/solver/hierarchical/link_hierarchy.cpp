@@ -1623,19 +1623,23 @@ struct LinkHierarchy::Impl {
     });
     std::vector<std::uint8_t> enclosed(sides, 0);
     for (std::size_t k = 0; k < sides; ++k) enclosed[k] = side_enclosure[k] == 2 ? 1 : 0;
+    // The polygon side (2 polygon + 1 for its back) that element side k lies on.
+    auto polygon_side = [&](std::size_t k) {
+      return 2 * std::size_t{patches[h.element(static_cast<std::uint32_t>(k / 2)).patch].polygon} + k % 2;
+    };
     {
       // Only the leaves of polygon sides mostly enclosed (kBalancePolygonShare).
       std::vector<double> polygon_area(2 * scene.polygons().size(), 0.0), polygon_enclosed(polygon_area.size(), 0.0);
       for (std::size_t k = 0; k < sides; ++k) {
         const Element& el = h.element(static_cast<std::uint32_t>(k / 2));
         if (!el.is_leaf() || (k % 2 == 1 && !has_back[el.patch])) continue;
-        const std::size_t ps = 2 * std::size_t{patches[el.patch].polygon} + k % 2;
+        const std::size_t ps = polygon_side(k);
         polygon_area[ps] += el.area;
         if (enclosed[k]) polygon_enclosed[ps] += el.area;
       }
       for (std::size_t k = 0; k < sides; ++k) {
         if (!enclosed[k]) continue;
-        const std::size_t ps = 2 * std::size_t{patches[h.element(static_cast<std::uint32_t>(k / 2)).patch].polygon} + k % 2;
+        const std::size_t ps = polygon_side(k);
         if (!(polygon_enclosed[ps] >= kBalancePolygonShare * polygon_area[ps])) enclosed[k] = 0;
       }
     }
@@ -1704,10 +1708,7 @@ struct LinkHierarchy::Impl {
         // closed, the ceiling, which also sees the rest of the room, is not; the lamp's delivery
         // came to 0.15 of its power, its scale to the bound, and the ceiling received 3.1 times
         // what the lamp emits.)
-        for (std::size_t k = 0; k < sides; ++k)
-          r_closed[k] = closed_polygon[2 * std::size_t{patches[h.element(static_cast<std::uint32_t>(k / 2)).patch].polygon} + k % 2]
-                            ? r[k]
-                            : 0.0f;
+        for (std::size_t k = 0; k < sides; ++k) r_closed[k] = closed_polygon[polygon_side(k)] ? r[k] : 0.0f;
         adjoint_delivery(h, backs, r_closed, shares, delivered_closed);
       }
       for (std::size_t k = 0; k < sides; ++k) {
