@@ -94,6 +94,10 @@ struct PlyElement {
   std::vector<PlyProperty> properties;
 };
 
+bool has_list(const PlyElement& e) {
+  return std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.list; });
+}
+
 /// A PLY header as Assimp 5.2's reader takes it, or refused where it would take it otherwise
 /// than its text says.
 struct PlyHeader {
@@ -323,20 +327,13 @@ void check_ply(const fs::path& path) {
                                             " after its header (a truncated file or a wrong count)");
   }
 
-  bool any_list = false;
-  for (const PlyElement& e : header.elements)
-    for (const PlyProperty& p : e.properties) any_list |= p.list;
-  if (!any_list) return;
+  if (std::none_of(header.elements.begin(), header.elements.end(), has_list)) return;
   ForwardReader in(path, header.body);
   if (header.binary) {
     for (const PlyElement& e : header.elements) {
-      bool lists = false;
-      double fixed = 0.0;
-      for (const PlyProperty& p : e.properties) {
-        lists |= p.list;
-        fixed += static_cast<double>(p.size);
-      }
-      if (!lists) {  // every instance of the same size: no walk
+      if (!has_list(e)) {  // every instance of the same size: no walk
+        double fixed = 0.0;
+        for (const PlyProperty& p : e.properties) fixed += static_cast<double>(p.size);
         if (!in.skip(e.count * fixed)) return;
         continue;
       }
@@ -387,7 +384,7 @@ void check_ply(const fs::path& path) {
   std::size_t number = 0;
   std::vector<std::string_view> values;
   for (const PlyElement& e : header.elements) {
-    const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.list; });
+    const bool lists = has_list(e);
     for (double k = 0.0; k < e.count; k += 1.0) {
       if (!lines.next(line, number)) return;  // a short body is Assimp's to report
       if (!lists) continue;
