@@ -687,6 +687,37 @@ TEST_SUITE("solver") {
     }
   }
 
+  TEST_CASE("hierarchical: a furnished room absorbs no more than its lamp emits") {
+    // tests/data/furnished_room.obj: a closed 4 x 3 x 4 room of reflectance 0.9, wound inward,
+    // furnished as people model it: a one-sided lamp facing down 2 cm under the ceiling, a shelf
+    // 1 cm from a wall, a table whose legs are open tubes, a crate without a bottom; all
+    // one-sided. What meets the backs (the lamp's, the tubes' and the crate's insides) is lost,
+    // so the room absorbs less than the lamp emits: Gauss-Seidel 0.984 of it. The balancing
+    // gained energy here (1.011, the room +2.8 % against Gauss-Seidel): its adjoint took an inner
+    // element's value as its children's area mean where the sweeps take their open-area mean,
+    // and the ceiling's leaves straddling the lamp's edge (partly taken for buried, in the pocket
+    // above the lamp) sent 2-3 times their open power, which nothing bounded. Now 1.0004, the
+    // room +1.7 %. (The same scene built in another polygon order gained less, 0.994: how much
+    // depends on where the elements fall.)
+    const rad::Scene scene = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/furnished_room.obj");
+    rad::SolveOptions options = hierarchical(0.05f);
+    options.tolerance = 1e-4f;
+    const rad::Solution sol = rad::solve(scene, options);
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    rad::SolveOptions gs;
+    gs.method = rad::SolverMethod::gauss_seidel;
+    gs.tolerance = 1e-4f;
+    const rad::Solution ref = rad::solve(scene, gs);
+    const double absorbed = sol.report().absorbed_power.y / sol.report().emitted_power.y;
+    const double reference = ref.report().absorbed_power.y / ref.report().emitted_power.y;
+    MESSAGE("absorbed / emitted: hierarchical " << absorbed << ", gauss-seidel " << reference);
+    CHECK(absorbed < 1.003);
+    CHECK(absorbed > reference - 0.01);
+    const float room = sol.group_radiosity("room").y, room_reference = ref.group_radiosity("room").y;
+    MESSAGE("the room's radiosity: hierarchical " << room << ", gauss-seidel " << room_reference);
+    CHECK(relative(room, room_reference) < 0.025);
+  }
+
   TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to E / (1 - rho) on every leaf") {
     // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
     // Balanced (every side of the closed box delivers what it sends and gathers 1 from uniform

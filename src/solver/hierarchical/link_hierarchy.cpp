@@ -516,17 +516,17 @@ struct LinkHierarchy::Impl {
     v.front.assign(count, Rgb(0.0f));
     v.back.assign(sys.has_backs() ? count : 0, Rgb(0.0f));
     for (std::size_t u = 0; u < sys.unknowns(); ++u) (u < sys.fronts() ? v.front : v.back)[sys.element(u)] = B[u];
-    leaf_values(hierarchy, v, true, with_max);
+    leaf_values(hierarchy, v, with_max);
   }
-  /// The rest of node_values() from the leaves' values already in v.front and v.back. With
-  /// `open`, the leaves' values are their open parts' (side_exposures()) and each inner
-  /// element takes its children's mean weighted by their open area: the links' factors see a
-  /// source's buried part as hidden, so a source sends its open part's radiosity. Without, area
-  /// means (the balancing's unit values).
+  /// The rest of node_values() from the leaves' values already in v.front and v.back: the
+  /// leaves' values are their open parts' (side_exposures()) and each inner element takes its
+  /// children's mean weighted by their open area: the links' factors see a source's buried part
+  /// as hidden, so a source sends its open part's radiosity. The balancing's unit values are
+  /// aggregated the same way (update_scales(); its adjoint transposes this).
   /// With `with_max`, also Values::cluster_max (only gather()'s hold reads it: 12 bytes a
   /// cluster not held through the sweeps otherwise).
-  void leaf_values(const PatchHierarchy& hierarchy, Values& v, bool open = false, bool with_max = false) const {
-    if (open && any_buried) {
+  void leaf_values(const PatchHierarchy& hierarchy, Values& v, bool with_max = false) const {
+    if (any_buried) {
       aggregate_open(hierarchy, v.front, [&](std::uint32_t e) { return leaf_exposure(e, false); });
       if (!v.back.empty()) aggregate_open(hierarchy, v.back, [&](std::uint32_t e) { return leaf_exposure(e, true); });
     } else {
@@ -1573,8 +1573,10 @@ struct LinkHierarchy::Impl {
   /// - r_u for a side whose rays all meet wholly enclosed polygon sides (a closed room's
   ///   inside): 1 / what it gathers from radiosity g on the enclosed sides. Such a closed
   ///   side's g counts only what the links take to closed sides (a second adjoint pass).
-  /// Sides of open scenes are left alone: what they send partly leaves the scene, and 32 rays
-  /// cannot say how much. Deterministic: fixed rays per side, the adjoint in serial passes.
+  /// - g for the other sides of a polygon side: 1, or less where its open leaves together
+  ///   would deliver more than the power they send (a bound the true transport always meets).
+  /// Sides of open scenes are otherwise left alone: what they send partly leaves the scene, and
+  /// 32 rays cannot say how much. Deterministic: fixed rays per side, the adjoint in serial passes.
   /// The rows cannot always be met: a receiving cluster that spreads light over members the
   /// source sees unlike (a ceiling above a lamp 1 cm under it, fine-meshed, gathers 1.76 from
   /// uniform radiosity) asks for more than any scaling can give, and its r and the lamp's g
@@ -1710,6 +1712,28 @@ struct LinkHierarchy::Impl {
         // what the lamp emits.)
         for (std::size_t k = 0; k < sides; ++k) r_closed[k] = closed_polygon[polygon_side(k)] ? r[k] : 0.0f;
         adjoint_delivery(h, backs, r_closed, shares, delivered_closed);
+      }
+      // A side that is not enclosed keeps the links' own estimate of what it delivers (its
+      // rays meet surfaces that do not take light in; 32 of them cannot say how much), but a
+      // polygon side's open leaves together never deliver more than the power they send.
+      // The burial test takes the pocket between a ceiling and a one-sided lamp 2 cm under it
+      // for buried, the links see into it from the side: the ceiling's leaves straddling the
+      // lamp's edge sent 2-3 times their open power, and a furnished room gained energy
+      // (docs/HIERARCHICAL.md, "Balancing closed regions").
+      {
+        std::vector<double> sent_open(2 * scene.polygons().size(), 0.0), arrived(sent_open.size(), 0.0);
+        for (std::size_t k = 0; k < sides; ++k) {
+          const Element& el = h.element(static_cast<std::uint32_t>(k / 2));
+          if (enclosed[k] || !el.is_leaf() || (k % 2 == 1 && !has_back[el.patch])) continue;
+          const double b = (k % 2 == 0 ? values.front : values.back)[k / 2].x;
+          sent_open[polygon_side(k)] += b * double{el.area} * leaf_exposure(static_cast<std::uint32_t>(k / 2), k % 2 == 1);
+          arrived[polygon_side(k)] += b * delivered[k];
+        }
+        for (std::size_t k = 0; k < sides; ++k) {
+          if (enclosed[k]) continue;
+          const std::size_t ps = polygon_side(k);
+          g[k] = arrived[ps] > sent_open[ps] ? static_cast<float>(sent_open[ps] / arrived[ps]) : 1.0f;
+        }
       }
       for (std::size_t k = 0; k < sides; ++k) {
         if (!enclosed[k]) continue;
@@ -1855,17 +1879,35 @@ struct LinkHierarchy::Impl {
       if (backs && has_back[p])
         delivered[2 * std::size_t{patches[p].root} + 1] += surface_share(R[i], bases.of(i), bases.back(p, n)) * patches[p].area;
     }
-    // The pull's transpose: an inner element's value is its children's area-weighted mean.
+    // leaf_values()'s transpose: an inner element's value is its children's mean weighted by
+    // their open area (aggregate_open(), as the sweeps take it), or by area where it has none.
+    std::vector<double> open(any_buried ? 2 * std::size_t{elements} : 0, 0.0);
+    for (std::uint32_t e = elements; any_buried && e-- > 0;) {
+      const Element& el = h.element(e);
+      for (std::size_t side = 0; side < 2; ++side) {
+        double& o = open[2 * std::size_t{e} + side];
+        if (el.is_leaf()) {
+          o = static_cast<double>(el.area) * leaf_exposure(e, side == 1);
+          continue;
+        }
+        for (std::uint32_t k = 0; k < 4; ++k) o += open[2 * std::size_t{el.first_child + k} + side];
+      }
+    }
     for (std::uint32_t e = 0; e < elements; ++e) {
       const Element& el = h.element(e);
       if (el.is_leaf()) continue;
-      double sum = 0.0;
-      for (std::uint32_t k = 0; k < 4; ++k) sum += h.element(el.first_child + k).area;
-      if (!(sum > 0.0)) continue;
-      for (std::uint32_t k = 0; k < 4; ++k)
-        for (std::size_t side = 0; side < 2; ++side)
-          delivered[2 * std::size_t{el.first_child + k} + side] +=
-              delivered[2 * std::size_t{e} + side] * h.element(el.first_child + k).area / sum;
+      for (std::size_t side = 0; side < 2; ++side) {
+        const bool by_open = any_buried && open[2 * std::size_t{e} + side] > 0.0;
+        double sum = 0.0;
+        for (std::uint32_t k = 0; k < 4; ++k)
+          sum += by_open ? open[2 * std::size_t{el.first_child + k} + side] : double{h.element(el.first_child + k).area};
+        if (!(sum > 0.0)) continue;
+        for (std::uint32_t k = 0; k < 4; ++k) {
+          const double part =
+              by_open ? open[2 * std::size_t{el.first_child + k} + side] : double{h.element(el.first_child + k).area};
+          delivered[2 * std::size_t{el.first_child + k} + side] += delivered[2 * std::size_t{e} + side] * part / sum;
+        }
+      }
     }
   }
 
