@@ -691,14 +691,16 @@ TEST_SUITE("solver") {
     // tests/data/furnished_room.obj: a closed 4 x 3 x 4 room of reflectance 0.9, wound inward,
     // furnished as people model it: a one-sided lamp facing down 2 cm under the ceiling, a shelf
     // 1 cm from a wall, a table whose legs are open tubes, a crate without a bottom; all
-    // one-sided. What meets the backs (the lamp's, the tubes' and the crate's insides) is lost,
-    // so the room absorbs less than the lamp emits: Gauss-Seidel 0.984 of it. The balancing
+    // one-sided. What meets a back (the lamp's, in the pocket above it) is lost, so the room
+    // absorbs less than the lamp emits: Gauss-Seidel 0.984 of it at this mesh. The balancing
     // gained energy here (1.011, the room +2.8 % against Gauss-Seidel): its adjoint took an inner
     // element's value as its children's area mean where the sweeps take their open-area mean,
     // and the ceiling's leaves straddling the lamp's edge (partly taken for buried, in the pocket
     // above the lamp) sent 2-3 times their open power, which nothing bounded. Now 1.0004, the
     // room +1.7 %. (The same scene built in another polygon order gained less, 0.994: how much
-    // depends on where the elements fall.)
+    // depends on where the elements fall.) Against the reference path tracer, the mean of a
+    // 96 x 72 view of the room (1024 paths a pixel, the lamp left out): Gauss-Seidel -3.5 %,
+    // hierarchical -1.9 % (-0.9 % before); at 0.01 m^2 elements -1.3 % and +0.2 % (+2.1 %).
     const rad::Scene scene = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/furnished_room.obj");
     rad::SolveOptions options = hierarchical(0.05f);
     options.tolerance = 1e-4f;
