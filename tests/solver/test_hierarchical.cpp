@@ -26,6 +26,20 @@ rad::SolveOptions hierarchical(float epsilon) {
   return o;
 }
 
+/// The options of the closed rooms' comparisons: `method` (hierarchical at epsilon 0.05) to a
+/// tolerance of 1e-4, so that what the solvers' answers differ by is not the sweeps'.
+rad::SolveOptions closed_room_options(rad::SolverMethod method) {
+  rad::SolveOptions o = hierarchical(0.05f);
+  o.method = method;
+  o.tolerance = 1e-4f;
+  return o;
+}
+
+/// The power a solution's surfaces absorb over the power its emitters send (green channel).
+double absorbed_share(const rad::Solution& s) {
+  return static_cast<double>(s.report().absorbed_power.y) / s.report().emitted_power.y;
+}
+
 /// A closed unit box whose walls all emit `emission` and reflect `reflectance` (the furnace).
 rad::Scene furnace(const rad::Rgb& emission, const rad::Rgb& reflectance) {
   rad::Material m;
@@ -702,16 +716,10 @@ TEST_SUITE("solver") {
     // 96 x 72 view of the room (1024 paths a pixel, the lamp left out): Gauss-Seidel -3.5 %,
     // hierarchical -2.3 % (-0.9 % before); at 0.01 m^2 elements -1.3 % and -0.6 % (+2.1 %).
     const rad::Scene scene = rad::load_scene(std::string(RADIOSITY_TEST_DATA) + "/furnished_room.obj");
-    rad::SolveOptions options = hierarchical(0.05f);
-    options.tolerance = 1e-4f;
-    const rad::Solution sol = rad::solve(scene, options);
+    const rad::Solution sol = rad::solve(scene, closed_room_options(rad::SolverMethod::hierarchical));
     REQUIRE(sol.status() == rad::SolveStatus::converged);
-    rad::SolveOptions gs;
-    gs.method = rad::SolverMethod::gauss_seidel;
-    gs.tolerance = 1e-4f;
-    const rad::Solution ref = rad::solve(scene, gs);
-    const double absorbed = sol.report().absorbed_power.y / sol.report().emitted_power.y;
-    const double reference = ref.report().absorbed_power.y / ref.report().emitted_power.y;
+    const rad::Solution ref = rad::solve(scene, closed_room_options(rad::SolverMethod::gauss_seidel));
+    const double absorbed = absorbed_share(sol), reference = absorbed_share(ref);
     MESSAGE("absorbed / emitted: hierarchical " << absorbed << ", gauss-seidel " << reference);
     CHECK(absorbed < 1.003);
     CHECK(absorbed > reference - 0.01);
@@ -738,16 +746,10 @@ TEST_SUITE("solver") {
     rad::Scene scene = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 4.0f));
     rad::add_quad(scene, {1.5f, 2.98f, 1.5f}, {1, 0, 0}, {0, 0, 1}, scene.add_material(lamp), "lamp");
     REQUIRE(scene.polygons().back().normal.y < -0.99f);
-    rad::SolveOptions options = hierarchical(0.05f);
-    options.tolerance = 1e-4f;
-    const rad::Solution sol = rad::solve(scene, options);
+    const rad::Solution sol = rad::solve(scene, closed_room_options(rad::SolverMethod::hierarchical));
     REQUIRE(sol.status() == rad::SolveStatus::converged);
-    rad::SolveOptions gs;
-    gs.method = rad::SolverMethod::gauss_seidel;
-    gs.tolerance = 1e-4f;
-    const rad::Solution ref = rad::solve(scene, gs);
-    const double absorbed = sol.report().absorbed_power.y / sol.report().emitted_power.y;
-    const double reference = ref.report().absorbed_power.y / ref.report().emitted_power.y;
+    const rad::Solution ref = rad::solve(scene, closed_room_options(rad::SolverMethod::gauss_seidel));
+    const double absorbed = absorbed_share(sol), reference = absorbed_share(ref);
     MESSAGE("absorbed / emitted: hierarchical " << absorbed << ", gauss-seidel " << reference);
     CHECK(absorbed < 1.0);
     double power = 0.0, reference_power = 0.0;
