@@ -761,6 +761,39 @@ TEST_SUITE("solver") {
     CHECK(relative(power, reference_power) < 0.011);
   }
 
+  TEST_CASE("hierarchical: the ceiling above a lamp's back delivers what its rays measure" * doctest::timeout(120)) {
+    // The room of the test above with the lamp 50 cm under the ceiling, 0.01 m^2 elements
+    // (10 000). The ceiling sees the lamp's back over much of its area: few of its leaves are
+    // enclosed, and the rest kept the links' estimate of what they deliver, 0.3 % over what
+    // their rays measure (0.9526 against 0.9492 of the power sent). None of those rays leaves
+    // the room, so their pooled share is taken instead. Measured: the room's power against
+    // Gauss-Seidel +1.9 % -> +0.6 % (against the reference path tracer, a view of the same
+    // room built as an OBJ: Gauss-Seidel -0.1 %, hierarchical +2.0 % -> +1.0 %).
+    rad::Material wall, lamp;
+    wall.name = "wall";
+    wall.reflectance = rad::Rgb(0.9f);
+    lamp.name = "lamp";
+    lamp.reflectance = rad::Rgb(0.5f);
+    lamp.emission = rad::Rgb(5.0f);
+    rad::Scene scene = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 4.0f));
+    rad::add_quad(scene, {1.5f, 2.5f, 1.5f}, {1, 0, 0}, {0, 0, 1}, scene.add_material(lamp), "lamp");
+    rad::SolveOptions options = closed_room_options(rad::SolverMethod::hierarchical), gs = closed_room_options(rad::SolverMethod::gauss_seidel);
+    for (rad::SolveOptions* o : {&options, &gs}) {
+      o->mesh.max_element_area = 0.01f;
+      o->mesh.max_patch_area = 0.04f;
+    }
+    const rad::Solution sol = rad::solve(scene, options);
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    const rad::Solution ref = rad::solve(scene, gs);
+    double power = 0.0, reference_power = 0.0;
+    for (const char* g : {"x0", "x1", "y0", "y1", "z0", "z1"}) {
+      power += sol.group_radiosity(g).y * sol.group_area(g);
+      reference_power += ref.group_radiosity(g).y * ref.group_area(g);
+    }
+    MESSAGE("the room's power: hierarchical " << power << ", gauss-seidel " << reference_power);
+    CHECK(relative(power, reference_power) < 0.01);
+  }
+
   TEST_CASE("hierarchical: a furnace of reflectance 0.99 converges to E / (1 - rho) on every leaf") {
     // B = E / (1 - rho) = 100 E: every per cent the links gain or lose is multiplied by up to 100.
     // Balanced (every side of the closed box delivers what it sends and gathers 1 from uniform
