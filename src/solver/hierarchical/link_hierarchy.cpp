@@ -1680,19 +1680,23 @@ struct LinkHierarchy::Impl {
     // rays left the scene (a closed room's ceiling that sees a lamp's back).
     side_reach.resize(sides, -1.0f);
     side_escapes.resize(sides, 0);
+    // A side off a mostly enclosed polygon side stops at its first ray that leaves the scene
+    // (its share is then not used; kNotMeasured): a two-sided room's outer faces cost a ray.
+    constexpr float kNotMeasured = -2.0f;
     each_leaf_side([&](std::size_t e, std::size_t side) {
       const std::size_t k = 2 * e + side;
-      if (enclosed[k] || side_reach[k] >= 0.0f) return;
+      const bool mostly = mostly_enclosed[polygon_side(k)] != 0;
+      if (enclosed[k] || side_reach[k] >= 0.0f || (side_reach[k] == kNotMeasured && !mostly)) return;
       std::uint32_t met = 0;
-      enclosure_rays(
+      const bool all = enclosure_rays(
           h, static_cast<std::uint32_t>(e), side == 1,
           [&](bool found, const RayScene::Hit& hit, bool front) {
             met += found && !scene.polygons()[hit.id].obstruction_only && receives[2 * std::size_t{hit.id} + (front ? 0 : 1)];
             side_escapes[k] = side_escapes[k] || !found;
-            return true;
+            return found || mostly;
           },
           kReachRays);
-      side_reach[k] = static_cast<float>(met) / static_cast<float>(kReachRays);
+      side_reach[k] = all ? static_cast<float>(met) / static_cast<float>(kReachRays) : kNotMeasured;
     });
     std::vector<std::uint8_t> measured = mostly_enclosed, escaped(mostly_enclosed.size(), 0);
     for (std::size_t k = 0; k < sides; ++k) {
