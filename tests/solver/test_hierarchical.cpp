@@ -777,7 +777,8 @@ TEST_SUITE("solver") {
     lamp.emission = rad::Rgb(5.0f);
     rad::Scene scene = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 4.0f));
     rad::add_quad(scene, {1.5f, 2.5f, 1.5f}, {1, 0, 0}, {0, 0, 1}, scene.add_material(lamp), "lamp");
-    rad::SolveOptions options = closed_room_options(rad::SolverMethod::hierarchical), gs = closed_room_options(rad::SolverMethod::gauss_seidel);
+    rad::SolveOptions options = closed_room_options(rad::SolverMethod::hierarchical);
+    rad::SolveOptions gs = closed_room_options(rad::SolverMethod::gauss_seidel);
     for (rad::SolveOptions* o : {&options, &gs}) {
       o->mesh.max_element_area = 0.01f;
       o->mesh.max_patch_area = 0.04f;

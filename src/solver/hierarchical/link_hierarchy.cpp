@@ -1590,7 +1590,8 @@ struct LinkHierarchy::Impl {
   ///   (side_reach, pooled); elsewhere 1, or less where a polygon side's open leaves together
   ///   would deliver more than the power they send (a bound the true transport always meets).
   /// Sides of open scenes are otherwise left alone: what they send partly leaves the scene, and
-  /// 32 rays a side cannot say how much. Deterministic: fixed rays per side, the adjoint in serial passes.
+  /// the rays of a side cannot say how much. Deterministic: fixed rays per side, the adjoint in
+  /// serial passes.
   /// The rows cannot always be met: a receiving cluster that spreads light over members the
   /// source sees unlike (a ceiling above a lamp 1 cm under it, fine-meshed, gathers 1.76 from
   /// uniform radiosity) asks for more than any scaling can give, and its r and the lamp's g
@@ -2623,8 +2624,8 @@ std::size_t LinkHierarchy::bytes() const {
   return m.sources.size() * sizeof(NodeHandle) + m.coefficients.size() * sizeof(float) +
          m.offsets.capacity() * sizeof(std::uint64_t) + clusters * (sizeof(ClusterNode) + 2 * sizeof(Moments)) +
          m.cumulative_area.capacity() * sizeof(double) + m.sample_patches.capacity() * sizeof(Impl::SamplePatch) +
-         (m.send_scale.capacity() + m.receive_scale.capacity() + m.side_reach.capacity()) * sizeof(float) + m.side_enclosure.capacity() + m.side_escapes.capacity() +
-         m.bases.memory_bytes();
+         (m.send_scale.capacity() + m.receive_scale.capacity() + m.side_reach.capacity()) * sizeof(float) +
+         m.side_enclosure.capacity() + m.side_escapes.capacity() + m.bases.memory_bytes();
 }
 
 const ClusterTree& LinkHierarchy::tree() const { return impl_->tree; }
