@@ -136,6 +136,16 @@ std::string region_breakdown(const rad::Scene& scene, const rad::Image& R, const
 
 rad::Camera inside_box_camera() { return rad::Camera{{0.5f, 0.5f, 0.1f}, {0.5f, 0.6f, 1.0f}, {0, 1, 0}, 90.0f}; }
 
+/// A 24 x 16 image at 64 paths a pixel from inside the unit box whose faces are all `m`.
+rad::Image furnace_image(const rad::Material& m) {
+  rad::PathTraceOptions o;
+  o.width = 24;
+  o.height = 16;
+  o.spp = 64;
+  o.camera = inside_box_camera();
+  return rad::render_path_traced(test::closed_box(m), o);
+}
+
 void check_error_names(const rad::PathTraceOptions& o, const std::string& field) {
   rad::Scene scene = test::closed_box(rad::Material{});
   try {
@@ -157,13 +167,7 @@ TEST_SUITE("path_tracer") {
     rad::Material m;
     m.emission = rad::Rgb(1.0f, 2.0f, 3.0f);
     m.reflectance = rad::Rgb(0.5f, 0.25f, 0.75f);
-    rad::Scene scene = test::closed_box(m);
-    rad::PathTraceOptions o;
-    o.width = 24;
-    o.height = 16;
-    o.spp = 64;
-    o.camera = inside_box_camera();
-    const rad::Image image = rad::render_path_traced(scene, o);
+    const rad::Image image = furnace_image(m);
     REQUIRE(image.width == 24);
     REQUIRE(image.height == 16);
     for (int c = 0; c < 3; ++c) {
@@ -190,13 +194,7 @@ TEST_SUITE("path_tracer") {
     rad::Material m;
     m.emission = rad::Rgb(1.0f);
     m.reflectance = rad::Rgb(0.99f);
-    const rad::Scene scene = test::closed_box(m);
-    rad::PathTraceOptions o;
-    o.width = 24;
-    o.height = 16;
-    o.spp = 64;
-    o.camera = inside_box_camera();
-    const rad::Image image = rad::render_path_traced(scene, o);
+    const rad::Image image = furnace_image(m);
     const double expected = 1.0 / (0.01 * kPi);
     const Stats s = channel_stats(image, 1);
     MESSAGE("mean " << s.mean << " (expected " << expected << "), standard error " << s.standard_error);

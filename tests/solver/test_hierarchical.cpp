@@ -40,6 +40,28 @@ double absorbed_share(const rad::Solution& s) {
   return static_cast<double>(s.report().absorbed_power.y) / s.report().emitted_power.y;
 }
 
+/// A closed 4 x 3 x 4 room of reflectance 0.9 (test::closed_box(), its walls' groups "x0" ..
+/// "z1") with a one-sided 1 m^2 lamp (E = 5, rho 0.5) facing down `gap` under its ceiling.
+rad::Scene room_with_lamp(float gap) {
+  rad::Material wall, lamp;
+  wall.name = "wall";
+  wall.reflectance = rad::Rgb(0.9f);
+  lamp.name = "lamp";
+  lamp.reflectance = rad::Rgb(0.5f);
+  lamp.emission = rad::Rgb(5.0f);
+  rad::Scene scene = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 4.0f));
+  rad::add_quad(scene, {1.5f, 3.0f - gap, 1.5f}, {1, 0, 0}, {0, 0, 1}, scene.add_material(lamp), "lamp");
+  REQUIRE(scene.polygons().back().normal.y < -0.99f);
+  return scene;
+}
+
+/// The power room_with_lamp()'s walls send (green channel), W.
+double room_power(const rad::Solution& s) {
+  double power = 0.0;
+  for (const char* g : {"x0", "x1", "y0", "y1", "z0", "z1"}) power += s.group_radiosity(g).y * s.group_area(g);
+  return power;
+}
+
 /// A closed unit box whose walls all emit `emission` and reflect `reflectance` (the furnace).
 rad::Scene furnace(const rad::Rgb& emission, const rad::Rgb& reflectance) {
   rad::Material m;
@@ -737,26 +759,14 @@ TEST_SUITE("solver") {
     // pooled. Measured against Gauss-Seidel: the room's power +1.4 % -> +0.6 %, absorbed /
     // emitted 1.000 -> 0.992 (Gauss-Seidel 0.986). (Against the reference path tracer, a view
     // of the same room built as an OBJ: Gauss-Seidel -1.1 %, hierarchical +0.8 % -> 0.0 %.)
-    rad::Material wall, lamp;
-    wall.name = "wall";
-    wall.reflectance = rad::Rgb(0.9f);
-    lamp.name = "lamp";
-    lamp.reflectance = rad::Rgb(0.5f);
-    lamp.emission = rad::Rgb(5.0f);
-    rad::Scene scene = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 4.0f));
-    rad::add_quad(scene, {1.5f, 2.98f, 1.5f}, {1, 0, 0}, {0, 0, 1}, scene.add_material(lamp), "lamp");
-    REQUIRE(scene.polygons().back().normal.y < -0.99f);
+    const rad::Scene scene = room_with_lamp(0.02f);
     const rad::Solution sol = rad::solve(scene, closed_room_options(rad::SolverMethod::hierarchical));
     REQUIRE(sol.status() == rad::SolveStatus::converged);
     const rad::Solution ref = rad::solve(scene, closed_room_options(rad::SolverMethod::gauss_seidel));
     const double absorbed = absorbed_share(sol), reference = absorbed_share(ref);
     MESSAGE("absorbed / emitted: hierarchical " << absorbed << ", gauss-seidel " << reference);
     CHECK(absorbed < 1.0);
-    double power = 0.0, reference_power = 0.0;
-    for (const char* g : {"x0", "x1", "y0", "y1", "z0", "z1"}) {
-      power += sol.group_radiosity(g).y * sol.group_area(g);
-      reference_power += ref.group_radiosity(g).y * ref.group_area(g);
-    }
+    const double power = room_power(sol), reference_power = room_power(ref);
     MESSAGE("the room's power: hierarchical " << power << ", gauss-seidel " << reference_power);
     CHECK(relative(power, reference_power) < 0.011);
   }
@@ -769,14 +779,7 @@ TEST_SUITE("solver") {
     // the room, so their pooled share is taken instead. Measured: the room's power against
     // Gauss-Seidel +1.9 % -> +0.6 % (against the reference path tracer, a view of the same
     // room built as an OBJ: Gauss-Seidel -0.1 %, hierarchical +2.0 % -> +1.0 %).
-    rad::Material wall, lamp;
-    wall.name = "wall";
-    wall.reflectance = rad::Rgb(0.9f);
-    lamp.name = "lamp";
-    lamp.reflectance = rad::Rgb(0.5f);
-    lamp.emission = rad::Rgb(5.0f);
-    rad::Scene scene = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 4.0f));
-    rad::add_quad(scene, {1.5f, 2.5f, 1.5f}, {1, 0, 0}, {0, 0, 1}, scene.add_material(lamp), "lamp");
+    const rad::Scene scene = room_with_lamp(0.5f);
     rad::SolveOptions options = closed_room_options(rad::SolverMethod::hierarchical);
     rad::SolveOptions gs = closed_room_options(rad::SolverMethod::gauss_seidel);
     for (rad::SolveOptions* o : {&options, &gs}) {
@@ -786,11 +789,7 @@ TEST_SUITE("solver") {
     const rad::Solution sol = rad::solve(scene, options);
     REQUIRE(sol.status() == rad::SolveStatus::converged);
     const rad::Solution ref = rad::solve(scene, gs);
-    double power = 0.0, reference_power = 0.0;
-    for (const char* g : {"x0", "x1", "y0", "y1", "z0", "z1"}) {
-      power += sol.group_radiosity(g).y * sol.group_area(g);
-      reference_power += ref.group_radiosity(g).y * ref.group_area(g);
-    }
+    const double power = room_power(sol), reference_power = room_power(ref);
     MESSAGE("the room's power: hierarchical " << power << ", gauss-seidel " << reference_power);
     CHECK(relative(power, reference_power) < 0.01);
   }
