@@ -34,31 +34,41 @@ void measure_exposure(const PatchHierarchy& h, const RayScene& occluders, float 
                       const std::vector<std::uint8_t>& back_surface, const std::vector<std::uint8_t>& has_back,
                       const std::vector<std::uint32_t>& leaves, unsigned threads, std::vector<float>& exposure);
 
-/// Fills the inner nodes of `values` (per element id; leaves are read) with the mean of their
-/// children weighted by open area, area x exposure, `leaf_exposure(e)` a leaf's (an inner
-/// node's weight is its children's sum): the leaves' values are their open parts', and so are
-/// the inner nodes'. A node with no open area takes the plain area mean.
+/// Per element id of `h` (the first `count`), its open area: a leaf's area x
+/// `leaf_exposure(e)`, an inner node's its children's sum. The weights of aggregate_open().
 template <typename LeafExposure>
-void aggregate_open(const PatchHierarchy& h, std::vector<Rgb>& values, const LeafExposure& leaf_exposure) {
-  std::vector<double> weight(values.size(), 0.0);
-  for (std::size_t e = values.size(); e-- > 0;) {  // children have larger ids than their parent
+std::vector<double> open_areas(const PatchHierarchy& h, std::size_t count, const LeafExposure& leaf_exposure) {
+  std::vector<double> open(count, 0.0);
+  for (std::size_t e = count; e-- > 0;) {  // children have larger ids than their parent
     const Element& el = h.element(static_cast<std::uint32_t>(e));
     if (el.is_leaf()) {
-      weight[e] = static_cast<double>(el.area) * static_cast<double>(leaf_exposure(static_cast<std::uint32_t>(e)));
+      open[e] = static_cast<double>(el.area) * static_cast<double>(leaf_exposure(static_cast<std::uint32_t>(e)));
       continue;
     }
+    for (std::uint32_t k = 0; k < 4; ++k) open[e] += open[el.first_child + k];
+  }
+  return open;
+}
+
+/// Fills the inner nodes of `values` (per element id; leaves are read) with the mean of their
+/// children weighted by open area (open_areas()): the leaves' values are their open parts', and
+/// so are the inner nodes'. A node with no open area takes the plain area mean.
+template <typename LeafExposure>
+void aggregate_open(const PatchHierarchy& h, std::vector<Rgb>& values, const LeafExposure& leaf_exposure) {
+  const std::vector<double> weight = open_areas(h, values.size(), leaf_exposure);
+  for (std::size_t e = values.size(); e-- > 0;) {
+    const Element& el = h.element(static_cast<std::uint32_t>(e));
+    if (el.is_leaf()) continue;
     glm::dvec3 sum(0.0), open_sum(0.0);
-    double area = 0.0, open = 0.0;
+    double area = 0.0;
     for (std::uint32_t k = 0; k < 4; ++k) {
       const std::uint32_t c = el.first_child + k;
       const double a = h.element(c).area;
       sum += a * glm::dvec3(values[c]);
       open_sum += weight[c] * glm::dvec3(values[c]);
       area += a;
-      open += weight[c];
     }
-    weight[e] = open;
-    values[e] = open > 0.0 ? Rgb(open_sum / open) : area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
+    values[e] = weight[e] > 0.0 ? Rgb(open_sum / weight[e]) : area > 0.0 ? Rgb(sum / area) : Rgb(0.0f);
   }
 }
 

@@ -1656,13 +1656,10 @@ struct LinkHierarchy::Impl {
         polygon_area[ps] += el.area;
         if (enclosed[k]) polygon_enclosed[ps] += el.area;
       }
-      for (std::size_t k = 0; k < sides; ++k) {
-        if (!enclosed[k]) continue;
-        const std::size_t ps = polygon_side(k);
-        if (!(polygon_enclosed[ps] >= kBalancePolygonShare * polygon_area[ps])) enclosed[k] = 0;
-      }
       for (std::size_t ps = 0; ps < mostly_enclosed.size(); ++ps)
         mostly_enclosed[ps] = polygon_area[ps] > 0.0 && polygon_enclosed[ps] >= kBalancePolygonShare * polygon_area[ps];
+      for (std::size_t k = 0; k < sides; ++k)
+        if (enclosed[k] && !mostly_enclosed[polygon_side(k)]) enclosed[k] = 0;
     }
     double enclosed_area = 0.0, total_area = 0.0;
     for (std::size_t k = 0; k < sides; ++k) {
@@ -1705,6 +1702,18 @@ struct LinkHierarchy::Impl {
       if (!enclosed[k] && el.is_leaf() && (k % 2 == 0 || has_back[el.patch]) && side_escapes[k]) escaped[polygon_side(k)] = 1;
     }
     for (std::size_t ps = 0; ps < measured.size(); ++ps) measured[ps] = measured[ps] || !escaped[ps];
+    // Per polygon side, the power its open leaves should deliver (update_scales()'s rounds):
+    // what their rays measure where `measured`, else at most the open power they send.
+    std::vector<double> open_target(measured.size(), 0.0);
+    for (std::size_t k = 0; k < sides; ++k) {
+      const Element& el = h.element(static_cast<std::uint32_t>(k / 2));
+      if (enclosed[k] || !el.is_leaf() || (k % 2 == 1 && !has_back[el.patch])) continue;
+      const std::size_t ps = polygon_side(k);
+      const double b = (k % 2 == 0 ? values.front : values.back)[k / 2].x;
+      const double share = measured[ps] ? double{side_reach[k]}
+                                         : double{leaf_exposure(static_cast<std::uint32_t>(k / 2), k % 2 == 1)};
+      open_target[ps] += b * double{el.area} * share;
+    }
     // Polygon sides all of whose leaves are enclosed, and the sides that see only those.
     std::vector<std::uint8_t> closed_polygon = receives;
     for (std::uint32_t e = 0; e < elements; ++e) {
@@ -1779,24 +1788,19 @@ struct LinkHierarchy::Impl {
       // open power (a furnished room gained energy; docs/HIERARCHICAL.md, "Balancing closed
       // regions").
       {
-        std::vector<double> target(2 * scene.polygons().size(), 0.0), arrived(target.size(), 0.0);
+        std::vector<double> arrived(open_target.size(), 0.0);
         for (std::size_t k = 0; k < sides; ++k) {
           const Element& el = h.element(static_cast<std::uint32_t>(k / 2));
           if (enclosed[k] || !el.is_leaf() || (k % 2 == 1 && !has_back[el.patch])) continue;
-          const std::size_t ps = polygon_side(k);
-          const double b = (k % 2 == 0 ? values.front : values.back)[k / 2].x;
-          const double share = measured[ps] ? double{side_reach[k]}
-                                             : double{leaf_exposure(static_cast<std::uint32_t>(k / 2), k % 2 == 1)};
-          target[ps] += b * double{el.area} * share;
-          arrived[ps] += b * delivered[k];
+          arrived[polygon_side(k)] += (k % 2 == 0 ? values.front : values.back)[k / 2].x * delivered[k];
         }
         for (std::size_t k = 0; k < sides; ++k) {
           if (enclosed[k]) continue;
           const std::size_t ps = polygon_side(k);
           if (measured[ps])
-            g[k] = arrived[ps] > 0.0 ? static_cast<float>(std::min(target[ps] / arrived[ps], double{kMaxBalance})) : 1.0f;
+            g[k] = arrived[ps] > 0.0 ? static_cast<float>(std::min(open_target[ps] / arrived[ps], double{kMaxBalance})) : 1.0f;
           else
-            g[k] = arrived[ps] > target[ps] ? static_cast<float>(target[ps] / arrived[ps]) : 1.0f;
+            g[k] = arrived[ps] > open_target[ps] ? static_cast<float>(open_target[ps] / arrived[ps]) : 1.0f;
         }
       }
       for (std::size_t k = 0; k < sides; ++k) {
@@ -1944,31 +1948,22 @@ struct LinkHierarchy::Impl {
         delivered[2 * std::size_t{patches[p].root} + 1] += surface_share(R[i], bases.of(i), bases.back(p, n)) * patches[p].area;
     }
     // leaf_values()'s transpose: an inner element's value is its children's mean weighted by
-    // their open area (aggregate_open(), as the sweeps take it), or by area where it has none.
-    std::vector<double> open(any_buried ? 2 * std::size_t{elements} : 0, 0.0);
-    for (std::uint32_t e = elements; any_buried && e-- > 0;) {
-      const Element& el = h.element(e);
-      for (std::size_t side = 0; side < 2; ++side) {
-        double& o = open[2 * std::size_t{e} + side];
-        if (el.is_leaf()) {
-          o = static_cast<double>(el.area) * leaf_exposure(e, side == 1);
-          continue;
-        }
-        for (std::uint32_t k = 0; k < 4; ++k) o += open[2 * std::size_t{el.first_child + k} + side];
-      }
-    }
+    // their open area (aggregate_open()'s open_areas(), as the sweeps take it), or by area where
+    // it has none.
+    std::array<std::vector<double>, 2> open;  // per side, when any leaf is buried
+    for (std::size_t side = 0; side < 2 && any_buried; ++side)
+      open[side] = open_areas(h, elements, [&](std::uint32_t e) { return leaf_exposure(e, side == 1); });
     for (std::uint32_t e = 0; e < elements; ++e) {
       const Element& el = h.element(e);
       if (el.is_leaf()) continue;
       for (std::size_t side = 0; side < 2; ++side) {
-        const bool by_open = any_buried && open[2 * std::size_t{e} + side] > 0.0;
+        const bool by_open = any_buried && open[side][e] > 0.0;
         double sum = 0.0;
         for (std::uint32_t k = 0; k < 4; ++k)
-          sum += by_open ? open[2 * std::size_t{el.first_child + k} + side] : double{h.element(el.first_child + k).area};
+          sum += by_open ? open[side][el.first_child + k] : double{h.element(el.first_child + k).area};
         if (!(sum > 0.0)) continue;
         for (std::uint32_t k = 0; k < 4; ++k) {
-          const double part =
-              by_open ? open[2 * std::size_t{el.first_child + k} + side] : double{h.element(el.first_child + k).area};
+          const double part = by_open ? open[side][el.first_child + k] : double{h.element(el.first_child + k).area};
           delivered[2 * std::size_t{el.first_child + k} + side] += delivered[2 * std::size_t{e} + side] * part / sum;
         }
       }
