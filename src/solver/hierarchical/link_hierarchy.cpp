@@ -161,8 +161,13 @@ struct LinkRecord {
   NodeHandle receiver, source;
   float coefficient;
 };
-/// Links as refinement makes them: a chunk per round (or for the links a later pass keeps).
+/// Links as refinement makes them: a chunk per block of a round, in the round's order (or the
+/// links a later pass keeps).
 using LinkChunks = std::vector<std::vector<LinkRecord>>;
+/// Node pairs to examine, in order: the segments one after the other. A round's pairs for the
+/// next are its blocks' outputs, kept as they were made: copied into one array, they were held
+/// twice for a moment, the largest round's pairs at the 246k city's peak.
+using PairSegments = std::vector<std::vector<Pair>>;
 
 /// One block's output of a refinement round, in the order it was made.
 struct BlockOutput {
@@ -1176,75 +1181,96 @@ struct LinkHierarchy::Impl {
     out.links.push_back({r, s, partly_hidden ? -coefficient * v : coefficient * v});
   }
 
-  /// Runs refinement rounds from `frontier` until it is empty; each round's links become a
-  /// chunk of `chunks`. False when `gate` cancels.
-  bool run_rounds(PatchHierarchy& hierarchy, Values& values, std::vector<Pair> frontier, float threshold,
+  /// Runs refinement rounds from `frontier` until it is empty; each round's links become
+  /// chunks of `chunks`, one per block. False when `gate` cancels.
+  bool run_rounds(PatchHierarchy& hierarchy, Values& values, PairSegments frontier, float threshold,
                   const SubdivisionLimits& limits, ProgressGate& gate, LinkChunks& chunks,
                   std::vector<std::uint32_t>& split, RefineStats& stats, bool merge_each_round) {
     bool subdivision_closed = limits.max_depth == 0;
-    std::size_t done = 0;
+    std::size_t done = 0, rounds = 0;
     std::vector<BlockOutput> blocks;
+    struct Block {
+      std::size_t segment, first, last;  ///< frontier[segment][first, last)
+    };
+    std::vector<Block> work;
     const std::size_t workers = static_cast<std::size_t>(thread_count(threads));
     BlockSizer slices(workers, workers, std::numeric_limits<std::size_t>::max());
-    while (!frontier.empty()) {
+    auto pairs_in = [](const PairSegments& segments) {
+      std::size_t count = 0;
+      for (const std::vector<Pair>& segment : segments) count += segment.size();
+      return count;
+    };
+    for (std::size_t pairs = pairs_in(frontier); pairs > 0; pairs = pairs_in(frontier)) {
+      ++rounds;
       const RoundContext rc{hierarchy, values, threshold, limits, subdivision_closed};
-      const std::size_t block_count = (frontier.size() + kBlock - 1) / kBlock;
+      // Blocks of at most kBlock pairs, none across segments: each pair's output depends on the
+      // pair alone, and the outputs are taken in block order, so the blocks' bounds change
+      // nothing.
+      work.clear();
+      for (std::size_t g = 0; g < frontier.size(); ++g)
+        for (std::size_t first = 0; first < frontier[g].size(); first += kBlock)
+          work.push_back({g, first, std::min(frontier[g].size(), first + kBlock)});
+      const std::size_t block_count = work.size();
       blocks.assign(block_count, BlockOutput{});
       // A round can hold millions of pairs: its blocks go in slices of about 15 ms with a
       // progress report between them, so a cancel is seen within a round too (refine() then
       // drops the pass's new links, as after a cancel between rounds); each block's output
       // does not depend on the slices.
+      std::size_t pairs_done = 0;
       for (std::size_t slice = 0, slice_end = 0; slice < block_count; slice = slice_end) {
         slice_end = std::min(block_count, slice + slices.size());
         parallel_for(threads, slice_end - slice, 1, [&](std::size_t begin, std::size_t end) {
           for (std::size_t b = slice + begin; b < slice + end; ++b) {
-            const std::size_t first = b * kBlock, last = std::min(frontier.size(), first + kBlock);
-            for (std::size_t k = first; k < last; ++k) process(rc, frontier[k], blocks[b]);
+            const Block& block = work[b];
+            for (std::size_t k = block.first; k < block.last; ++k) process(rc, frontier[block.segment][k], blocks[b]);
+            // Kept as the next round's segment and a chunk of links: without the slack their
+            // doubling growth left.
+            blocks[b].next.shrink_to_fit();
+            blocks[b].links.shrink_to_fit();
           }
         });
         slices.done(slice_end - slice);
+        for (std::size_t b = slice; b < slice_end; ++b) pairs_done += work[b].last - work[b].first;
         if (slice_end == block_count) break;
         Progress p;
         p.phase = Phase::form_factors;
-        p.fraction = static_cast<double>(done + slice_end * kBlock) / static_cast<double>(done + frontier.size());
+        p.fraction = static_cast<double>(done + pairs_done) / static_cast<double>(done + pairs);
         if (!gate.report(p, false)) return false;
       }
-      done += frontier.size();
-      frontier = {};  // read; its memory goes before the next round's is made
-      // The round's links and next pairs, in block order, each array made at its final size
-      // (no doubling growth: these are the refinement's largest arrays).
+      done += pairs;
+      frontier = {};  // read; its memory goes before the next round's is held
       std::size_t link_count = 0, next_count = 0;
       for (const BlockOutput& b : blocks) {
         link_count += b.links.size();
         next_count += b.next.size();
       }
       stats.links_added += link_count;
-      // The round's arrays are about to be made while the blocks still hold their parts: refuse
-      // here, with the figure, if the links so far and the round's would pass the budget.
+      // The links so far and the round's pairs, before merging makes the link arrays grow:
+      // refuse here, with the figure, if they pass the budget.
       {
-        std::size_t held = 0;
-        for (const std::vector<LinkRecord>& c : chunks) held += c.capacity() * sizeof(LinkRecord);
-        const double needed = static_cast<double>(held) + 2.0 * static_cast<double>(link_count * sizeof(LinkRecord)) +
-                              2.0 * static_cast<double>(next_count * sizeof(Pair));
-        if (needed > static_cast<double>(memory_budget))
-          refuse_memory("hierarchical radiosity's link refinement (" + std::to_string(held / sizeof(LinkRecord) + link_count) +
-                            " links and " + std::to_string(next_count) + " node pairs to examine after round " +
-                            std::to_string(chunks.size() + 1) + ")",
-                        needed, memory_budget, memory_budget_field,
+        std::size_t held = 0, links_held = link_count;
+        for (const std::vector<LinkRecord>& c : chunks) {
+          held += c.capacity() * sizeof(LinkRecord);
+          links_held += c.size();
+        }
+        for (const BlockOutput& b : blocks)
+          held += b.links.capacity() * sizeof(LinkRecord) + b.next.capacity() * sizeof(Pair);
+        if (static_cast<double>(held) > static_cast<double>(memory_budget))
+          refuse_memory("hierarchical radiosity's link refinement (" + std::to_string(links_held) + " links and " +
+                            std::to_string(next_count) + " node pairs to examine after round " +
+                            std::to_string(rounds) + ")",
+                        static_cast<double>(held), memory_budget, memory_budget_field,
                         "; raise HierarchicalOptions::epsilon, coarsen the mesh or raise the budget");
       }
-      std::vector<LinkRecord>& links = chunks.emplace_back();
-      links.reserve(link_count);
-      frontier.reserve(next_count);
       std::vector<std::uint32_t> subdivide;
       for (BlockOutput& b : blocks) {
-        links.insert(links.end(), b.links.begin(), b.links.end());
-        frontier.insert(frontier.end(), b.next.begin(), b.next.end());
+        if (!b.links.empty()) chunks.push_back(std::move(b.links));
+        if (!b.next.empty()) frontier.push_back(std::move(b.next));
         subdivide.insert(subdivide.end(), b.subdivide.begin(), b.subdivide.end());
         stats.examined += b.examined;
         stats.refined += b.refined;
         stats.rays += b.rays;
-        b = BlockOutput{};  // its memory goes as it is copied, not at the end of the round
+        b = BlockOutput{};
       }
       blocks.clear();
       if (!subdivide.empty()) {
@@ -1272,10 +1298,12 @@ struct LinkHierarchy::Impl {
         }
       }
       if (merge_each_round) merge(chunks, static_cast<std::uint32_t>(hierarchy.elements().size()));
+      release_free_heap();
       Progress p;
       p.phase = Phase::form_factors;
-      p.fraction = static_cast<double>(done) / static_cast<double>(done + frontier.size());
-      if (!gate.report(p, frontier.empty())) return false;
+      const std::size_t next = pairs_in(frontier);
+      p.fraction = static_cast<double>(done) / static_cast<double>(done + next);
+      if (!gate.report(p, next == 0)) return false;
     }
     return true;
   }
@@ -2437,7 +2465,7 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   }
 
   LinkChunks chunks;
-  std::vector<Pair> frontier;
+  std::vector<Pair> frontier;  // the first round's pairs: run_rounds() takes them as one segment
   std::vector<LinkRecord> replaced;  // multigridding: the links being refined
   if (!m.linked) {
     frontier.push_back({cluster_handle(ClusterTree::root()), cluster_handle(ClusterTree::root())});
@@ -2500,7 +2528,8 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   // the links are then dropped, and the next solve starts again); a later pass at its end.
   const bool first_pass = !m.linked;
   const bool completed =
-      m.run_rounds(hierarchy, values, std::move(frontier), threshold, limits, gate, chunks, split, stats, first_pass);
+      m.run_rounds(hierarchy, values, PairSegments{std::move(frontier)}, threshold, limits, gate, chunks, split, stats,
+                   first_pass);
   // After the rounds: they may have split elements (adaptive subdivision).
   const auto elements = static_cast<std::uint32_t>(hierarchy.elements().size());
   if (!completed) {
@@ -2518,6 +2547,7 @@ bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& sys
   }
   replaced = {};
   m.merge(chunks, elements);
+  release_free_heap();
   m.update_exposure(hierarchy);
   m.update_scales(hierarchy, values);
   m.release_sampling();
