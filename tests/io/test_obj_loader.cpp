@@ -395,6 +395,27 @@ TEST_CASE("a reflectance of 1 or more in an MTL is clamped to 0.99 with a warnin
               "ke_negative.mtl", 3, "Ke", true);
 }
 
+TEST_CASE("an illum that names no model (0 to 10) is ignored with a warning - an error naming the MTL line under strict") {
+  // 99999999999999999 came from the OBJ fuzzer: cast to int it was undefined behaviour.
+  const std::string obj = "mtllib illum_range.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl shiny\nf 1 2 3\n";
+  for (const char* illum : {"99999999999999999", "-3", "11"}) {
+    CAPTURE(illum);
+    write_tmp("illum_range.mtl", std::string("newmtl shiny\nKd 0.5\nKs 0.25\nNs 20\nillum ") + illum + "\n");
+    const fs::path path = write_tmp("illum_range.obj", obj);
+    const radiosity::Scene s = radiosity::load_scene(path);
+    // As without illum: Ks with Ns is a Phong lobe; no mirror, no glass.
+    const radiosity::Material& m = s.material(s.polygons()[0].material);
+    CHECK(near(m.reflectance, Rgb(0.5f)));
+    CHECK(near(m.specular, Rgb(0.25f)));
+    CHECK(m.specular_exponent == doctest::Approx(20.0f));
+    CHECK(near(m.transmittance, Rgb(0.0f)));
+    REQUIRE(s.warnings().size() == 1);
+    CHECK(contains(s.warnings()[0], "illum_range.mtl:5: material 'shiny': illum"));
+    CHECK(contains(s.warnings()[0], "no illumination model"));
+    check_error(path, ErrorCode::invalid_scene, "illum_range.mtl", 5, "illum", true);
+  }
+}
+
 TEST_CASE("line numbers count comments - blank lines and CRLF or CR line ends") {
   check_error(kData / "line_numbers.obj", ErrorCode::parse_error, "line_numbers.obj", 23, "'99'");
   std::ifstream in(kData / "line_numbers.obj", std::ios::binary);

@@ -60,13 +60,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// A number as the messages show it: 6 significant digits, no trailing zeros.
-std::string number_text(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 /// The size in bytes of a PLY scalar type (char, uchar, ..., float64), 0 for another name
 /// (Assimp 5.2 does not read "FLOAT" either).
 std::size_t ply_type_size(const std::string& type) {

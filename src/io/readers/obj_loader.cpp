@@ -265,7 +265,17 @@ Material to_material(const MtlInfo& info, ReaderWarnings& warnings) {
   m.reflectance = kd;
   m.emission = kPi * ke;
 
-  const int illum = static_cast<int>(scalar(info, "illum", -1.0f));  // -1: not given
+  // The illumination model, 0 to 10 in the MTL specification; -1 when not given. Another number
+  // names no model and is ignored (casting 1e17 to int was undefined: a fuzzer's finding).
+  int illum = -1;
+  if (const MtlKey* k = info.key("illum")) {
+    if (k->value[0] >= 0.0f && k->value[0] <= 10.0f)
+      illum = static_cast<int>(k->value[0]);
+    else
+      warnings.forgive("MTL illum out of range", ErrorCode::invalid_scene, loc(info.file, k->line),
+                       info.what() + "illum " + number_text(k->value[0]) + " is no illumination model (0 to 10)",
+                       "ignored");
+  }
   const bool refracts = illum == 4 || illum == 6 || illum == 7 || illum == 9;
   const bool mirror = illum == 3 || illum == 5 || illum == 8;
   const bool pbr = !refracts && (info.key("Pr") || info.key("Pm"));
@@ -606,8 +616,9 @@ Scene load_obj(const fs::path& path, const LoadOptions& options) {
   // Materials: every MTL material, in order; "default" grey is added on demand.
   std::map<std::string_view, MaterialId, std::less<>> by_name;
   for (const MtlInfo& info : infos) {
+    Material material = to_material(info, warnings);  // its errors (strict) name their own line
     try {
-      by_name.emplace(info.name, scene.add_material(to_material(info, warnings)));
+      by_name.emplace(info.name, scene.add_material(std::move(material)));
     } catch (const Error& e) {
       throw Error(e.code(), at(info.file, info.line) + e.what());
     }

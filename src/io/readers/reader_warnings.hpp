@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,6 +19,13 @@
 #include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
+
+/// A number as the readers' messages show it: 6 significant digits, no trailing zeros.
+inline std::string number_text(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 /// Where the readers clamp a diffuse reflectance of 1 or more (and scale Kd + Ks to): the
 /// largest albedo a real diffuse material reaches (a white reference target, about 0.99).

@@ -37,12 +37,6 @@ using json = nlohmann::json;
 
 constexpr int kFormatVersion = 1;
 
-std::string number_text(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 std::string rgb_text(const Rgb& c) {
   std::ostringstream s;
   s << '[' << c.x << ", " << c.y << ", " << c.z << ']';
