@@ -65,7 +65,7 @@ std::size_t lookup_block(std::size_t rows) { return std::clamp<std::size_t>(rows
 
 /// F_ji for the rows i of one block of consecutive rows, asked in increasing i: a cursor per row
 /// j that only moves forward (rows are sorted by column), so a block costs its entries plus one
-/// binary search per row it reaches. (A binary search per entry took a sixth of the exact
+/// binary search per row it reaches. (A binary search per entry took an eighth of the exact
 /// mode's time in the enclosure benchmark, rows of 2 600 entries; a transposed copy would cost
 /// the matrix's memory again.) One per thread: it is the thread's cursors.
 class TransposedLookup {
