@@ -44,8 +44,9 @@ inline std::string mib_text(double bytes) {
 /// thread that allocated it, and raises its mmap threshold whenever a mapped block is freed,
 /// so later large blocks come from the heap as well; the next phase's arrays were then mapped
 /// afresh beside resident pages that held nothing. The hierarchical solver calls it after each
-/// refinement round and merge: the 246k city's peak RSS 494-512 MiB -> 450-464 MiB
-/// (docs/HIERARCHICAL.md). Thread safety: may be called concurrently with any allocation.
+/// refinement round and merge (alone, on session 26's rounds: the 246k city's peak RSS 494-512
+/// -> 466 MiB; with the rounds' pairs kept in segments too, 450-464 MiB; docs/HIERARCHICAL.md).
+/// Thread safety: may be called concurrently with any allocation.
 inline void release_free_heap() {
 #if defined(__GLIBC__)
   malloc_trim(0);
