@@ -78,26 +78,34 @@ constexpr std::size_t kBlock = 1024;
 /// at 0.3, -2.4 % at 0.5).
 constexpr float kSeparation = 0.4f;
 constexpr float kSeparationFloor = 0.1f;
-/// A link with a cluster end is refined, whatever the separation, while the power it may bring
-/// (its bound times the receiver's area) exceeds this share of the threshold times the scene's
-/// area (about epsilon times the power all surfaces send): Hanrahan et al.'s brightness-weighted
-/// oracle weighted by area ("BFA"), for cluster links only. A group mean is an area integral,
-/// and the corrected centroid transport's small relative error has one sign over the many
-/// cluster links into a group; in a scene of few patches each such link carries a large share
-/// of a group's light, so the per-link threshold does not bound the group's error. In a large
-/// scene no cluster link carries that much, and the rule leaves it alone. Measured (worst group
-/// mean against Gauss-Seidel over element-to-element factors, epsilon 0.05, seeds averaged):
-/// - the Cornell box at 100 mm elements, 8 seeds: 0.60 % (the ceiling) -> 0.44 % (0.36 % at a
-///   share of 0.0003);
-/// - at 16 679 elements, 4 seeds: 0.48 % (the floor) -> 0.33 % (the same at 0.0003);
-/// - the 22k city: links +0.5 % (+3.7 % at 0.0003), element RMS against its reference 1.36 %
-///   either way; the 246k city: links +0.2 % at 0.0003;
+/// A link's *power share*: the power it may bring (its bound times the receiver's area) over
+/// the threshold times the scene's area (about epsilon times the power all surfaces send;
+/// power_share()). Group means are area integrals, so a link's error counts in a group by its
+/// power, which the per-link threshold (irradiance) does not bound: in a scene of few patches
+/// one link can carry a large share of a group's light; in a large scene none does, and the two
+/// rules below leave it alone. Hanrahan et al. 1991's brightness-weighted oracle weighted by
+/// area ("BFA"):
+/// - a link with a cluster end is refined, whatever the separation, while its share exceeds
+///   kLinkPowerShare: the corrected centroid transport's small relative error has one sign over
+///   the many cluster links into a group;
+/// - a link's estimate casts at least (share / kLinkPowerShare)^2 / 4 rays (within the bounds
+///   above), so that its visibility noise in power stays about kLinkPowerShare times the unit:
+///   a few strong links of the lamp into floor elements half in a block's shadow, 12 rays each,
+///   moved the floor's mean by up to 2.6 % from one seed to the next.
+/// Measured (worst group mean against Gauss-Seidel over element-to-element factors, epsilon
+/// 0.05, seeds averaged):
+/// - the Cornell box at 100 mm elements, 8 seeds: 0.60 % (the ceiling) -> 0.44 % with the
+///   refinement (0.36 % at a share of 0.0003) -> 0.35 % with the rays too; the floor on single
+///   seeds from -1.5..+2.6 % to -0.7..+0.6 %, every group of every seed within 0.7 %;
+/// - at 16 679 elements, 4 seeds: 0.48 % (the floor) -> 0.33 % (the rays change nothing there);
+/// - the 22k city: links +0.5 % (+3.7 % at 0.0003), link rays unchanged, element RMS against
+///   its reference 1.36 % either way; the 246k city: links +0.2 % at 0.0003;
 /// - closed rooms of reflectance 0.99 (tests/data/exported_room.obj, room_lamp_under_ceiling.obj,
 ///   made two-sided), balanced: the inside -0.7 % -> -0.1 % and -3.0 % -> -1.1 % against
 ///   Gauss-Seidel, at 1.8 times the solve time (a third refinement pass, more sweeps); at 0.0003
 ///   the first came out -3.3 %, more links losing more light than the balancing restores.
 /// kSeparation 0.3 instead gives 0.38 % on the small box, at 1.7 times the city's links.
-constexpr float kClusterPowerShare = 0.001f;
+constexpr float kLinkPowerShare = 0.001f;
 /// A partly hidden link into a cluster is refined while it may bring more than this fraction of
 /// the threshold (other partly hidden links: more than the threshold). A cluster spreads what it
 /// receives over its members alike, so light that only some of them see reaches the hidden ones
@@ -994,12 +1002,18 @@ struct LinkHierarchy::Impl {
     return {bound, widest * (1.0f / (gap * gap) - 1.0f / (far * far)) + bound * variation};
   }
 
+  /// A link's power share (kLinkPowerShare): the power it may bring over the threshold times
+  /// the scene's area.
+  float power_share(const RoundContext& rc, NodeHandle r, const LinkError& error) const {
+    return error.bound * area(rc.hierarchy, r) / (rc.threshold * tree.node(ClusterTree::root()).area);
+  }
+
   /// The oracle (docs/HIERARCHICAL.md, "Refinement (the oracle)"): refine a link when its
   /// transport varies over its nodes by more than the threshold; when it has a cluster end
   /// and its nodes are large for their distance (a cluster's transport is taken from its
   /// centre, accurate only when the nodes are small for their distance, as in Barnes & Hut's
   /// multipole acceptance), unless it carries little, or may bring a share of the scene's
-  /// power (kClusterPowerShare); when it is partly hidden (a shadow
+  /// power (kLinkPowerShare); when it is partly hidden (a shadow
   /// boundary somewhere in its nodes) and may bring more than the threshold (kHiddenClusterFloor
   /// x the threshold into a cluster). A fully visible or fully hidden link is never refined for
   /// visibility.
@@ -1012,8 +1026,7 @@ struct LinkHierarchy::Impl {
     if (partly_hidden && error.bound > (is_cluster(r) ? kHiddenClusterFloor : 1.0f) * rc.threshold) return true;
     if (is_cluster(r) && !wholly_exposed(handle_index(r)) && error.bound > kBuriedClusterFloor * rc.threshold) return true;
     if (!is_cluster(r) && !is_cluster(s)) return false;
-    if (error.bound * area(rc.hierarchy, r) > kClusterPowerShare * rc.threshold * tree.node(ClusterTree::root()).area)
-      return true;
+    if (power_share(rc, r, error) > kLinkPowerShare) return true;
     const float reach = radius(rc.hierarchy, r) + radius(rc.hierarchy, s);
     return reach > kSeparation * glm::length(centre(rc.hierarchy, r) - centre(rc.hierarchy, s)) &&
            error.bound > kSeparationFloor * rc.threshold;
@@ -1180,9 +1193,10 @@ struct LinkHierarchy::Impl {
     if (pilot.cast == 0) return;  // no facing pair found: nothing passes
     const bool partly_hidden = pilot.clear > 0 && pilot.clear < pilot.cast;
     // The estimate's rays: as many as make the visible fraction's standard error (at most
-    // 1 / (2 sqrt(n))) times what the link may bring about the threshold, within bounds: a pure
-    // pilot's link has no shadow boundary in sight, a mixed one that cannot be split has.
-    const float ratio = error.bound / rc.threshold;
+    // 1 / (2 sqrt(n))) times what the link may bring about the threshold, and times its power
+    // about kLinkPowerShare of the unit, within bounds: a pure pilot's link has no shadow
+    // boundary in sight, a mixed one that cannot be split has.
+    const float ratio = std::max(error.bound / rc.threshold, power_share(rc, r, error) / kLinkPowerShare);
     const float wanted = 0.25f * ratio * ratio;
     int rays = static_cast<int>(std::clamp(wanted, static_cast<float>(kFirstRays), static_cast<float>(kMaxPureRays)));
     if (partly_hidden) {
