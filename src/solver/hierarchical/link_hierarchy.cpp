@@ -83,8 +83,8 @@ constexpr float kSeparationFloor = 0.1f;
 /// power_share()). Group means are area integrals, so a link's error counts in a group by its
 /// power, which the per-link threshold (irradiance) does not bound: in a scene of few patches
 /// one link can carry a large share of a group's light; in a large scene none does, and the two
-/// rules below leave it alone. Hanrahan et al. 1991's brightness-weighted oracle weighted by
-/// area ("BFA"):
+/// rules below leave it alone. Hanrahan, Salzman & Aupperle 1991's brightness-weighted ("BF")
+/// oracle weighted by area, the power ("BFA") criterion of later hierarchical systems:
 /// - a link with a cluster end is refined, whatever the separation, while its share exceeds
 ///   kLinkPowerShare: the corrected centroid transport's small relative error has one sign over
 ///   the many cluster links into a group;
