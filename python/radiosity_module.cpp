@@ -406,6 +406,12 @@ Doubles element_values(const PySolution& s, const std::string& quantity) {
   return rgb_rows(out);
 }
 
+/// The estimator that ran, or None for the hierarchical solver (its links are its own transport).
+py::object estimator_used(const rad::SolveReport& r) {
+  if (r.method == rad::SolverMethod::hierarchical) return py::none();
+  return py::str(rad::to_string(r.form_factor_method));
+}
+
 py::dict report_dict(const rad::Solution& s) {
   const rad::SolveReport& r = s.report();
   py::dict d;
@@ -416,7 +422,7 @@ py::dict report_dict(const rad::Solution& s) {
   d["time_history"] = vector_array<double>(r.time_history);
   d["method"] = name_of(r.method, kSolverMethods);
   d["method_choice"] = r.method_choice;
-  d["form_factor_method"] = rad::to_string(r.form_factor_method);
+  d["form_factor_method"] = estimator_used(r);
   d["patch_count"] = r.patch_count;
   d["element_count"] = r.element_count;
   d["refined_elements"] = r.refined_elements;
@@ -790,8 +796,9 @@ PYBIND11_MODULE(radiosity, m) {
       .def_property_readonly("residual", [](const PySolution& s) { return s.solution.report().residual; })
       .def_property_readonly("method", [](const PySolution& s) { return name_of(s.solution.report().method, kSolverMethods); },
                              "The solver that ran (never 'auto').")
-      .def_property_readonly("form_factor_method",
-                             [](const PySolution& s) { return rad::to_string(s.solution.report().form_factor_method); })
+      .def_property_readonly("form_factor_method", [](const PySolution& s) { return estimator_used(s.solution.report()); },
+                             "The form-factor estimator that ran, or None for the hierarchical solver (its links are "
+                             "its own transport).")
       .def_property_readonly("seconds", [](const PySolution& s) { return total_seconds(s.solution.report()); },
                              "Wall time of meshing, lights, form factors and solving.")
       .def_property_readonly("report", [](const PySolution& s) { return report_dict(s.solution); },

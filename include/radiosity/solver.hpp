@@ -151,7 +151,8 @@ struct SolveReport {
   SolverMethod method = SolverMethod::gauss_seidel;
   std::string method_choice;
   /// The estimator that ran: SolveOptions' form_factors.method with automatic resolved
-  /// (choose_form_factor_method()).
+  /// (choose_form_factor_method()). SolverMethod::hierarchical runs none (its links are its
+  /// own transport); there it is the options' method, resolved as for the others.
   FormFactorMethod form_factor_method = FormFactorMethod::automatic;
   /// FormFactorOptions::specular_depth of the factors: how many mirror reflections and window
   /// passages the solution carries between diffuse surfaces (0: classic radiosity). The

@@ -45,6 +45,18 @@ def test_cornell_box_solution_is_finite_and_balances_energy():
     assert np.all(solution.element_polygons() < len(scene.polygons))
 
 
+def test_form_factor_method_names_the_estimator_that_ran_and_none_for_hierarchical():
+    scene = radiosity.cornell_box()
+    matrix = radiosity.solve(scene, "gauss-seidel", max_patch_area=40000)
+    assert matrix.form_factor_method in ("monte-carlo", "ray-cast")
+    assert matrix.report["form_factor_method"] == matrix.form_factor_method
+    links = radiosity.solve(scene, "hierarchical", max_patch_area=40000)
+    assert links.method == "hierarchical"
+    assert links.form_factor_method is None
+    assert links.report["form_factor_method"] is None
+    assert links.report["link_count"] > 0
+
+
 def test_mesh_vertex_values_on_a_triangle_scene():
     vertices, quads, _ = unit_cube_arrays()
     triangles = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])

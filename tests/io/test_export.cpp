@@ -333,6 +333,29 @@ TEST_CASE("write_mesh_ply writes the host's vertices and triangles with UV1 and 
   }
 }
 
+TEST_CASE("write_stats_json names the estimator that ran, and none for the hierarchical solver") {
+  // The hierarchical solver's links are its own transport: until session 28 the file said
+  // "monte_carlo" there, an estimator that never ran.
+  const radiosity::Scene scene = radiosity::cornell_box();
+  for (const radiosity::SolverMethod method : {radiosity::SolverMethod::gauss_seidel, radiosity::SolverMethod::hierarchical}) {
+    radiosity::SolveOptions opt;
+    opt.method = method;
+    opt.mesh.max_patch_area = 40000.0f;
+    const radiosity::Solution sol = radiosity::solve(scene, opt);
+    const fs::path path = kTmp / "stats_estimator.json";
+    radiosity::write_stats_json(sol, path, opt, "cornell");
+    const nlohmann::json j = nlohmann::json::parse(read_all(path));
+    if (method == radiosity::SolverMethod::hierarchical) {
+      CHECK(j.at("method_used") == "hierarchical");
+      CHECK(j.at("form_factor_method_used").is_null());
+      CHECK(j.at("link_count").get<std::uint64_t>() > 0);
+    } else {
+      CHECK(j.at("method_used") == "gauss_seidel");
+      CHECK(j.at("form_factor_method_used") == "monte_carlo");  // automatic, on a mesh this small
+    }
+  }
+}
+
 TEST_CASE("write_stats_json with options records the scene and the solve's method") {
   const radiosity::Solution sol = small_solution();
   radiosity::SolveOptions opt;
