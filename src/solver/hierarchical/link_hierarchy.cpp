@@ -93,19 +93,24 @@ constexpr float kSeparationFloor = 0.1f;
 ///   a few strong links of the lamp into floor elements half in a block's shadow, 12 rays each,
 ///   moved the floor's mean by up to 2.6 % from one seed to the next.
 /// Measured (worst group mean against Gauss-Seidel over element-to-element factors, epsilon
-/// 0.05, seeds averaged):
-/// - the Cornell box at 100 mm elements, 8 seeds: 0.60 % (the ceiling) -> 0.44 % with the
-///   refinement (0.36 % at a share of 0.0003) -> 0.35 % with the rays too; the floor on single
-///   seeds from -1.5..+2.6 % to -0.7..+0.6 %, every group of every seed within 0.7 %;
-/// - at 16 679 elements, 4 seeds: 0.48 % (the floor) -> 0.33 % (the rays change nothing there);
-/// - the 22k city: links +0.5 % (+3.7 % at 0.0003), link rays unchanged, element RMS against
-///   its reference 1.36 % either way; the 246k city: links +0.2 % at 0.0003;
+/// 0.05, seeds averaged), without the rules / at a share of 0.001 / at 0.0002 (kept):
+/// - the Cornell box at 100 mm elements (248), 8 seeds: 0.60 / 0.35 / 0.35 % (the ceiling); the
+///   floor on single seeds -1.5..+2.6 % without the rays rule, within 0.7 % with it;
+/// - at 50 mm (about 1 000), 8 seeds: 0.70 / 0.65 / 0.29 % (0.41 % at 0.0003, 0.20 % at
+///   0.0001): the smaller the elements, the smaller each cluster link's share, while their sum
+///   stays, so a share that holds at 100 mm did not at 50;
+/// - at 16 679 elements, 4 seeds: 0.48 / 0.33 / 0.34 %;
+/// - the 22k city: links 0.94 / 0.94 / 1.00 M (1.10 M at 0.0001), link rays 11.5 / 11.5 /
+///   12.8 M, element RMS against its reference 1.36 / 1.36 / 1.35 %; the 246k city at 0.0001:
+///   links +1.2 %, link rays +4 %;
 /// - closed rooms of reflectance 0.99 (tests/data/exported_room.obj, room_lamp_under_ceiling.obj,
-///   made two-sided), balanced: the inside -0.7 % -> -0.1 % and -3.0 % -> -1.1 % against
-///   Gauss-Seidel, at 1.8 times the solve time (a third refinement pass, more sweeps); at 0.0003
-///   the first came out -3.3 %, more links losing more light than the balancing restores.
+///   made two-sided), balanced, the inside against Gauss-Seidel: -0.8 / -0.1 / -1.4 % and
+///   -3.0 / -1.1 / -0.3 %, at up to 2.5 times the solve time (a third refinement pass, more
+///   sweeps); the balancing's result moves by shares there (-3.3 % at 0.0003, +0.1 % at 0.0001).
+///   Without the balancing the links' loss grows with their number (the exported room -1.1 /
+///   -3.1 / -6.4 %: at reflectance 0.99 a loss of 0.06 % of a bounce).
 /// kSeparation 0.3 instead gives 0.38 % on the small box, at 1.7 times the city's links.
-constexpr float kLinkPowerShare = 0.001f;
+constexpr float kLinkPowerShare = 0.0002f;
 /// A partly hidden link into a cluster is refined while it may bring more than this fraction of
 /// the threshold (other partly hidden links: more than the threshold). A cluster spreads what it
 /// receives over its members alike, so light that only some of them see reaches the hidden ones
