@@ -541,7 +541,7 @@ TEST_SUITE("solver") {
     // converge, the report says why they were held, and the room's inside agrees with
     // Gauss-Seidel within 8 %: measured 18.243 against 18.277 (0.19 %) in session 15, 18.06
     // against 18.26 at the start of session 28, and 17.09 (-6.4 %) since its refinement of
-    // cluster links by power (kLinkPowerShare: 1.1 times the links here), which moves the links
+    // cluster links by power (kLinkPowerShare: 1.5 times the links here), which moves the links
     // from gaining light to losing it; at reflectance 0.99 a loss of 0.06 % of the light a
     // bounce carries is 6 % of the radiosity. The balancing (the default, below) is what holds a
     // closed region's rows to 1: -1.4 % there (-0.8 % before session 28). The inside of the box
