@@ -5,7 +5,8 @@
 //    error and row standard errors before the correction, the sky view factors per group;
 //  - a closed, obstructed enclosure of facets (a faceted room around a faceted block) in exact
 //    mode (ray_cast: contour integrals, occlusion by shaft-culled rays) and fast mode, both
-//    enclosure-corrected: their agreement per row sum and per large factor, and the speed ratio;
+//    enclosure-corrected, and the hierarchical links' rows (ViewFactorMethod::hierarchical): their
+//    agreement per row sum and per large factor, and the speed ratios;
 //    and, side by side with NIST View3D (G. N. Walton, "Calculation of obstructed view factors by
 //    adaptive integration", NISTIR 6925, 2002), built apart from this repository: --write-vs3
 //    writes the room as View3D's input file, --view3d-output reads View3D's text output for it
@@ -360,20 +361,31 @@ bool enclosure_part(const Args& a) {
   char what[96];
   std::snprintf(what, sizeof what, "fast (monte-carlo, %u rays per facet), enclosure", a.rays);
   print_matrix(what, fast);
+  // The hierarchical links' rows (ViewFactorMethod::hierarchical, at ViewFactorOptions' epsilon).
+  o.method = rad::ViewFactorMethod::hierarchical;
+  const rad::ViewFactorMatrix links = rad::view_factor_matrix(scene, o);
+  std::snprintf(what, sizeof what, "hierarchical links (epsilon %g), enclosure", static_cast<double>(o.epsilon));
+  print_matrix(what, links);
+  o.method = rad::ViewFactorMethod::estimator;
   // Agreement: factors of 0.01 and more in the exact matrix.
-  double worst = 0.0, squares = 0.0;
-  std::size_t large = 0;
-  for (std::size_t i = 0; i < exact.rows(); ++i)
-    for (std::uint64_t k = exact.row_offsets[i]; k < exact.row_offsets[i + 1]; ++k) {
-      if (exact.values[k] < 0.01f) continue;
-      const double d = std::fabs(fast.at(i, exact.columns[k]) - static_cast<double>(exact.values[k]));
-      worst = std::max(worst, d);
-      squares += d * d;
-      ++large;
-    }
-  std::printf("  fast against exact, over the %zu factors >= 0.01: largest |difference| %.3g, RMS %.3g\n", large, worst,
-              large ? std::sqrt(squares / static_cast<double>(large)) : 0.0);
-  std::printf("  speed: fast is %.1fx the exact mode's\n", exact.seconds / fast.seconds);
+  auto against_exact = [&](const char* name, const rad::ViewFactorMatrix& m) {
+    double worst = 0.0, squares = 0.0;
+    std::size_t large = 0;
+    for (std::size_t i = 0; i < exact.rows(); ++i)
+      for (std::uint64_t k = exact.row_offsets[i]; k < exact.row_offsets[i + 1]; ++k) {
+        if (exact.values[k] < 0.01f) continue;
+        const double d = std::fabs(m.at(i, exact.columns[k]) - static_cast<double>(exact.values[k]));
+        worst = std::max(worst, d);
+        squares += d * d;
+        ++large;
+      }
+    std::printf("  %s against exact, over the %zu factors >= 0.01: largest |difference| %.3g, RMS %.3g\n", name, large,
+                worst, large ? std::sqrt(squares / static_cast<double>(large)) : 0.0);
+  };
+  against_exact("fast", fast);
+  against_exact("hierarchical", links);
+  std::printf("  speed: fast is %.1fx the exact mode's, hierarchical %.1fx\n", exact.seconds / fast.seconds,
+              exact.seconds / links.seconds);
   if (a.view3d_output.empty()) return true;
 
   // Side by side with View3D: our exact mode once more without correction, then both modes
@@ -407,6 +419,7 @@ bool enclosure_part(const Args& a) {
   print_agreement("exact, no correction", exact_raw, scene);
   print_agreement("exact, enclosure", against_view3d(exact, view3d), scene);
   print_agreement("fast, enclosure", against_view3d(fast, view3d), scene);
+  print_agreement("hierarchical, enclosure", against_view3d(links, view3d), scene);
   if (a.view3d_seconds > 0.0) {
     const unsigned threads = a.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : a.threads;
     std::printf("  time: View3D %.1f s (one thread; measured outside) against the exact mode's %.2f s on %u threads"

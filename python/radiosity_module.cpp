@@ -615,7 +615,8 @@ level: 'polygon' (rows are the scene's polygons in order, obstruction-only ones 
 'element' (the leaves of the mesh that max_patch_area/max_element_area make) or 'group'.
 method: 'auto' (= 'ray-cast': exact unoccluded factors, occlusion by rays), 'ray-cast',
 'analytic' (no occlusion), 'hemicube', 'monte-carlo' (hemisphere_rays per element; rows x rays
-cost, for large scenes) or 'hierarchical' (group level only, epsilon its refinement threshold).
+cost, for large scenes) or 'hierarchical' (the links of hierarchical radiosity, epsilon their
+refinement threshold; reciprocal whatever the correction).
 correction: 'none', 'reciprocity' (A_i F_ij = A_j F_ji exactly) or 'enclosure' (reciprocity
 and rows summing to 1, for closed enclosures). groups: names of the groups whose surfaces are
 rows and columns (None = all). seed and threads as in solve(); the result does not depend on

@@ -237,9 +237,9 @@ enum class ViewFactorMethod {
   /// grow as elements x patches.
   estimator,
   /// Hierarchical radiosity's links (SolverMethod::hierarchical, docs/HIERARCHICAL.md), refined
-  /// for unit radiosity on every surface against ViewFactorOptions::epsilon: cost close to
-  /// linear in the scene; the group factors are made reciprocal (A_i F_ij = A_j F_ji exactly)
-  /// by averaging each pair's two transports.
+  /// for unit radiosity on every surface against ViewFactorOptions::epsilon: links close to
+  /// linear in the scene; the factors at every level are made reciprocal (A_i F_ij = A_j F_ji
+  /// exactly) by averaging each pair's two transports.
   hierarchical,
 };
 
@@ -396,10 +396,13 @@ struct ViewFactorMatrix {
 /// polygons of those groups only. The estimator options.form_factors.method names computes
 /// every row (automatic means ray_cast: exact unoccluded factors, occlusion by rays, cost
 /// rows x polygons; monte_carlo: hemisphere rays per element, cost and memory rows x rays,
-/// the method for large scenes); ViewFactorMethod::hierarchical is group level only. Memory
-/// is bounded by the result plus a few thousand element rows; the same scene, options and
-/// seed give bit-identical results at any thread count. Throws as view_factors() does, and
-/// Error{invalid_argument} for ViewFactorMethod::hierarchical below group level.
+/// the method for large scenes). ViewFactorMethod::hierarchical takes each row from the links
+/// (the transpose of their gather at unit radiosity: a cluster link spreads over every patch
+/// of its source that faces it, so rows are as dense as the view factors are, up to every
+/// polygon in a closed room) and always makes them reciprocal (correction none acts as
+/// reciprocity). Memory is bounded by the result plus a few thousand element rows (and the
+/// links); the same scene, options and seed give bit-identical results at any thread count.
+/// Throws as view_factors() does.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions& options = {});
 

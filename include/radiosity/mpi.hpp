@@ -31,8 +31,9 @@ namespace mpi {
 /// applies options.correction. Rank 0 returns the whole matrix, bit for bit the single-process
 /// result (seconds aside); every other rank returns its own block only, uncorrected (its rows
 /// named by `ids`, its columns numbering the whole matrix's rows, `sky` from its row sums,
-/// `correction` empty). The group level (and ViewFactorMethod::hierarchical) is not split:
-/// rank 0 computes it alone and the other ranks return an empty matrix of that level. Memory
+/// `correction` empty). With ViewFactorMethod::hierarchical every process refines the same
+/// links (the whole scene's) and computes its block's rows from them. The group level is not
+/// split: rank 0 computes it alone and the other ranks return an empty matrix of that level. Memory
 /// per process: the scene, its mesh and ray scene, and its block's rows; rank 0 holds the whole
 /// matrix as well. on_progress is called on every process for its block; a cancel stops that
 /// process's block, and the matrix is then `cancelled` on every rank, which returns its own
@@ -66,7 +67,8 @@ struct ViewFactorBlock {
 /// The rows of this process only (see view_factor_matrix() for how they are split). The
 /// correction needs the whole matrix: options.correction must be none. Polygon and element
 /// levels only. Throws Error{invalid_argument} for ViewFactorLevel::group,
-/// ViewFactorMethod::hierarchical or a correction, and as view_factor_matrix() does; errors are
+/// ViewFactorMethod::hierarchical (its factors are made reciprocal over the whole matrix) or a
+/// correction, and as view_factor_matrix() does; errors are
 /// collective. Memory per process: the scene, its mesh and ray scene, and its block.
 /// Thread safety: collective; one call at a time per communicator.
 RADIOSITY_API ViewFactorBlock view_factor_block(const Scene& scene, const ViewFactorOptions& options, MPI_Comm comm);

@@ -73,6 +73,20 @@ def test_monte_carlo_states_row_errors_and_group_level_names_rows(cube):
     assert g[0, 1] == pytest.approx(OPPOSITE, rel=5e-3)
 
 
+def test_hierarchical_links_per_polygon_are_reciprocal_and_match_howell(cube):
+    # The links' rows (the transpose of their gather), made reciprocal even without a correction.
+    f, info = radiosity.view_factor_matrix(cube, method="hierarchical", epsilon=0.05, return_info=True,
+                                           max_patch_area=1.0, max_element_area=1.0 / 16)
+    assert info["method"] == "hierarchical"
+    dense = f.toarray()
+    expected = expected_cube_matrix()
+    off = expected > 0
+    np.testing.assert_allclose(dense[off], expected[off], rtol=1e-2)
+    np.testing.assert_allclose(dense.sum(axis=1), np.ones(6), atol=1e-2)
+    area = info["area"]
+    np.testing.assert_allclose(area[:, None] * dense, (area[:, None] * dense).T, rtol=1e-6)
+
+
 def test_view_factors_of_a_loaded_view3d_cube(data_dir):
     scene = radiosity.load_scene(data_dir / "view3d" / "cube.vs3")
     f = radiosity.view_factor_matrix(scene, threads=1, max_patch_area=4.0, max_element_area=1.0)

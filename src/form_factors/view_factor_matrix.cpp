@@ -35,6 +35,7 @@
 #include "form_factors/exact_view_factors.hpp"
 #include "form_factors/view_factor_correction.hpp"
 #include "form_factors/view_factor_rows.hpp"
+#include "solver/hierarchical/link_view_factors.hpp"
 #include "radiosity/form_factors.hpp"
 
 namespace radiosity {
@@ -335,10 +336,9 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
   if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factor_matrix: the scene has no polygons");
   const FormFactorOptions ff = detail::view_factor_estimator_options(options);
   const bool links = options.method == ViewFactorMethod::hierarchical;
-  if (links && options.level != ViewFactorLevel::group)
+  if (links && !(options.epsilon > 0.0f && options.epsilon <= 1.0f))
     throw Error(ErrorCode::invalid_argument,
-                std::string("view_factor_matrix: the hierarchical method gives group-level factors only (level '") +
-                    to_string(options.level) + "'); use the estimator method (monte_carlo for large scenes)");
+                "view_factor_matrix: epsilon must be in (0, 1], got " + std::to_string(options.epsilon));
 
   ViewFactorMatrix out;
   out.level = options.level;
@@ -388,7 +388,7 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     Progress start;
     start.phase = Phase::form_factors;
     out.cancelled = !gate.report(start, true);
-    out.method = to_string(ff.method);
+    out.method = links ? "hierarchical" : to_string(ff.method);
     if (!out.cancelled) {
       const detail::ViewFactorRows rows(scene, options, &options.on_progress);
       out.cancelled = rows.cancelled();
@@ -418,6 +418,10 @@ struct ViewFactorRows::Impl {
   ViewFactorLevel level = ViewFactorLevel::polygon;
   std::size_t memory_budget = detail::kDefaultMemoryBudget;  ///< ViewFactorOptions::memory_budget_bytes, resolved
   FormFactorOptions ff;
+  /// ViewFactorMethod::hierarchical: the links' rows (refined against `epsilon`) instead of the
+  /// estimator's.
+  bool links = false;
+  float epsilon = 0.0f;
   /// Element level: the given scene's mesh (its leaves name the rows) and the scene whose
   /// polygons are its leaf elements, on which the rows are computed.
   std::optional<PatchHierarchy> element_mesh;
@@ -450,6 +454,8 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
   m.level = options.level;
   m.memory_budget = detail::resolve_memory_budget(options.memory_budget_bytes);
   m.ff = view_factor_estimator_options(options);
+  m.links = options.method == ViewFactorMethod::hierarchical;
+  m.epsilon = options.epsilon;
   std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
   MeshOptions mesh = options.mesh;
   m.scene = &scene;
@@ -518,7 +524,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   const std::vector<std::uint32_t>& sources = m.sources;
   const std::size_t rows = end - begin;
   out.level = m.level;
-  out.method = to_string(m.ff.method);
+  out.method = m.links ? "hierarchical" : to_string(m.ff.method);
   out.ids.assign(m.ids.begin() + static_cast<std::ptrdiff_t>(begin), m.ids.begin() + static_cast<std::ptrdiff_t>(end));
   // Element level: leaf position -> element id.
   if (m.element_mesh)
@@ -529,7 +535,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   out.values.clear();
   out.element_count = first[end] - first[begin];
   out.cancelled = false;
-  const bool monte_carlo = m.ff.method == FormFactorMethod::monte_carlo;
+  const bool monte_carlo = !m.links && m.ff.method == FormFactorMethod::monte_carlo;
   // The rows' share of the progress (the sky's rays come after them): about half of the rays
   // for Monte Carlo, most of the work for the other estimators.
   const double rows_share = monte_carlo ? 0.5 : 0.9;
@@ -539,7 +545,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   if (monte_carlo) out.row_standard_error.assign(rows, 0.0);
   if (rows == 0) return;
 
-  if (m.ff.method == FormFactorMethod::ray_cast) {
+  if (!m.links && m.ff.method == FormFactorMethod::ray_cast) {
     // The exact mode: polygon pairs integrated once, without rays (exact_view_factors.hpp).
     out.cancelled =
         !exact_rows(*m.scene, m.ids, m.area, begin, end, m.ff.threads, m.memory_budget, gate, rows_share, out);
@@ -547,7 +553,23 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
       out.cancelled = !row_sky(*m.scene, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
     return;
   }
-  const std::unique_ptr<FormFactorEstimator> estimator = make_form_factor_estimator(*m.scene, hierarchy, m.ff);
+  // The element rows: the estimator's, or the links' (refined over the whole scene, so every
+  // block of rows refines the same links: a process of a split computation too). refine()
+  // takes its mesh mutable though it splits nothing here, so the links get a copy.
+  std::unique_ptr<FormFactorEstimator> estimator;
+  std::optional<PatchHierarchy> linked_mesh;
+  std::unique_ptr<LinkHierarchy> links;
+  if (m.links) {
+    std::uint64_t rays = 0;
+    links = view_factor_links(*m.scene, linked_mesh.emplace(hierarchy), m.epsilon, m.ff.seed, m.ff.threads,
+                              m.memory_budget, gate, rays);
+    if (!links) {
+      out.cancelled = true;
+      return;
+    }
+  } else {
+    estimator = make_form_factor_estimator(*m.scene, hierarchy, m.ff);
+  }
   std::vector<double> sum(m.ids.size(), 0.0);  // the accumulator of one row, by column
   std::vector<std::uint32_t> touched;
   std::vector<std::uint32_t> batch;
@@ -560,7 +582,10 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
     while (last < end && (last == row || first[last] - first[row] < chunk.size())) ++last;
     batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
                  sources.begin() + static_cast<std::ptrdiff_t>(first[last]));
-    estimator->sparse_element_rows(batch, element_rows);
+    if (links)
+      links->view_factor_rows(*linked_mesh, batch, element_rows);
+    else
+      estimator->sparse_element_rows(batch, element_rows);
     chunk.done(batch.size());
     for (std::size_t r = row; r < last; ++r) {
       touched.clear();
@@ -622,8 +647,14 @@ void fill_missing_sky(ViewFactorMatrix& m) {
 void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options, ViewFactorMatrix& out) {
   if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
   if (!out.cancelled) {
+    // The links' two directions of a pair were refined and sampled apart: their factors are
+    // reciprocal by construction, each pair's transport the mean of the two (as at group level).
+    const ViewFactorCorrection correction =
+        options.method == ViewFactorMethod::hierarchical && options.correction == ViewFactorCorrection::none
+            ? ViewFactorCorrection::reciprocity
+            : options.correction;
     SparseRowsF F{std::move(out.row_offsets), std::move(out.columns), std::move(out.values)};
-    out.correction = correct_view_factors(options.correction, out.area, F, view_factor_estimator_options(options).threads);
+    out.correction = correct_view_factors(correction, out.area, F, view_factor_estimator_options(options).threads);
     out.row_offsets = std::move(F.offsets);
     out.columns = std::move(F.columns);
     out.values = std::move(F.values);

@@ -64,10 +64,9 @@ Block compute_block(const Scene& scene, const ViewFactorOptions& options, const 
   detail::collectively(comm, [&] {
     if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factor_matrix: the scene has no polygons");
     const FormFactorOptions ff = detail::view_factor_estimator_options(options);
-    if (options.method == ViewFactorMethod::hierarchical)
+    if (options.method == ViewFactorMethod::hierarchical && !(options.epsilon > 0.0f && options.epsilon <= 1.0f))
       throw Error(ErrorCode::invalid_argument,
-                  std::string("view_factor_matrix: the hierarchical method gives group-level factors only (level '") +
-                      to_string(options.level) + "'); use the estimator method (monte_carlo for large scenes)");
+                  "view_factor_matrix: epsilon must be in (0, 1], got " + std::to_string(options.epsilon));
     detail::ProgressGate gate(options.on_progress);
     Progress start;
     start.phase = Phase::form_factors;
@@ -78,7 +77,7 @@ Block compute_block(const Scene& scene, const ViewFactorOptions& options, const 
     const std::size_t first = block.offsets[static_cast<std::size_t>(comm.rank())];
     const std::size_t last = cancelled ? first : block.offsets[static_cast<std::size_t>(comm.rank()) + 1];
     rows.compute(first, last, gate, block.rows);
-    block.rows.method = to_string(ff.method);
+    block.rows.method = options.method == ViewFactorMethod::hierarchical ? "hierarchical" : to_string(ff.method);
     block.rows.cancelled = block.rows.cancelled || cancelled;
   });
   block.rows.cancelled = comm.any(block.rows.cancelled);
@@ -165,6 +164,10 @@ ViewFactorBlock view_factor_block(const Scene& scene, const ViewFactorOptions& o
     if (options.level == ViewFactorLevel::group)
       throw Error(ErrorCode::invalid_argument,
                   "mpi::view_factor_block: the group level is not split into blocks (use mpi::view_factor_matrix())");
+    if (options.method == ViewFactorMethod::hierarchical)
+      throw Error(ErrorCode::invalid_argument,
+                  "mpi::view_factor_block: the hierarchical links' factors are made reciprocal over the whole matrix: "
+                  "use mpi::view_factor_matrix()");
     if (options.correction != ViewFactorCorrection::none)
       throw Error(ErrorCode::invalid_argument,
                   std::string("mpi::view_factor_block: the ") + to_string(options.correction) +

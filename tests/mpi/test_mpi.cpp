@@ -198,6 +198,22 @@ TEST_SUITE("mpi") {
     check_view_factors(scene, coarse(factor_options(rad::ViewFactorLevel::group, rad::FormFactorMethod::monte_carlo)));
   }
 
+  TEST_CASE("mpi view factors from the hierarchical links per polygon are the single process's bit for bit") {
+    // Every process refines the same links; rank 0 gathers the rows and makes them reciprocal.
+    const rad::Scene scene = rad::cornell_box();
+    rad::ViewFactorOptions o;
+    o.method = rad::ViewFactorMethod::hierarchical;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.mesh.max_patch_area = 40000.0f;
+    o.mesh.max_element_area = 40000.0f;
+    const rad::ViewFactorMatrix single = rad::view_factor_matrix(scene, o);
+    const rad::ViewFactorMatrix split = rad::mpi::view_factor_matrix(scene, o, MPI_COMM_WORLD);
+    if (rank() == 0) check_same_matrix(split, single);
+    CHECK(split.method == "hierarchical");
+    CHECK_THROWS_WITH_AS(rad::mpi::view_factor_block(scene, o, MPI_COMM_WORLD), doctest::Contains("reciprocal"),
+                         rad::Error);
+  }
+
   TEST_CASE("mpi view factors with the enclosure correction of a meshed closed box are the single process's") {
     const rad::Scene scene = test::closed_box(rad::Material{}, glm::vec3(1.0f, 2.0f, 3.0f));
     rad::ViewFactorOptions o =

@@ -211,8 +211,12 @@ int run_factors(const FactorsArgs& a) {
     ProgressBar bar;
     o.on_progress = [&bar](const rad::Progress& p) { return bar.update(p); };
     if (!a.blocks.empty()) {
-      if (o.level == rad::ViewFactorLevel::group || o.method == rad::ViewFactorMethod::hierarchical)
-        throw rad::Error(rad::ErrorCode::invalid_argument, "--blocks is for --level polygon or element (the estimator's rows)");
+      if (o.level == rad::ViewFactorLevel::group)
+        throw rad::Error(rad::ErrorCode::invalid_argument, "--blocks is for --level polygon or element");
+      if (o.method == rad::ViewFactorMethod::hierarchical)
+        throw rad::Error(rad::ErrorCode::invalid_argument,
+                         "--blocks writes uncorrected rows: the hierarchical links' factors are made reciprocal over the "
+                         "whole matrix");
       if (o.correction != rad::ViewFactorCorrection::none)
         throw rad::Error(rad::ErrorCode::invalid_argument,
                          "--blocks writes uncorrected rows: the " + correction + " correction needs the whole matrix");

@@ -13,6 +13,7 @@
 #include <limits>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -1576,6 +1577,180 @@ struct LinkHierarchy::Impl {
     }
   }
 
+  // ---- View factors from the links ------------------------------------------------------------
+
+  /// What view_factor_rows() reads besides the links: the push's shares at unit radiosity on
+  /// every front, and each cluster's parent.
+  struct RowContext {
+    PushShares shares;
+    std::vector<std::uint32_t> parent;
+  };
+  std::unique_ptr<RowContext> row_context;
+
+  /// Per thread: transport_row()'s sums, zero between rows.
+  struct RowWorkspace {
+    std::vector<std::array<double, 6>> R;  ///< per cluster: per unit of its sending moments
+    std::vector<std::uint8_t> queued;      ///< per cluster: in `heap`
+    std::vector<std::uint32_t> heap;       ///< clusters to push down, smallest id first
+    std::vector<double> by_patch;          ///< per patch: transport from the row's element
+    std::vector<std::uint32_t> patches;    ///< patches with a non-zero by_patch
+  };
+
+  /// One row of the links' view factors: F(e -> p) for the front of leaf element `e` to the
+  /// front of every patch p, into `row` (patches increasing). It is adjoint_delivery() for a
+  /// weight of 1 on e alone: the push's transpose only along e's ancestors (its parent elements,
+  /// its patch's leaf cluster and that cluster's parents), the links into those, and each
+  /// source cluster's sending moments down to its patches. So a row costs its ancestors' links
+  /// plus the source clusters' subtrees it reaches: as dense as the links make it.
+  void transport_row(const PatchHierarchy& h, std::uint32_t e, RowWorkspace& ws, SparseFactors& row) const {
+    row.index.clear();
+    row.value.clear();
+    row.exposed = 1.0f;
+    const double area = h.element(e).area;
+    // A wholly buried element (every point the burial test tried is inside a solid: the floor
+    // under a block) sees nothing, nor is it seen (below), whatever the few rays of its element
+    // links that graze the solid's edge found (up to 8e-5 of a row on the 3 708-facet room
+    // around a block).
+    if (!(area > 0.0) || element_exposure(e, false) == 0.0f) return;
+    const RowContext& context = *row_context;
+    const std::uint32_t elements = linked_elements;
+    const std::vector<Patch>& patches = h.patches();
+    auto add_patch = [&](std::uint32_t p, double t) {
+      if (!(t > 0.0)) return;
+      if (ws.by_patch[p] == 0.0) ws.patches.push_back(p);
+      ws.by_patch[p] += t;
+    };
+    auto queue = [&](std::uint32_t c) {
+      if (ws.queued[c]) return;
+      ws.queued[c] = 1;
+      ws.heap.push_back(c);
+      std::push_heap(ws.heap.begin(), ws.heap.end(), std::greater<>());
+    };
+    // As adjoint_delivery()'s from_source(): kappa per unit of I_s(w); fronts only (the view
+    // factors' radiosity is 1 on every front, 0 on every back). A source cluster's share goes to
+    // its open parts only: the links were refined with every patch sending, buried ones too (a
+    // floor under a block), and their rays from buried points were blocked, so the link already
+    // carries the open parts' light alone; it is spread over their open area (each moment over
+    // its open share here, each patch by its open area below), else a buried patch would get a
+    // share of it and keep the open ones' (measured on the 3 708-facet room around a block: ten
+    // floor facets under the block with rows of up to 1e-3 after the reciprocity averaging).
+    auto from_source = [&](NodeHandle s, const glm::vec3& w, double kappa) {
+      if (is_cluster(s)) {
+        const std::uint32_t c = handle_index(s);
+        const MomentBasis& b = bases.of(c);
+        std::array<double, 6>& to = ws.R[c];
+        auto add = [&](int k, double amount) {
+          const double open = wholly_exposed(c) ? 1.0 : cluster_exposure_toward(c, b.direction(k));
+          if (open > 0.0) to[static_cast<std::size_t>(k)] += amount / open;
+        };
+        if (b.axes) {
+          for (int a = 0; a < 3; ++a)
+            if (w[a] != 0.0f) add(w[a] >= 0.0f ? 2 * a : 2 * a + 1, kappa * kInvPi * std::abs(w[a]));
+        } else {
+          for (int k = 0; k < b.count; ++k)
+            add(k, kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w)));
+        }
+        queue(c);
+        return;
+      }
+      if (is_back(s) || element_exposure(element_of(s), false) == 0.0f) return;
+      const std::uint32_t x = element_of(s);
+      add_patch(h.element(x).patch, kappa * h.element(x).area * std::max(0.0f, glm::dot(side_normal(h, s), w)) * kInvPi);
+    };
+    // Up the element chain: W, what unit irradiance on each ancestor side delivers into e (the
+    // push's shares and exposure ratios), and the links into each.
+    double W = area;
+    std::uint32_t x = e;
+    for (;;) {
+      const NodeHandle r = side_handle(x, false);
+      const std::uint64_t i = receiver_index(r, elements);
+      const glm::vec3 cr = centroid(h, r), nr = side_normal(h, r);
+      for (std::uint64_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+        const NodeHandle s = sources[k];
+        if (!is_cluster(s)) {
+          if (!is_back(s) && element_exposure(element_of(s), false) != 0.0f)
+            add_patch(h.element(element_of(s)).patch, std::abs(coefficients[k]) * W);
+          continue;
+        }
+        const glm::vec3 w = glm::normalize(cr - centroid(h, s));
+        from_source(s, w, std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w)) * W);
+      }
+      const std::uint32_t parent = h.element(x).parent;
+      if (parent == kNone) break;
+      W *= context.shares.of_side(2 * std::size_t{x}) * exposure_ratio(element_exposure(x, false), element_exposure(parent, false));
+      x = parent;
+    }
+    // Up the cluster chain: Q, what unit irradiance moments on each cluster deliver into e.
+    const std::uint32_t p = h.element(e).patch;
+    std::uint32_t c = tree.leaf_of(p);
+    std::array<double, 6> Q{};
+    const SideDirection front = bases.front(p, patches[p].normal);
+    add_element_weight(Q, bases.of(c), front, W * exposure_ratio(element_exposure(x, false), cluster_exposure_toward(c, front)));
+    for (;;) {
+      const glm::vec3 cr = cluster_centroid[c];
+      const MomentBasis& b = bases.of(c);
+      for (std::uint64_t k = offsets[c]; k < offsets[c + 1]; ++k) {
+        const NodeHandle s = sources[k];
+        const glm::vec3 w = glm::normalize(cr - centroid(h, s));
+        // add_irradiance()'s transpose: sum_k Q_k max(0, u_k . d), d = -w.
+        double taken = 0.0;
+        if (b.axes) {
+          for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * Q[2 * a] : w[a] * Q[2 * a + 1];
+        } else {
+          for (int j = 0; j < b.count; ++j)
+            taken += std::max(0.0f, -glm::dot(b.directions[static_cast<std::size_t>(j)], w)) * Q[static_cast<std::size_t>(j)];
+        }
+        from_source(s, w, std::abs(coefficients[k]) * taken);
+      }
+      const std::uint32_t parent = context.parent[c];
+      if (parent == kNone) break;
+      std::array<double, 6> shared = Q;
+      for (double& q : shared) q *= context.shares.of_cluster(c);
+      Q = {};
+      push_exposed_transpose(shared, c, Q, parent);
+      c = parent;
+    }
+    // Down each source cluster to its patches (parents before children: smallest id first).
+    while (!ws.heap.empty()) {
+      std::pop_heap(ws.heap.begin(), ws.heap.end(), std::greater<>());
+      const std::uint32_t i = ws.heap.back();
+      ws.heap.pop_back();
+      ws.queued[i] = 0;
+      std::array<double, 6> Ri = ws.R[i];
+      ws.R[i] = {};
+      const ClusterNode& node = tree.node(i);
+      if (node.is_leaf()) {
+        const std::uint32_t q = tree.order()[node.first];
+        add_patch(q, surface_share(Ri, bases.of(i), bases.front(q, patches[q].normal)) * patches[q].area *
+                         element_exposure(patches[q].root, false));
+        continue;
+      }
+      const MomentBasis& pb = bases.of(i);
+      for (const std::uint32_t child : node.children) {
+        // pull_moments()'s transpose, as adjoint_delivery() pushes R down.
+        const MomentBasis& cb = bases.of(child);
+        if (cb.axes && pb.axes) {
+          for (std::size_t a = 0; a < 6; ++a) ws.R[child][a] += Ri[a];
+        } else {
+          for (int k = 0; k < cb.slots(); ++k) {
+            const SideDirection d = cb.direction(k);
+            if (pb.axes || pb.slot(d.id) >= 0) ws.R[child][static_cast<std::size_t>(k)] += surface_share(Ri, pb, d);
+          }
+        }
+        queue(child);
+      }
+    }
+    std::sort(ws.patches.begin(), ws.patches.end());
+    for (const std::uint32_t q : ws.patches) {
+      const auto f = static_cast<float>(ws.by_patch[q] / area);
+      ws.by_patch[q] = 0.0;
+      if (!(f > 0.0f)) continue;
+      row.index.push_back(q);
+      row.value.push_back(f);
+    }
+    ws.patches.clear();
+  }
+
   // ---- Enclosure ----------------------------------------------------------------------------
 
   /// Casts an element side's `count` (a multiple of kEnclosureBatch) cosine-distributed rays
@@ -2678,6 +2853,41 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
 double LinkHierarchy::enclosed_power_share(const PatchHierarchy& hierarchy, const RadiositySystem& system,
                                            const std::vector<Rgb>& B) const {
   return impl_->enclosed_power_share(hierarchy, system, B);
+}
+
+void LinkHierarchy::prepare_view_factor_rows(const PatchHierarchy& hierarchy, const RadiositySystem& system) {
+  Impl& m = *impl_;
+  auto context = std::make_unique<Impl::RowContext>();
+  // The push's shares at the view factors' radiosity: 1 on every front.
+  std::vector<Rgb> B(system.unknowns(), Rgb(0.0f));
+  for (std::size_t u = 0; u < system.fronts(); ++u) B[u] = Rgb(1.0f);
+  Impl::Values values;
+  m.node_values(hierarchy, system, B, values);
+  std::vector<Rgb> front, back, bound_front, bound_back;
+  m.gather_sides(hierarchy, values, system.has_backs(), false, front, back, bound_front, bound_back, &context->shares);
+  context->parent.assign(m.tree.nodes().size(), kNone);
+  for (std::uint32_t c = 0; c < m.tree.nodes().size(); ++c)
+    if (!m.tree.node(c).is_leaf())
+      for (const std::uint32_t child : m.tree.node(c).children) context->parent[child] = c;
+  m.row_context = std::move(context);
+}
+
+void LinkHierarchy::view_factor_rows(const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& elements,
+                                     std::vector<SparseFactors>& rows) const {
+  const Impl& m = *impl_;
+  RADIOSITY_ASSERT(m.row_context != nullptr);
+  rows.resize(elements.size());
+  if (!m.linked) {
+    for (SparseFactors& r : rows) r = SparseFactors{};
+    return;
+  }
+  parallel_for(m.threads, elements.size(), 16, [&](std::size_t begin, std::size_t end) {
+    Impl::RowWorkspace ws;
+    ws.R.assign(m.tree.nodes().size(), std::array<double, 6>{});
+    ws.queued.assign(m.tree.nodes().size(), 0);
+    ws.by_patch.assign(hierarchy.patches().size(), 0.0);
+    for (std::size_t k = begin; k < end; ++k) m.transport_row(hierarchy, elements[k], ws, rows[k]);
+  });
 }
 
 std::size_t LinkHierarchy::link_count() const { return impl_->sources.size(); }

@@ -17,6 +17,7 @@
 
 #include "core/progress.hpp"
 #include "geometry/ray_scene.hpp"
+#include "radiosity/form_factors.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 #include "solver/hierarchical/cluster_tree.hpp"
@@ -108,6 +109,20 @@ class LinkHierarchy {
   /// the links' own loss. Thread safety: as solve().
   double enclosed_power_share(const PatchHierarchy& hierarchy, const RadiositySystem& system,
                               const std::vector<Rgb>& B) const;
+
+  /// View factors from the links (ViewFactorMethod::hierarchical at polygon and element level,
+  /// docs/VIEW_FACTORS.md): prepare once after refine() (the push's shares at unit radiosity on
+  /// every front: a gather), then view_factor_rows() for any leaf elements: per element, its
+  /// front's factors F(e -> patch) to the fronts of the patches, indices increasing. They are
+  /// the transpose of the gather at that radiosity (adjoint_delivery()'s, for one receiver):
+  /// a row's sum is the irradiance the sweeps would give the element, and a cluster link
+  /// spreads over every patch of its source that faces it, so rows are as dense as the links
+  /// make them (up to every patch in a closed room). Rows are computed in parallel, each alone,
+  /// so the same at any thread count. view_factor_rows() may be called concurrently with
+  /// itself, not with prepare_view_factor_rows() or refine().
+  void prepare_view_factor_rows(const PatchHierarchy& hierarchy, const RadiositySystem& system);
+  void view_factor_rows(const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& elements,
+                        std::vector<SparseFactors>& rows) const;
 
   std::size_t link_count() const;
   /// Memory of the links, the cluster tree and the sweeps' per-node arrays, bytes.

@@ -1,5 +1,6 @@
 // View factors from hierarchical radiosity's links (ViewFactorMethod::hierarchical): the links
-// refined for unit radiosity on every surface, then one gather per group.
+// refined for unit radiosity on every surface, then one gather per group (group level) or the
+// gather's transpose per row (polygon and element levels: LinkHierarchy::view_factor_rows()).
 // Based on: P. Hanrahan, D. Salzman & L. Aupperle, "A rapid hierarchical radiosity algorithm",
 // SIGGRAPH 1991 (the links as a hierarchical representation of the form-factor matrix: any
 // block of it is one gather away); J. Howell, M. Menguc & R. Siegel, "Thermal Radiation Heat
@@ -12,29 +13,41 @@
 
 namespace radiosity::detail {
 
+std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierarchy& hierarchy, float epsilon,
+                                                 std::uint64_t seed, unsigned threads, std::size_t memory_budget,
+                                                 ProgressGate& gate, std::uint64_t& rays) {
+  const RadiositySystem system(scene, hierarchy, false);
+  auto links = std::make_unique<LinkHierarchy>(scene, hierarchy, seed, threads);
+  links->set_memory_budget(memory_budget, "ViewFactorOptions::memory_budget_bytes");
+  // The links' own factors: the view factor options have their own enclosure correction.
+  links->set_balancing(false);
+  // Unit radiosity everywhere: the oracle judges the geometry alone, and its threshold (the
+  // irradiance a link may get wrong) is then a view factor.
+  const std::vector<Rgb> one(system.unknowns(), Rgb(1.0f));
+  std::vector<std::uint32_t> split;
+  RefineStats stats;
+  if (!links->refine(hierarchy, system, one, epsilon, SubdivisionLimits{}, gate, split, stats)) return nullptr;
+  RADIOSITY_ASSERT(split.empty());  // no subdivision limits: the meshed elements stay
+  rays = stats.rays;
+  links->prepare_view_factor_rows(hierarchy, system);
+  return links;
+}
+
 LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hierarchy,
                                         const std::vector<std::size_t>& slot, std::size_t groups, float epsilon,
                                         std::uint64_t seed, unsigned threads, std::size_t memory_budget,
                                         ProgressGate& gate) {
   LinkGroupTransport out;
   out.transport.assign(groups * groups, 0.0);
-  const RadiositySystem system(scene, hierarchy, false);
-  LinkHierarchy links(scene, hierarchy, seed, threads);
-  links.set_memory_budget(memory_budget, "ViewFactorOptions::memory_budget_bytes");
-  // The links' own factors: the view factor options have their own enclosure correction.
-  links.set_balancing(false);
-  // Unit radiosity everywhere: the oracle judges the geometry alone, and its threshold (the
-  // irradiance a link may get wrong) is then a view factor.
-  const std::vector<Rgb> one(system.unknowns(), Rgb(1.0f));
-  std::vector<std::uint32_t> split;
-  RefineStats stats;
-  if (!links.refine(hierarchy, system, one, epsilon, SubdivisionLimits{}, gate, split, stats)) {
+  const std::unique_ptr<LinkHierarchy> linked =
+      view_factor_links(scene, hierarchy, epsilon, seed, threads, memory_budget, gate, out.link_rays);
+  if (!linked) {
     out.cancelled = true;
     return out;
   }
-  RADIOSITY_ASSERT(split.empty());  // no subdivision limits: the meshed elements stay
+  const LinkHierarchy& links = *linked;
+  const RadiositySystem system(scene, hierarchy, false);
   out.link_count = links.link_count();
-  out.link_rays = stats.rays;
 
   // Column k: the irradiance every front receives from unit radiosity on the fronts of group k
   // alone is its view factor to that group; summed over each group's fronts, times their area.

@@ -3,13 +3,24 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/progress.hpp"
 #include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
+#include "solver/hierarchical/link_hierarchy.hpp"
 
 namespace radiosity::detail {
+
+/// The links of `hierarchy`'s scene refined for unit radiosity on every front against
+/// `epsilon` (a view factor), without the balancing (the view factors have their own
+/// correction) and without subdividing the meshed elements, ready for view_factor_rows();
+/// `rays` gets their visibility rays. Null when `gate` cancels. Deterministic for a seed at
+/// any thread count.
+std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierarchy& hierarchy, float epsilon,
+                                                 std::uint64_t seed, unsigned threads, std::size_t memory_budget,
+                                                 ProgressGate& gate, std::uint64_t& rays);
 
 /// What link_group_transport() found.
 struct LinkGroupTransport {
