@@ -1608,9 +1608,9 @@ struct LinkHierarchy::Impl {
     row.exposed = 1.0f;
     const double area = h.element(e).area;
     // A wholly buried element (every point the burial test tried is inside a solid: the floor
-    // under a block) sees nothing, nor is it seen (below), whatever the few rays of its element
-    // links that graze the solid's edge found (up to 8e-5 of a row on the 3 708-facet room
-    // around a block).
+    // under a block) sends nothing (its radiosity is 0 here, as in refinement:
+    // view_factor_links()) and receives nothing, whatever the few rays of its element links that
+    // graze the solid's edge found (up to 8e-5 of a row on the 3 708-facet room around a block).
     if (!(area > 0.0) || element_exposure(e, false) == 0.0f) return;
     const RowContext& context = *row_context;
     const std::uint32_t elements = linked_elements;
@@ -1627,28 +1627,17 @@ struct LinkHierarchy::Impl {
       std::push_heap(ws.heap.begin(), ws.heap.end(), std::greater<>());
     };
     // As adjoint_delivery()'s from_source(): kappa per unit of I_s(w); fronts only (the view
-    // factors' radiosity is 1 on every front, 0 on every back). A source cluster's share goes to
-    // its open parts only: the links were refined with every patch sending, buried ones too (a
-    // floor under a block), and their rays from buried points were blocked, so the link already
-    // carries the open parts' light alone; it is spread over their open area (each moment over
-    // its open share here, each patch by its open area below), else a buried patch would get a
-    // share of it and keep the open ones' (measured on the 3 708-facet room around a block: ten
-    // floor facets under the block with rows of up to 1e-3 after the reciprocity averaging).
+    // factors' radiosity is 1 on every front but wholly buried ones, 0 on every back).
     auto from_source = [&](NodeHandle s, const glm::vec3& w, double kappa) {
       if (is_cluster(s)) {
         const std::uint32_t c = handle_index(s);
         const MomentBasis& b = bases.of(c);
         std::array<double, 6>& to = ws.R[c];
-        auto add = [&](int k, double amount) {
-          const double open = wholly_exposed(c) ? 1.0 : cluster_exposure_toward(c, b.direction(k));
-          if (open > 0.0) to[static_cast<std::size_t>(k)] += amount / open;
-        };
         if (b.axes) {
-          for (int a = 0; a < 3; ++a)
-            if (w[a] != 0.0f) add(w[a] >= 0.0f ? 2 * a : 2 * a + 1, kappa * kInvPi * std::abs(w[a]));
+          for (int a = 0; a < 3; ++a) to[w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
         } else {
           for (int k = 0; k < b.count; ++k)
-            add(k, kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w)));
+            to[static_cast<std::size_t>(k)] += kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w));
         }
         queue(c);
         return;
@@ -1721,8 +1710,8 @@ struct LinkHierarchy::Impl {
       const ClusterNode& node = tree.node(i);
       if (node.is_leaf()) {
         const std::uint32_t q = tree.order()[node.first];
-        add_patch(q, surface_share(Ri, bases.of(i), bases.front(q, patches[q].normal)) * patches[q].area *
-                         element_exposure(patches[q].root, false));
+        if (element_exposure(patches[q].root, false) > 0.0f)
+          add_patch(q, surface_share(Ri, bases.of(i), bases.front(q, patches[q].normal)) * patches[q].area);
         continue;
       }
       const MomentBasis& pb = bases.of(i);
@@ -2858,9 +2847,14 @@ double LinkHierarchy::enclosed_power_share(const PatchHierarchy& hierarchy, cons
 void LinkHierarchy::prepare_view_factor_rows(const PatchHierarchy& hierarchy, const RadiositySystem& system) {
   Impl& m = *impl_;
   auto context = std::make_unique<Impl::RowContext>();
-  // The push's shares at the view factors' radiosity: 1 on every front.
+  if (!m.linked) {  // no patches: no links, and rows of nothing
+    m.row_context = std::move(context);
+    return;
+  }
+  // The push's shares at the view factors' radiosity: 1 on every front but wholly buried ones.
   std::vector<Rgb> B(system.unknowns(), Rgb(0.0f));
-  for (std::size_t u = 0; u < system.fronts(); ++u) B[u] = Rgb(1.0f);
+  for (std::size_t u = 0; u < system.fronts(); ++u)
+    if (m.element_exposure(system.element(u), false) != 0.0f) B[u] = Rgb(1.0f);
   Impl::Values values;
   m.node_values(hierarchy, system, B, values);
   std::vector<Rgb> front, back, bound_front, bound_back;
@@ -2889,6 +2883,13 @@ void LinkHierarchy::view_factor_rows(const PatchHierarchy& hierarchy, const std:
     for (std::size_t k = begin; k < end; ++k) m.transport_row(hierarchy, elements[k], ws, rows[k]);
   });
 }
+
+void LinkHierarchy::measure_buried_parts(const PatchHierarchy& hierarchy, const RadiositySystem& system) {
+  impl_->refresh_patch_data(hierarchy, system);
+  impl_->update_exposure(hierarchy);
+}
+
+float LinkHierarchy::exposure(std::uint32_t element, bool back) const { return impl_->element_exposure(element, back); }
 
 std::size_t LinkHierarchy::link_count() const { return impl_->sources.size(); }
 

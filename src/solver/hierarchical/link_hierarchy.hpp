@@ -114,13 +114,19 @@ class LinkHierarchy {
   /// docs/VIEW_FACTORS.md): prepare once after refine() (the push's shares at unit radiosity on
   /// every front: a gather), then view_factor_rows() for any leaf elements: per element, its
   /// front's factors F(e -> patch) to the fronts of the patches, indices increasing. They are
-  /// the transpose of the gather at that radiosity (adjoint_delivery()'s, for one receiver):
+  /// the transpose of the gather at that radiosity (adjoint_delivery()'s, for one receiver; the
+  /// linear pull left out, as there; wholly buried sides at 0, as view_factor_links() refines):
   /// a row's sum is the irradiance the sweeps would give the element, and a cluster link
   /// spreads over every patch of its source that faces it, so rows are as dense as the links
   /// make them (up to every patch in a closed room). Rows are computed in parallel, each alone,
   /// so the same at any thread count. view_factor_rows() may be called concurrently with
   /// itself, not with prepare_view_factor_rows() or refine().
   void prepare_view_factor_rows(const PatchHierarchy& hierarchy, const RadiositySystem& system);
+  /// The exposure of every leaf element side measured now (refine() measures it after its
+  /// first pass), so that a first refine() can be given radiosity 0 on wholly buried sides.
+  void measure_buried_parts(const PatchHierarchy& hierarchy, const RadiositySystem& system);
+  /// The share of element side (`element`, `back`) that is not buried; 1 before it is measured.
+  float exposure(std::uint32_t element, bool back = false) const;
   void view_factor_rows(const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& elements,
                         std::vector<SparseFactors>& rows) const;
 
