@@ -2,7 +2,8 @@
 // urban-climate users, on two scenes:
 //  - the procedural city of city.hpp (open, under the sky) in fast mode (Monte Carlo rows) with
 //    the reciprocity correction: time, peak memory, stored factors, the estimates' reciprocity
-//    error and row standard errors before the correction, the sky view factors per group;
+//    error and row standard errors before the correction, the sky view factors per group; with
+//    --city-links the hierarchical links' factors as well;
 //  - a closed, obstructed enclosure of facets (a faceted room around a faceted block) in exact
 //    mode (ray_cast: contour integrals, occlusion by shaft-culled rays) and fast mode, both
 //    enclosure-corrected, and the hierarchical links' rows (ViewFactorMethod::hierarchical): their
@@ -37,6 +38,7 @@ struct Args {
   std::uint32_t rays = rad::FormFactorOptions{}.hemisphere_rays;
   unsigned threads = 0;
   bool city_part = true, enclosure_part = true;
+  bool city_links = false;  ///< the city's factors from the hierarchical links as well (--city-links)
   /// The enclosure's facet size (a 4 m room): 0.25 gives 1 648 facets; 1/6 (0.1666667) 3 708, the
   /// most below 4 000 whose floor facets end at the block's footprint (at 0.16 some lie partly
   /// under it, see nothing there, and the enclosure correction refuses the room).
@@ -50,7 +52,7 @@ int usage(const char* bad) {
   if (bad) std::fprintf(stderr, "bench_view_factors: bad argument '%s'\n", bad);
   std::fprintf(stderr,
                "usage: bench_view_factors [22k|246k] [--blocks N] [--facet METRES] [--rays N] [--threads T]\n"
-               "                          [--room-facet METRES] [--only city|enclosure]\n"
+               "                          [--room-facet METRES] [--only city|enclosure] [--city-links]\n"
                "                          [--write-vs3 FILE] [--view3d-output FILE [--view3d-seconds S]]\n");
   return bad ? 2 : 0;
 }
@@ -326,6 +328,17 @@ void city_part(const Args& a) {
     over += sum > 1.0 + 3.0 * se + 1e-6 ? 1 : 0;
   }
   std::printf("\n    rows whose factors and sky add up to more than 1 (beyond 3 standard errors): %zu\n", over);
+  if (!a.city_links) return;
+  // The hierarchical links' rows: a cluster link spreads over every facet of its source that
+  // faces it, so the rows hold every facet a facet may see; the budget may refuse them.
+  o.method = rad::ViewFactorMethod::hierarchical;
+  try {
+    const rad::ViewFactorMatrix links = rad::view_factor_matrix(city.scene, o);
+    std::snprintf(what, sizeof what, "hierarchical links (epsilon %g), reciprocity", static_cast<double>(o.epsilon));
+    print_matrix(what, links);
+  } catch (const rad::Error& e) {
+    std::printf("  hierarchical links: %s\n", e.what());
+  }
 }
 
 bool enclosure_part(const Args& a) {
@@ -470,6 +483,8 @@ int main(int argc, char** argv) {
       const double v = std::strtod(argv[++i], &end);
       if (*end != '\0' || !(v > 0.0) || !std::isfinite(v)) return usage(argv[i]);
       a.view3d_seconds = v;
+    } else if (arg == "--city-links") {
+      a.city_links = true;
     } else if (arg == "--only" && has_value) {
       const std::string which = argv[++i];
       if (which != "city" && which != "enclosure") return usage(argv[i]);
