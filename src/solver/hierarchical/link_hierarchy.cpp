@@ -13,7 +13,6 @@
 #include <limits>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -1590,8 +1589,8 @@ struct LinkHierarchy::Impl {
   /// Per thread: transport_row()'s sums, zero between rows.
   struct RowWorkspace {
     std::vector<std::array<double, 6>> R;  ///< per cluster: per unit of its sending moments
-    std::vector<std::uint8_t> queued;      ///< per cluster: in `heap`
-    std::vector<std::uint32_t> heap;       ///< clusters to push down, smallest id first
+    std::vector<std::uint8_t> queued;      ///< per cluster: in `touched`
+    std::vector<std::uint32_t> touched;    ///< source clusters with a share, to push down
     std::vector<double> by_patch;          ///< per patch: transport from the row's element
     std::vector<std::uint32_t> patches;    ///< patches with a non-zero by_patch
   };
@@ -1623,8 +1622,7 @@ struct LinkHierarchy::Impl {
     auto queue = [&](std::uint32_t c) {
       if (ws.queued[c]) return;
       ws.queued[c] = 1;
-      ws.heap.push_back(c);
-      std::push_heap(ws.heap.begin(), ws.heap.end(), std::greater<>());
+      ws.touched.push_back(c);
     };
     // As adjoint_delivery()'s from_source(): kappa per unit of I_s(w); fronts only (the view
     // factors' radiosity is 1 on every front but wholly buried ones, 0 on every back).
@@ -1699,36 +1697,44 @@ struct LinkHierarchy::Impl {
       push_exposed_transpose(shared, c, Q, parent);
       c = parent;
     }
-    // Down each source cluster to its patches (parents before children: smallest id first).
-    while (!ws.heap.empty()) {
-      std::pop_heap(ws.heap.begin(), ws.heap.end(), std::greater<>());
-      const std::uint32_t i = ws.heap.back();
-      ws.heap.pop_back();
-      ws.queued[i] = 0;
-      std::array<double, 6> Ri = ws.R[i];
-      ws.R[i] = {};
-      const ClusterNode& node = tree.node(i);
-      if (node.is_leaf()) {
-        const std::uint32_t q = tree.order()[node.first];
-        if (element_exposure(patches[q].root, false) > 0.0f)
-          add_patch(q, surface_share(Ri, bases.of(i), bases.front(q, patches[q].normal)) * patches[q].area);
-        continue;
-      }
-      const MomentBasis& pb = bases.of(i);
-      for (const std::uint32_t child : node.children) {
-        // pull_moments()'s transpose, as adjoint_delivery() pushes R down.
-        const MomentBasis& cb = bases.of(child);
-        if (cb.axes && pb.axes) {
-          for (std::size_t a = 0; a < 6; ++a) ws.R[child][a] += Ri[a];
-        } else {
-          for (int k = 0; k < cb.slots(); ++k) {
-            const SideDirection d = cb.direction(k);
-            if (pb.axes || pb.slot(d.id) >= 0) ws.R[child][static_cast<std::size_t>(k)] += surface_share(Ri, pb, d);
+    // Down each source cluster to its patches. The tree is in depth-first order, so a cluster's
+    // subtree is the ids [c, c + 2 count - 1): one scan in increasing id over the union of the
+    // touched clusters' subtrees visits every parent before its children, a nested touched
+    // cluster's own share already in place (a heap of the touched clusters instead made the 22k
+    // city's rows take 28 s).
+    std::sort(ws.touched.begin(), ws.touched.end());
+    std::uint32_t covered = 0;  // ids below this were scanned
+    for (const std::uint32_t t : ws.touched) {
+      ws.queued[t] = 0;
+      const std::uint32_t end = t + 2 * tree.node(t).count - 1;
+      for (std::uint32_t i = std::max(t, covered); i < end; ++i) {
+        std::array<double, 6>& Ri = ws.R[i];
+        const ClusterNode& node = tree.node(i);
+        if (node.is_leaf()) {
+          const std::uint32_t q = tree.order()[node.first];
+          if (element_exposure(patches[q].root, false) > 0.0f)
+            add_patch(q, surface_share(Ri, bases.of(i), bases.front(q, patches[q].normal)) * patches[q].area);
+          Ri = {};
+          continue;
+        }
+        const MomentBasis& pb = bases.of(i);
+        for (const std::uint32_t child : node.children) {
+          // pull_moments()'s transpose, as adjoint_delivery() pushes R down.
+          const MomentBasis& cb = bases.of(child);
+          if (cb.axes && pb.axes) {
+            for (std::size_t k = 0; k < 6; ++k) ws.R[child][k] += Ri[k];
+          } else {
+            for (int k = 0; k < cb.slots(); ++k) {
+              const SideDirection d = cb.direction(k);
+              if (pb.axes || pb.slot(d.id) >= 0) ws.R[child][static_cast<std::size_t>(k)] += surface_share(Ri, pb, d);
+            }
           }
         }
-        queue(child);
+        Ri = {};
       }
+      covered = std::max(covered, end);
     }
+    ws.touched.clear();
     std::sort(ws.patches.begin(), ws.patches.end());
     for (const std::uint32_t q : ws.patches) {
       const auto f = static_cast<float>(ws.by_patch[q] / area);
