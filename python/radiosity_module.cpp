@@ -408,8 +408,7 @@ Doubles element_values(const PySolution& s, const std::string& quantity) {
 
 /// The estimator that ran, or None for the hierarchical solver (its links are its own transport).
 py::object estimator_used(const rad::SolveReport& r) {
-  if (r.method == rad::SolverMethod::hierarchical) return py::none();
-  return py::str(rad::to_string(r.form_factor_method));
+  return r.estimator_ran() ? py::object(py::str(rad::to_string(r.form_factor_method))) : py::none();
 }
 
 py::dict report_dict(const rad::Solution& s) {

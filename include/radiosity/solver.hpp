@@ -152,8 +152,11 @@ struct SolveReport {
   std::string method_choice;
   /// The estimator that ran: SolveOptions' form_factors.method with automatic resolved
   /// (choose_form_factor_method()). SolverMethod::hierarchical runs none (its links are its
-  /// own transport); there it is the options' method, resolved as for the others.
+  /// own transport); there it is the options' method, resolved as for the others, and
+  /// estimator_ran() is false.
   FormFactorMethod form_factor_method = FormFactorMethod::automatic;
+  /// Whether form_factor_method computed the transport: false for SolverMethod::hierarchical.
+  bool estimator_ran() const { return method != SolverMethod::hierarchical; }
   /// FormFactorOptions::specular_depth of the factors: how many mirror reflections and window
   /// passages the solution carries between diffuse surfaces (0: classic radiosity). The
   /// two-pass compositor reads it so that its photon map leaves those paths out.

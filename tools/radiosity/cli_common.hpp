@@ -429,7 +429,7 @@ inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& o
   if (!r.method_choice.empty())
     std::printf("method: %s (automatic: %s; --method overrides)\n",
                 r.method == rad::SolverMethod::hierarchical ? "hierarchical" : "gauss-seidel", r.method_choice.c_str());
-  if (r.method == rad::SolverMethod::hierarchical) {
+  if (!r.estimator_ran()) {
     std::printf("form factors: links of the hierarchy (point-to-polygon and cluster transport, shadow rays)\n");
     return;
   }

@@ -75,11 +75,10 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
     j["max_iterations"] = options->max_iterations;
     j["seed"] = options->seed;
   }
-  // The hierarchical solver's links are its own transport: no estimator ran.
-  if (r.method == SolverMethod::hierarchical)
-    j["form_factor_method_used"] = nullptr;
-  else
+  if (r.estimator_ran())
     j["form_factor_method_used"] = form_factor_name(r.form_factor_method);
+  else
+    j["form_factor_method_used"] = nullptr;
   j["status"] = status_name(solution.status());
   j["iterations"] = r.iterations;
   j["residual"] = number(r.residual);
