@@ -28,13 +28,16 @@ std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierar
   // a visible fraction that counted its burial, while the cluster's moments counted its
   // radiosity: measured on the 3 708-facet room around a block, the block's lowest facets' rows
   // were 0.87-0.92 before correction (their factors to the far wall's lowest facets half the
-  // exact ones), now 0.96-0.97; the worst row 0.091 -> 0.063 from 1. (Drawing the receivers'
-  // points by open area too, tried: the floor beside the block then 1.16-1.34, as the push's
-  // exposure ratios assume a receiving cluster's visible fraction over all of its area.)
+  // exact ones), now 0.96-0.97; the worst row of the reciprocal matrix 0.135 -> 0.063 from 1.
+  // (Drawing the receivers' points by open area too, tried: the floor beside the block then
+  // 1.16-1.34, as the push's exposure ratios assume a receiving cluster's visible fraction over
+  // all of its area.)
+  // Fronts only, as the view factors' surfaces send and receive (a two-sided material's back
+  // is no surface here).
   links->measure_buried_parts(hierarchy, system);
-  std::vector<Rgb> one(system.unknowns(), Rgb(1.0f));
-  for (std::size_t u = 0; u < system.unknowns(); ++u)
-    if (links->exposure(system.element(u), u >= system.fronts()) == 0.0f) one[u] = Rgb(0.0f);
+  std::vector<Rgb> one(system.unknowns(), Rgb(0.0f));
+  for (std::size_t u = 0; u < system.fronts(); ++u)
+    if (links->exposure(system.element(u)) != 0.0f) one[u] = Rgb(1.0f);
   std::vector<std::uint32_t> split;
   RefineStats stats;
   if (!links->refine(hierarchy, system, one, epsilon, SubdivisionLimits{}, gate, split, stats)) return nullptr;
