@@ -1593,6 +1593,7 @@ struct LinkHierarchy::Impl {
     std::vector<std::uint32_t> touched;    ///< source clusters with a share, to push down
     std::vector<double> by_patch;          ///< per patch: transport from the row's element
     std::vector<std::uint32_t> patches;    ///< patches with a non-zero by_patch
+    bool clean = true;                     ///< all zero (false while a row is being made)
   };
 
   /// One row of the links' view factors: F(e -> p) for the front of leaf element `e` to the
@@ -1611,6 +1612,7 @@ struct LinkHierarchy::Impl {
     // view_factor_links()) and receives nothing, whatever the few rays of its element links that
     // graze the solid's edge found (up to 8e-5 of a row on the 3 708-facet room around a block).
     if (!(area > 0.0) || element_exposure(e, false) == 0.0f) return;
+    ws.clean = false;
     const RowContext& context = *row_context;
     const std::uint32_t elements = linked_elements;
     const std::vector<Patch>& patches = h.patches();
@@ -1744,6 +1746,7 @@ struct LinkHierarchy::Impl {
       row.value.push_back(f);
     }
     ws.patches.clear();
+    ws.clean = true;
   }
 
   // ---- Enclosure ----------------------------------------------------------------------------
@@ -2882,10 +2885,16 @@ void LinkHierarchy::view_factor_rows(const PatchHierarchy& hierarchy, const std:
     return;
   }
   parallel_for(m.threads, elements.size(), 16, [&](std::size_t begin, std::size_t end) {
-    Impl::RowWorkspace ws;
-    ws.R.assign(m.tree.nodes().size(), std::array<double, 6>{});
-    ws.queued.assign(m.tree.nodes().size(), 0);
-    ws.by_patch.assign(hierarchy.patches().size(), 0.0);
+    // Per thread, kept between blocks and calls: every row leaves it zero, so only a new size
+    // (another scene) or a row that did not finish (an exception) fills it again (filling it
+    // per block of 16 rows was megabytes each).
+    thread_local Impl::RowWorkspace ws;
+    if (!ws.clean || ws.R.size() != m.tree.nodes().size() || ws.by_patch.size() != hierarchy.patches().size()) {
+      ws = Impl::RowWorkspace{};
+      ws.R.assign(m.tree.nodes().size(), std::array<double, 6>{});
+      ws.queued.assign(m.tree.nodes().size(), 0);
+      ws.by_patch.assign(hierarchy.patches().size(), 0.0);
+    }
     for (std::size_t k = begin; k < end; ++k) m.transport_row(hierarchy, elements[k], ws, rows[k]);
   });
 }
