@@ -537,8 +537,10 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   out.cancelled = false;
   const bool monte_carlo = !m.links && m.ff.method == FormFactorMethod::monte_carlo;
   // The rows' share of the progress (the sky's rays come after them): about half of the rays
-  // for Monte Carlo, most of the work for the other estimators.
+  // for Monte Carlo, most of the work for the other estimators; the links' refinement takes the
+  // first half of theirs.
   const double rows_share = monte_carlo ? 0.5 : 0.9;
+  const double rows_start = m.links ? 0.45 : 0.0;
   out.sky.clear();
   out.sky_standard_error.clear();
   out.row_standard_error.clear();
@@ -560,9 +562,16 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   std::optional<PatchHierarchy> linked_mesh;
   std::unique_ptr<LinkHierarchy> links;
   if (m.links) {
+    // The refinement reports its own fraction, of [0, rows_start) here; a cancel goes through.
+    const ProgressFn refining = [&](const Progress& p) {
+      Progress q = p;
+      q.fraction = rows_start * p.fraction;
+      return gate.report(q);
+    };
+    ProgressGate refine_gate(refining);
     std::uint64_t rays = 0;
     links = view_factor_links(*m.scene, linked_mesh.emplace(hierarchy), m.epsilon, m.ff.seed, m.ff.threads,
-                              m.memory_budget, gate, rays);
+                              m.memory_budget, refine_gate, rays);
     if (!links) {
       out.cancelled = true;
       return;
@@ -627,7 +636,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
                         row - begin, rows, m.memory_budget);
     Progress p;
     p.phase = Phase::form_factors;
-    p.fraction = rows_share * static_cast<double>(row - begin) / static_cast<double>(rows);
+    p.fraction = rows_start + (rows_share - rows_start) * static_cast<double>(row - begin) / static_cast<double>(rows);
     if (!gate.report(p, false)) {
       out.cancelled = true;
       for (std::size_t r = row; r < end; ++r) out.row_offsets[r - begin + 1] = out.columns.size();

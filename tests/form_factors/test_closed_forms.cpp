@@ -470,7 +470,18 @@ TEST_SUITE("form_factors") {
     for (const float eps : {0.05f, 0.01f}) {
       CAPTURE(eps);
       o.epsilon = eps;
+      // Progress goes forward through the links' refinement and then their rows.
+      double last_fraction = 0.0;
+      int backward = 0;
+      o.on_progress = [&](const rad::Progress& p) {
+        if (p.phase != rad::Phase::form_factors) return true;
+        backward += p.fraction < last_fraction ? 1 : 0;
+        last_fraction = p.fraction;
+        return true;
+      };
       const rad::ViewFactorMatrix links = rad::view_factor_matrix(s, o);
+      CHECK(backward == 0);
+      CHECK(last_fraction == 1.0);
       REQUIRE(links.rows() == exact.rows());
       double difference = 0.0, size = 0.0, worst_row = 0.0, worst_large = 0.0;
       std::array<double, 6> area{};

@@ -1234,6 +1234,7 @@ struct LinkHierarchy::Impl {
                   std::vector<std::uint32_t>& split, RefineStats& stats, bool merge_each_round) {
     bool subdivision_closed = limits.max_depth == 0;
     std::size_t done = 0, rounds = 0;
+    double reported = 0.0;  // the largest fraction reported
     std::vector<BlockOutput> blocks;
     struct Block {
       std::size_t segment, first, last;  ///< frontier[segment][first, last)
@@ -1278,9 +1279,12 @@ struct LinkHierarchy::Impl {
         slices.done(slice_end - slice);
         for (std::size_t b = slice; b < slice_end; ++b) pairs_done += work[b].last - work[b].first;
         if (slice_end == block_count) break;
+        // The pairs of the rounds to come are not known yet, so this estimate can fall when a
+        // round turns out larger than the last; reported, it only goes forward.
         Progress p;
         p.phase = Phase::form_factors;
-        p.fraction = static_cast<double>(done + pairs_done) / static_cast<double>(done + pairs);
+        reported = std::max(reported, static_cast<double>(done + pairs_done) / static_cast<double>(done + pairs));
+        p.fraction = reported;
         if (!gate.report(p, false)) return false;
       }
       done += pairs;
@@ -1348,7 +1352,8 @@ struct LinkHierarchy::Impl {
       Progress p;
       p.phase = Phase::form_factors;
       const std::size_t next = pairs_in(frontier);
-      p.fraction = static_cast<double>(done) / static_cast<double>(done + next);
+      reported = std::max(reported, static_cast<double>(done) / static_cast<double>(done + next));
+      p.fraction = reported;
       if (!gate.report(p, next == 0)) return false;
     }
     return true;
