@@ -592,9 +592,11 @@ TEST_SUITE("solver") {
     CHECK(relative(balanced.group_back_radiosity("box").y, ref.group_back_radiosity("box").y) < 0.6);
   }
 
-  // Not under ThreadSanitizer (44 s there), for the same reason as the test above.
-  TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there" *
-            test::not_under_thread_sanitizer) {
+  // Release only (44 s under ThreadSanitizer, 29 s under AddressSanitizer, the slowest test there
+  // since session 28's power rule made the closed room's solve longer): its unbalanced solve at
+  // reflectance 0.99 is what the hold test above runs in the sanitizer builds, and the
+  // warning's check is a few sums.
+  TEST_CASE("hierarchical: light the links lose in a closed room is reported, and only there" * test::release_only) {
     // A room as an exporter writes it (outward winding, Kd 1 clamped to 0.99), made two-sided,
     // a lamp panel 0.2 m under the ceiling: closed, so no light can leave, and rho = 0.99 turns
     // every 0.1 % the links lose or gain per bounce into about 10 % of the power. Without the
@@ -629,7 +631,6 @@ TEST_SUITE("solver") {
     const rad::Solution open = rad::solve(rad::cornell_box(), hierarchical(0.05f));
     CHECK(open.report().escaped_power.y > 0.2f * open.report().emitted_power.y);
     CHECK_FALSE(warned(open));
-    if (test::kSanitizerBuild) return;  // the Gauss-Seidel solve at rho 0.99 is the Release build's
     rad::SolveOptions gs;
     gs.method = rad::SolverMethod::gauss_seidel;
     const rad::Solution ref = rad::solve(room, gs);
