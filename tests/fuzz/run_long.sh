@@ -12,7 +12,9 @@
 # Why chunks: the targets of Assimp's formats run without a leak check per input (13 times
 # faster), and Assimp's leaks on broken files (suppressed: tests/lsan.supp) then pile up to
 # libFuzzer's 2 GB RSS limit after about a million inputs (FBX: after 272 034 in session 23;
-# FUZZ_CHUNK=200000 runs chunks of that many inputs instead of a million).
+# FUZZ_CHUNK=200000 runs chunks of that many inputs instead of a million). FUZZ_TIMEOUT=30 gives
+# each input 30 s instead of 10: OpenEXR takes 3-4 s under AddressSanitizer on some broken
+# headers (session 29), which a 2-thread load beside it stretches past 10 s.
 # Do not pause a run (SIGSTOP): libFuzzer's timeout is wall-clock, so the input being run when
 # it resumes is reported as a timeout. Stop it with SIGINT and start again from the next chunk.
 set -u
@@ -28,7 +30,7 @@ chunk="${FUZZ_CHUNK:-1000000}"
 mkdir -p "$work/long" "$work/artifacts/$format" "$work/corpus/$format"
 for ((k = first; k < first + millions; ++k)); do
   log="$work/long/$format.$k.log"
-  nice -n 19 "$build/bin/radiosity_fuzz_$format" -seed=$((100 + k)) -runs="$chunk" -timeout=10 -rss_limit_mb=2048 \
+  nice -n 19 "$build/bin/radiosity_fuzz_$format" -seed=$((100 + k)) -runs="$chunk" -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 \
     -print_final_stats=1 -detect_leaks="$leaks" -artifact_prefix="$work/artifacts/$format/" \
     "$work/corpus/$format" "$work/seeds/$format" > "$log" 2>&1
   rc=$?
