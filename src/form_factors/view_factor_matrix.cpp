@@ -571,7 +571,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
     ProgressGate refine_gate(refining);
     std::uint64_t rays = 0;
     links = view_factor_links(*m.scene, linked_mesh.emplace(hierarchy), m.epsilon, m.ff.seed, m.ff.threads,
-                              m.memory_budget, refine_gate, rays);
+                              m.memory_budget, refine_gate, rays, true);
     if (!links) {
       out.cancelled = true;
       return;

@@ -1635,21 +1635,13 @@ struct LinkHierarchy::Impl {
     // factors' radiosity is 1 on every front but wholly buried ones, 0 on every back).
     auto from_source = [&](NodeHandle s, const glm::vec3& w, double kappa) {
       if (is_cluster(s)) {
-        const std::uint32_t c = handle_index(s);
-        const MomentBasis& b = bases.of(c);
-        std::array<double, 6>& to = ws.R[c];
-        if (b.axes) {
-          for (int a = 0; a < 3; ++a) to[w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
-        } else {
-          for (int k = 0; k < b.count; ++k)
-            to[static_cast<std::size_t>(k)] += kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w));
-        }
-        queue(c);
+        add_intensity_weight(ws.R[handle_index(s)], bases.of(handle_index(s)), w, kappa);
+        queue(handle_index(s));
         return;
       }
-      if (is_back(s) || element_exposure(element_of(s), false) == 0.0f) return;
-      const std::uint32_t x = element_of(s);
-      add_patch(h.element(x).patch, kappa * h.element(x).area * std::max(0.0f, glm::dot(side_normal(h, s), w)) * kInvPi);
+      const std::uint32_t se = element_of(s);
+      if (is_back(s) || element_exposure(se, false) == 0.0f) return;
+      add_patch(h.element(se).patch, kappa * h.element(se).area * std::max(0.0f, glm::dot(side_normal(h, s), w)) * kInvPi);
     };
     // Up the element chain: W, what unit irradiance on each ancestor side delivers into e (the
     // push's shares and exposure ratios), and the links into each.
@@ -1686,15 +1678,7 @@ struct LinkHierarchy::Impl {
       for (std::uint64_t k = offsets[c]; k < offsets[c + 1]; ++k) {
         const NodeHandle s = sources[k];
         const glm::vec3 w = glm::normalize(cr - centroid(h, s));
-        // add_irradiance()'s transpose: sum_k Q_k max(0, u_k . d), d = -w.
-        double taken = 0.0;
-        if (b.axes) {
-          for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * Q[2 * a] : w[a] * Q[2 * a + 1];
-        } else {
-          for (int j = 0; j < b.count; ++j)
-            taken += std::max(0.0f, -glm::dot(b.directions[static_cast<std::size_t>(j)], w)) * Q[static_cast<std::size_t>(j)];
-        }
-        from_source(s, w, std::abs(coefficients[k]) * taken);
+        from_source(s, w, std::abs(coefficients[k]) * irradiance_weight(Q, b, w));
       }
       const std::uint32_t parent = context.parent[c];
       if (parent == kNone) break;
@@ -1724,19 +1708,7 @@ struct LinkHierarchy::Impl {
           Ri = {};
           continue;
         }
-        const MomentBasis& pb = bases.of(i);
-        for (const std::uint32_t child : node.children) {
-          // pull_moments()'s transpose, as adjoint_delivery() pushes R down.
-          const MomentBasis& cb = bases.of(child);
-          if (cb.axes && pb.axes) {
-            for (std::size_t k = 0; k < 6; ++k) ws.R[child][k] += Ri[k];
-          } else {
-            for (int k = 0; k < cb.slots(); ++k) {
-              const SideDirection d = cb.direction(k);
-              if (pb.axes || pb.slot(d.id) >= 0) ws.R[child][static_cast<std::size_t>(k)] += surface_share(Ri, pb, d);
-            }
-          }
-        }
+        for (const std::uint32_t child : node.children) pull_moments_transpose(Ri, i, ws.R[child], child);
         Ri = {};
       }
       covered = std::max(covered, end);
@@ -2072,6 +2044,46 @@ struct LinkHierarchy::Impl {
   /// the link sums' transpose, the cluster moments' transpose, the pull's transpose). For a leaf,
   /// delivered / area is the fraction of the power it sends that arrives. One serial pass over
   /// the links: the same sums in the same order at any thread count.
+  // The transposes of the gather's steps through a cluster's moments, which the balancing's
+  // adjoint (adjoint_delivery()) and the view factors' rows (transport_row()) both take.
+  /// intensity()'s transpose: adds kappa per unit of I(w) to the weights R of the sending
+  /// moments in basis `b`.
+  static void add_intensity_weight(std::array<double, 6>& R, const MomentBasis& b, const glm::vec3& w, double kappa) {
+    if (b.axes) {
+      for (int a = 0; a < 3; ++a) R[w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
+      return;
+    }
+    for (int k = 0; k < b.count; ++k)
+      R[static_cast<std::size_t>(k)] += kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w));
+  }
+  /// add_irradiance()'s transpose: sum_k Q_k max(0, u_k . d) for d = -w, what flux arriving
+  /// along w at a cluster of basis `b` delivers per unit, given the weights Q of its moments.
+  static double irradiance_weight(const std::array<double, 6>& Q, const MomentBasis& b, const glm::vec3& w) {
+    double taken = 0.0;
+    if (b.axes) {
+      for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * Q[2 * a] : w[a] * Q[2 * a + 1];
+      return taken;
+    }
+    for (int j = 0; j < b.count; ++j)
+      taken += std::max(0.0f, -glm::dot(b.directions[static_cast<std::size_t>(j)], w)) * Q[static_cast<std::size_t>(j)];
+    return taken;
+  }
+  /// pull_moments()'s transpose: the weights R of cluster `parent`'s sending moments passed on
+  /// to those of its child `child` (added to Rc).
+  void pull_moments_transpose(const std::array<double, 6>& R, std::uint32_t parent, std::array<double, 6>& Rc,
+                              std::uint32_t child) const {
+    const MomentBasis& cb = bases.of(child);
+    const MomentBasis& pb = bases.of(parent);
+    if (cb.axes && pb.axes) {
+      for (std::size_t a = 0; a < 6; ++a) Rc[a] += R[a];
+      return;
+    }
+    for (int k = 0; k < cb.slots(); ++k) {
+      const SideDirection d = cb.direction(k);
+      if (pb.axes || pb.slot(d.id) >= 0) Rc[static_cast<std::size_t>(k)] += surface_share(R, pb, d);
+    }
+  }
+
   void adjoint_delivery(const PatchHierarchy& h, bool backs, const std::vector<float>& weight,
                         const PushShares& shares, std::vector<double>& delivered) const {
     const std::uint32_t elements = linked_elements;
@@ -2123,14 +2135,7 @@ struct LinkHierarchy::Impl {
     std::vector<std::array<double, 6>> R(C, std::array<double, 6>{});
     auto from_source = [&](NodeHandle s, const glm::vec3& w, double kappa) {  // kappa per unit I_s(w)
       if (is_cluster(s)) {
-        const MomentBasis& b = bases.of(handle_index(s));
-        std::array<double, 6>& to = R[handle_index(s)];
-        if (b.axes) {
-          for (int a = 0; a < 3; ++a) to[w[a] >= 0.0f ? 2 * a : 2 * a + 1] += kappa * kInvPi * std::abs(w[a]);
-          return;
-        }
-        for (int k = 0; k < b.count; ++k)
-          to[static_cast<std::size_t>(k)] += kappa * kInvPi * std::max(0.0f, glm::dot(b.directions[static_cast<std::size_t>(k)], w));
+        add_intensity_weight(R[handle_index(s)], bases.of(handle_index(s)), w, kappa);
         return;
       }
       const std::uint32_t e = element_of(s);
@@ -2149,15 +2154,7 @@ struct LinkHierarchy::Impl {
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
           const glm::vec3 w = glm::normalize(cr - centroid(h, s));
-          // add_irradiance()'s transpose: sum_k Q_k max(0, u_k . d), d = -w.
-          double taken = 0.0;
-          if (b.axes) {
-            for (int a = 0; a < 3; ++a) taken += w[a] <= 0.0f ? -w[a] * q[2 * a] : w[a] * q[2 * a + 1];
-          } else {
-            for (int j = 0; j < b.count; ++j)
-              taken += std::max(0.0f, -glm::dot(b.directions[static_cast<std::size_t>(j)], w)) * q[static_cast<std::size_t>(j)];
-          }
-          from_source(s, w, std::abs(coefficients[k]) * taken);
+          from_source(s, w, std::abs(coefficients[k]) * irradiance_weight(q, b, w));
         }
         continue;
       }
@@ -2178,19 +2175,7 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t i = 0; i < C; ++i) {
       const ClusterNode& c = tree.node(i);
       if (!c.is_leaf()) {
-        for (const std::uint32_t child : c.children) {
-          // pull_moments()'s transpose.
-          const MomentBasis& cb = bases.of(child);
-          const MomentBasis& pb = bases.of(i);
-          if (cb.axes && pb.axes) {
-            for (int a = 0; a < 6; ++a) R[child][a] += R[i][a];
-            continue;
-          }
-          for (int k = 0; k < cb.slots(); ++k) {
-            const SideDirection d = cb.direction(k);
-            if (pb.axes || pb.slot(d.id) >= 0) R[child][static_cast<std::size_t>(k)] += surface_share(R[i], pb, d);
-          }
-        }
+        for (const std::uint32_t child : c.children) pull_moments_transpose(R[i], i, R[child], child);
         continue;
       }
       const std::uint32_t p = tree.order()[c.first];

@@ -15,7 +15,7 @@ namespace radiosity::detail {
 
 std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierarchy& hierarchy, float epsilon,
                                                  std::uint64_t seed, unsigned threads, std::size_t memory_budget,
-                                                 ProgressGate& gate, std::uint64_t& rays) {
+                                                 ProgressGate& gate, std::uint64_t& rays, bool rows) {
   const RadiositySystem system(scene, hierarchy, false);
   auto links = std::make_unique<LinkHierarchy>(scene, hierarchy, seed, threads);
   links->set_memory_budget(memory_budget, "ViewFactorOptions::memory_budget_bytes");
@@ -43,7 +43,7 @@ std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierar
   if (!links->refine(hierarchy, system, one, epsilon, SubdivisionLimits{}, gate, split, stats)) return nullptr;
   RADIOSITY_ASSERT(split.empty());  // no subdivision limits: the meshed elements stay
   rays = stats.rays;
-  links->prepare_view_factor_rows(hierarchy, system);
+  if (rows) links->prepare_view_factor_rows(hierarchy, system);
   return links;
 }
 
@@ -54,7 +54,7 @@ LinkGroupTransport link_group_transport(const Scene& scene, PatchHierarchy& hier
   LinkGroupTransport out;
   out.transport.assign(groups * groups, 0.0);
   const std::unique_ptr<LinkHierarchy> linked =
-      view_factor_links(scene, hierarchy, epsilon, seed, threads, memory_budget, gate, out.link_rays);
+      view_factor_links(scene, hierarchy, epsilon, seed, threads, memory_budget, gate, out.link_rays, false);
   if (!linked) {
     out.cancelled = true;
     return out;

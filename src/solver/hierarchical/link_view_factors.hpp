@@ -15,12 +15,12 @@ namespace radiosity::detail {
 
 /// The links of `hierarchy`'s scene refined for unit radiosity on every front against
 /// `epsilon` (a view factor), without the balancing (the view factors have their own
-/// correction) and without subdividing the meshed elements, ready for view_factor_rows();
-/// `rays` gets their visibility rays. Null when `gate` cancels. Deterministic for a seed at
-/// any thread count.
+/// correction) and without subdividing the meshed elements; with `rows`, ready for
+/// view_factor_rows() (a gather more). `rays` gets their visibility rays. Null when `gate`
+/// cancels. Deterministic for a seed at any thread count.
 std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierarchy& hierarchy, float epsilon,
                                                  std::uint64_t seed, unsigned threads, std::size_t memory_budget,
-                                                 ProgressGate& gate, std::uint64_t& rays);
+                                                 ProgressGate& gate, std::uint64_t& rays, bool rows);
 
 /// What link_group_transport() found.
 struct LinkGroupTransport {
