@@ -777,6 +777,22 @@ PYBIND11_MODULE(radiosity, m) {
            py::arg("obstruction_only") = true,
            "Marks a polygon obstruction-only (it hides, but gets no row or column in view_factor_matrix()).")
       .def("make_two_sided", &rad::Scene::make_two_sided, "Makes every material two-sided.")
+      .def(
+          "reverse_winding",
+          [](rad::Scene& s, const py::object& polygons) {
+            if (polygons.is_none())
+              s.reverse_winding();
+            else
+            {
+              std::vector<rad::PolygonId> ids;
+              for (const py::handle id : py::iterable(polygons)) ids.push_back(id.cast<rad::PolygonId>());
+              s.reverse_winding(ids);
+            }
+          },
+          py::arg("polygons") = py::none(),
+          "Turns polygons over (reverses their winding; their meshes' triangles follow): the given polygon ids, or "
+          "every polygon. For one-sided models wound the wrong way; radiosity.find_polygons_facing_outward(scene) "
+          "lists the polygons of a closed room wound outwards.")
       .def("__repr__", [](const rad::Scene& s) {
         return "<radiosity.Scene: " + std::to_string(s.polygons().size()) + " polygons, " +
                std::to_string(s.groups().size()) + " groups, " + std::to_string(s.materials().size()) +
@@ -892,6 +908,23 @@ PYBIND11_MODULE(radiosity, m) {
       "renderer would step over (degenerate faces, Kd >= 1, a missing MTL) is an error instead of a warning "
       "(Scene.warnings). photometric: light intensities in candela and lux. Raises radiosity.Error naming "
       "the file and line. Thread safety: releases the GIL; concurrent calls are safe.");
+  m.def(
+      "find_polygons_facing_outward",
+      [](const rad::Scene& scene) {
+        rad::OutwardFacing outward;
+        {
+          py::gil_scoped_release release;
+          outward = rad::find_polygons_facing_outward(scene);
+        }
+        py::list ids;
+        for (const rad::PolygonId id : outward.polygons) ids.append(id);
+        return ids;
+      },
+      py::arg("scene"),
+      "find_polygons_facing_outward(scene) -> list of polygon ids\n\n"
+      "The one-sided polygons whose front sees nothing while their back sees the scene all around, as the walls "
+      "of a closed room or enclosure wound outwards do (radiosity check's warning): what "
+      "scene.reverse_winding(ids) turns over. Deterministic (a fixed seed).");
   m.def("cornell_box", &rad::cornell_box,
         "The Cornell box (geometry in mm, measured reflectances, light E = pi (17, 12, 4)); groups floor, ceiling, "
         "back_wall, red_wall, green_wall, light, short_block, tall_block. Thread safety: may be called "

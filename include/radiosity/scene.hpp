@@ -336,6 +336,21 @@ class RADIOSITY_API Scene {
   /// second radiosity per element. Thread safety: mutates the scene.
   void make_two_sided();
 
+  /// Turns polygons over, as if the file had been written with their winding reversed: each
+  /// keeps its first corner and takes the others in reverse order, its normal negated (its area
+  /// unchanged). A mesh's triangles follow their polygons (their second and third indices
+  /// swapped), so that mesh and polygons still face the same way and per-vertex results stay
+  /// aligned with the host's vertices; a vertex normal is negated when every triangle that uses
+  /// it was turned. For one-sided models wound the wrong way (CLI `--reverse-winding`): above
+  /// all a closed room or enclosure wound outwards, whose inside is otherwise dark and whose
+  /// view factors are 0 (find_polygons_facing_outward() finds such polygons). Unlike
+  /// make_two_sided() it keeps one radiosity per element, and it is what view factors need:
+  /// they are taken on fronts only. The first form turns `polygons` (an id listed twice is
+  /// turned once), the second every polygon. Throws Error{invalid_argument} naming an unknown
+  /// id, the scene then unchanged. Cost: linear in the corners. Thread safety: mutates the scene.
+  void reverse_winding(const std::vector<PolygonId>& polygons);
+  void reverse_winding();
+
   /// Adds a light (Light) and returns its id, with `direction` normalised and its default
   /// filled in. Throws Error{invalid_scene} naming the light (its name and id) and the field
   /// for a NaN or infinite value, a negative intensity or colour channel, cones outside
@@ -433,8 +448,12 @@ struct OutwardFacing {
 /// of its front's rays and at least 15 of its back's meet a polygon. An exterior seen alone (a
 /// box with nothing around it) is reported too, and so is a roof under an open sky (its back
 /// sees the building's inside), so the caller judges the share of the one-sided area:
-/// `radiosity check` warns above half of it. Deterministic (a fixed seed). Cost: a BVH over the
-/// scene and 32 rays per one-sided polygon. Throws Error{internal} if Embree cannot create a
+/// `radiosity check` warns above half of it. Rays cannot judge a polygon coincident with another
+/// (find_overlaps(): a box's bottom on a floor), so such pairs are reported so that turning the
+/// polygons found leaves them facing opposite ways (in contact), not the same way: of a pair
+/// facing the same way one (the larger, when rays found both: the floor, not the box's bottom),
+/// of a pair in contact both or neither. Scene::reverse_winding() turns the polygons found over. Deterministic
+/// (a fixed seed). Cost: a BVH over the scene, 32 rays per one-sided polygon, and find_overlaps(). Throws Error{internal} if Embree cannot create a
 /// device. Thread safety: concurrent calls are safe.
 RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene);
 

@@ -126,3 +126,23 @@ def test_cornell_box_has_its_groups():
                                  "short_block", "tall_block"}
     assert len(scene.polygons) == len(scene.polygon_areas()) > 0
     assert "polygons" in repr(scene)
+
+
+def test_reverse_winding_turns_the_polygons_found_facing_outward(data_dir):
+    # A room as an exporter writes it: walls and floor wound outwards, a box standing on the
+    # floor wound as it should be.
+    scene = radiosity.load_scene(data_dir / "messy" / "exported_room.obj")
+    found = radiosity.find_polygons_facing_outward(scene)
+    assert found == [0, 1, 2, 3, 4, 5]  # the room, not the box's bottom on its floor
+    floor_normal = scene.polygons[0].normal.copy()
+    np.testing.assert_allclose(floor_normal, [0, -1, 0], atol=1e-6)
+    scene.reverse_winding(np.array(found))  # any sequence of ids
+    np.testing.assert_allclose(scene.polygons[0].normal, [0, 1, 0], atol=1e-6)
+    assert radiosity.find_polygons_facing_outward(scene) == []
+    before = [p.vertices.copy() for p in scene.polygons]
+    scene.reverse_winding()
+    scene.reverse_winding()
+    for p, v in zip(scene.polygons, before):
+        np.testing.assert_array_equal(p.vertices, v)
+    with pytest.raises(radiosity.Error, match="polygon 99 does not exist"):
+        scene.reverse_winding([99])

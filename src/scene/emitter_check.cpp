@@ -159,7 +159,7 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
       std::snprintf(share, sizeof share, "%.0f", 100.0 * lost / total);
       warnings.push_back(std::string("the scene looks closed but ") + share +
                          " % of the emitted light left it: polygons probably face outwards (wound the wrong way); "
-                         "reverse their winding or use two-sided materials (--two-sided)");
+                         "reverse their winding (--reverse-winding outward) or use two-sided materials (--two-sided)");
     }
   }
   return warnings;
@@ -231,6 +231,20 @@ OutwardFacing find_polygons_facing_outward(const Scene& scene) {
       outward[p] = seen[0] * kRays <= 1.0 && seen[1] * kRays + 1.0 >= kRays ? 1 : 0;
     }
   });
+  // A polygon lying on another (a box's bottom on a floor) sees nothing in front because its
+  // rays start past the other one, so rays cannot judge it. Turning the polygons found must
+  // leave every coincident pair facing opposite ways (in contact) rather than the same way
+  // (z-fighting): of a pair that faces the same way, one is turned (the larger when both were
+  // found: the room's floor, not the box standing on it); of a pair in contact, both or none.
+  for (const PolygonOverlap& o : find_overlaps(scene)) {
+    if (o.kind != OverlapKind::coincident) continue;
+    const PolygonId a = o.first, b = o.second;
+    if (glm::dot(polygons[a].normal, polygons[b].normal) > 0.0f) {
+      if (outward[a] && outward[b]) (polygons[a].area >= polygons[b].area ? outward[b] : outward[a]) = 0;
+    } else if (outward[a] != outward[b]) {
+      outward[a] = outward[b] = 0;
+    }
+  }
   for (PolygonId p = 0; p < polygons.size(); ++p) {
     const Polygon& polygon = polygons[p];
     if (!one_sided(scene.material(polygon.material))) continue;

@@ -81,6 +81,44 @@ void Scene::make_two_sided() {
   for (Material& m : materials_) m.two_sided = true;
 }
 
+void Scene::reverse_winding(const std::vector<PolygonId>& polygons) {
+  std::vector<std::uint8_t> turn(polygons_.size(), 0);
+  for (const PolygonId id : polygons) {
+    if (id >= polygons_.size())
+      throw Error(ErrorCode::invalid_argument, "Scene::reverse_winding: polygon " + std::to_string(id) +
+                                                   " does not exist (the scene has " +
+                                                   std::to_string(polygons_.size()) + ")");
+    turn[id] = 1;
+  }
+  for (PolygonId id = 0; id < polygons_.size(); ++id) {
+    if (!turn[id]) continue;
+    Polygon& p = polygons_[id];
+    // Corner 0 stays first, so a mesh triangle (a, b, c) becomes (a, c, b) in both places.
+    if (p.vertices.size() > 2) std::reverse(p.vertices.begin() + 1, p.vertices.end());
+    p.normal = -p.normal;
+  }
+  for (Mesh& m : meshes_) {
+    // Per vertex: bit 0 when a turned triangle uses it, bit 1 when a kept one does.
+    std::vector<std::uint8_t> use(m.positions.size(), 0);
+    for (std::size_t t = 0; t < m.triangle_polygon.size(); ++t) {
+      const PolygonId p = m.triangle_polygon[t];
+      if (p == kNone) continue;  // a skipped (degenerate) triangle faces nowhere
+      const std::uint8_t bit = turn[p] ? 1 : 2;
+      if (turn[p]) std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
+      for (std::size_t c = 0; c < 3; ++c) use[m.indices[3 * t + c]] |= bit;
+    }
+    if (m.normals.empty()) continue;
+    for (std::size_t v = 0; v < use.size(); ++v)
+      if (use[v] == 1) m.normals[v] = -m.normals[v];
+  }
+}
+
+void Scene::reverse_winding() {
+  std::vector<PolygonId> all(polygons_.size());
+  for (PolygonId id = 0; id < all.size(); ++id) all[id] = id;
+  reverse_winding(all);
+}
+
 GroupId Scene::intern_group(std::string_view name) {
   if (name.empty()) name = "default";
   if (auto id = find_group(name)) return *id;

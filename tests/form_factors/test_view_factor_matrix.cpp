@@ -188,6 +188,27 @@ TEST_SUITE("form_factors") {
     for (std::size_t i = 0; i < mc.rows(); ++i) CHECK(std::fabs(row_sum(mc, i) - 1.0) < 1e-4);  // no ray escapes
   }
 
+  TEST_CASE("view_factor_matrix of a box wound outward: every row empty and said so by find_polygons_facing_outward - "
+            "turned over, the factors of the box wound inward to the bit") {
+    const rad::Scene inward = faceted_box(1, 2, 3, 1.0f);
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    const rad::ViewFactorMatrix want = rad::view_factor_matrix(inward, o);
+    rad::Scene outward = inward;  // as a CAD solid's facets: pointing out of the box
+    outward.reverse_winding();
+    const rad::ViewFactorMatrix blind = rad::view_factor_matrix(outward, o);
+    REQUIRE(blind.rows() == inward.polygons().size());
+    CHECK(blind.values.empty());  // fronts see nothing: no factor at all
+    const rad::OutwardFacing found = rad::find_polygons_facing_outward(outward);
+    CHECK(found.polygons.size() == inward.polygons().size());
+    outward.reverse_winding(found.polygons);  // what `factors --reverse-winding outward` does
+    const rad::ViewFactorMatrix got = rad::view_factor_matrix(outward, o);
+    CHECK(got.row_offsets == want.row_offsets);
+    CHECK(got.columns == want.columns);
+    CHECK(got.values == want.values);
+    for (std::size_t i = 0; i < got.rows(); ++i) CHECK(std::fabs(row_sum(got, i) - 1.0) < 1e-4);
+  }
+
   TEST_CASE("view_factor_matrix corrections: reciprocity to 1e-6 - enclosure rows to 1e-6 - the changes stated and "
             "small - the closed forms within 0.01 after it") {
     const rad::Scene s = faceted_box(1, 2, 3, 0.5f);

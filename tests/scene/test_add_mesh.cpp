@@ -183,6 +183,63 @@ TEST_SUITE("scene") {
 }
 
 TEST_SUITE("scene") {
+  TEST_CASE("reverse_winding: chosen polygons turn over with their mesh triangles - a vertex normal only when all its triangles turned - all twice is the identity") {
+    rad::Scene scene;
+    const rad::MaterialId m = scene.add_material(rad::Material{});
+    HostMesh host;
+    const std::vector<glm::vec3> normals(host.positions.size(), glm::vec3(0, 0, 1));
+    rad::MeshDesc desc = host.desc(m);
+    desc.normals = normals.data();
+    scene.add_mesh(desc);
+    rad::add_quad(scene, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, m, "lid");  // polygon 2, not a mesh's
+    REQUIRE(scene.polygons().size() == 3);
+    const rad::Scene before = scene;
+
+    // Polygon 0 alone (the mesh's first triangle 0-1-2): corner 0 stays first.
+    scene.reverse_winding({0});
+    const rad::Polygon& p0 = scene.polygons()[0];
+    CHECK(p0.normal == glm::vec3(0, 0, -1));
+    CHECK(p0.area == doctest::Approx(0.5));
+    CHECK(std::vector<glm::vec3>(p0.vertices) == std::vector<glm::vec3>{{0, 0, 0}, {1, 1, 0}, {1, 0, 0}});
+    CHECK(scene.polygons()[1].normal == glm::vec3(0, 0, 1));
+    const rad::Mesh& mesh = scene.meshes()[0];
+    CHECK(mesh.indices == std::vector<std::uint32_t>{0, 2, 1, 0, 2, 3, 0, 1, 4});  // the skipped triangle as given
+    // Vertex 1 belongs to the turned triangle only; 0 and 2 to both; 3 to the kept one; 4 to
+    // the skipped (degenerate) one only.
+    CHECK(mesh.normals == std::vector<glm::vec3>{{0, 0, 1}, {0, 0, -1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}});
+
+    // Everything: polygon 0 back as it was, the others turned.
+    scene.reverse_winding();
+    CHECK(scene.polygons()[0].normal == glm::vec3(0, 0, 1));
+    CHECK(scene.polygons()[1].normal == glm::vec3(0, 0, -1));
+    CHECK(scene.polygons()[2].normal == -before.polygons()[2].normal);
+    CHECK(mesh.indices == std::vector<std::uint32_t>{0, 1, 2, 0, 3, 2, 0, 1, 4});
+    CHECK(mesh.normals == std::vector<glm::vec3>{{0, 0, -1}, {0, 0, 1}, {0, 0, -1}, {0, 0, -1}, {0, 0, 1}});
+
+    // An unknown id throws and changes nothing.
+    const std::vector<glm::vec3> corners(scene.polygons()[1].vertices);
+    try {
+      scene.reverse_winding({1, 3});
+      FAIL("no error for polygon 3");
+    } catch (const rad::Error& e) {
+      CHECK(e.code() == rad::ErrorCode::invalid_argument);
+      CHECK(contains(e.what(), "polygon 3 does not exist (the scene has 3)"));
+    }
+    CHECK(std::vector<glm::vec3>(scene.polygons()[1].vertices) == corners);
+
+    // Back to the start: polygon 0 turned once more, then everything twice.
+    scene.reverse_winding({0, 0});  // listed twice, turned once
+    scene.reverse_winding();
+    scene.reverse_winding();
+    scene.reverse_winding();
+    for (std::size_t p = 0; p < 3; ++p) {
+      CHECK(std::vector<glm::vec3>(scene.polygons()[p].vertices) == std::vector<glm::vec3>(before.polygons()[p].vertices));
+      CHECK(scene.polygons()[p].normal == before.polygons()[p].normal);
+    }
+    CHECK(scene.meshes()[0].indices == before.meshes()[0].indices);
+    CHECK(scene.meshes()[0].normals == before.meshes()[0].normals);
+  }
+
   TEST_CASE("PolygonVertices: up to four corners inline, more on the heap, read and compared like a vector") {
     const std::vector<glm::vec3> quad{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
     std::vector<glm::vec3> hexagon;

@@ -99,7 +99,7 @@ TEST_SUITE("solver") {
     REQUIRE(sol.status() == rad::SolveStatus::converged);
     CHECK(share(r.escaped_power, r.emitted_power) > 0.5);
     CHECK(has_warning(r, "the scene looks closed but 100 % of the emitted light left it: polygons probably face "
-                         "outwards (wound the wrong way); reverse their winding or use two-sided materials"));
+                         "outwards (wound the wrong way); reverse their winding (--reverse-winding outward) or use two-sided materials"));
     CHECK(!has_warning(r, "faces away"));
     CHECK(rad::find_emitters_facing_away(scene).empty());
   }
@@ -171,17 +171,18 @@ TEST_SUITE("solver") {
     grey.reflectance = rad::Rgb(0.5f);
     const rad::Scene inward = test::closed_box(grey, glm::vec3(2.0f, 1.0f, 3.0f));
     CHECK(rad::find_polygons_facing_outward(inward).polygons.empty());
-    // The same box with every polygon reversed: its fronts face out, its backs see the box.
-    rad::Scene outward;
-    const rad::MaterialId g = outward.add_material(grey);
-    for (const rad::Polygon& p : inward.polygons()) {
-      std::vector<glm::vec3> reversed(p.vertices.begin(), p.vertices.end());
-      std::reverse(reversed.begin(), reversed.end());
-      outward.add_polygon(reversed, g, inward.groups()[p.group]);
-    }
-    CHECK(rad::find_polygons_facing_outward(outward).polygons.size() == 6);
-    outward.make_two_sided();
-    CHECK(rad::find_polygons_facing_outward(outward).polygons.empty());
+    // The same box with every polygon turned over: its fronts face out, its backs see the box.
+    rad::Scene outward = inward;
+    outward.reverse_winding();
+    const std::vector<rad::PolygonId> found_whole = rad::find_polygons_facing_outward(outward).polygons;
+    CHECK(found_whole.size() == 6);
+    rad::Scene turned_back = outward;  // what --reverse-winding outward does
+    turned_back.reverse_winding(found_whole);
+    CHECK(rad::find_polygons_facing_outward(turned_back).polygons.empty());
+    for (std::size_t p = 0; p < 6; ++p) CHECK(turned_back.polygons()[p].normal == inward.polygons()[p].normal);
+    rad::Scene two_sided = outward;
+    two_sided.make_two_sided();
+    CHECK(rad::find_polygons_facing_outward(two_sided).polygons.empty());
     // A box standing on a large ground, wound outward as an exterior should be: only its roof
     // (open sky in front, the box's inside behind) is reported, a small share of the area, which
     // is why `radiosity check` warns only above half of it.

@@ -144,7 +144,7 @@ int run_bake(const BakeArgs& a) {
     if (is_gltf(a.output) && a.solve.light_groups)
       throw rad::Error(rad::ErrorCode::invalid_argument,
                        "--light-groups needs an output folder (a .glb/.gltf holds the total only)");
-    rad::Scene scene = load(a.solve.scene, a.solve.strict, a.solve.two_sided, a.solve.photometric);
+    rad::Scene scene = load(a.solve.scene, a.solve.strict, a.solve.photometric, {a.solve.two_sided, a.solve.reverse_winding});
     print_warnings(scene.warnings());
     // Surfaces that came as polygons (OBJ faces, JSON shapes, the built-in scenes) are baked per
     // group, as meshes welded at shared corners.

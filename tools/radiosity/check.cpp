@@ -22,6 +22,7 @@ struct CheckArgs {
   bool strict = false;
   bool photometric = false;
   bool two_sided = false;
+  std::string reverse_winding;
   float max_patch_area = 0.0f, max_element_area = 0.0f;
 };
 
@@ -137,8 +138,8 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
                            " polygons (" + share +
                            " % of the one-sided area) see nothing in front of them and surfaces behind: a closed "
                            "model wound outward (a CAD solid's facets point out of it)? Its inside then stays dark "
-                           "and its view factors are 0; reverse the winding, or use two-sided materials "
-                           "(--two-sided) to light it");
+                           "and its view factors are 0; reverse the winding (--reverse-winding outward), or use "
+                           "two-sided materials (--two-sided) to light it");
     }
   }
 
@@ -270,7 +271,7 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
 
 int run_check(const CheckArgs& a) {
   return run_guarded([&] {
-    const rad::Scene scene = load(a.scene, a.strict, a.two_sided, a.photometric);
+    const rad::Scene scene = load(a.scene, a.strict, a.photometric, {a.two_sided, a.reverse_winding});
     const CheckResult r = check_scene(a, scene);
     if (a.format == "json")
       print_json(r, scene);
@@ -296,6 +297,7 @@ Command add_check_command(CLI::App& app) {
   add_strict_flag(*cmd, a.strict);
   add_photometric_flag(*cmd, a.photometric);
   cmd->add_flag("--two-sided", a.two_sided, "Make every material two-sided, as render and solve --two-sided do");
+  add_reverse_winding_option(*cmd, a.reverse_winding);
   cmd->add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(non_negative<float>());
   cmd->add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")

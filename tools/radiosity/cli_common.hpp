@@ -193,6 +193,7 @@ struct SolveArgs {
   bool strict = false;
   bool photometric = false;
   bool two_sided = false;
+  std::string reverse_winding;  ///< `--reverse-winding`: "", "all" or "outward"
   bool light_groups = false;
 };
 
@@ -265,6 +266,17 @@ inline void add_photometric_flag(CLI::App& cmd, bool& photometric) {
                "divide by 683 lm/W; without it they are W/sr and W/m^2 as written (the library is radiometric)");
 }
 
+/// Adds `--reverse-winding all|outward` (every command that loads a scene has it).
+inline void add_reverse_winding_option(CLI::App& cmd, std::string& reverse_winding) {
+  cmd.add_option("--reverse-winding", reverse_winding,
+                 "Turn polygons over (reverse their vertex order) after loading, for one-sided models wound the wrong "
+                 "way: 'outward' the polygons whose front sees nothing and whose back sees the scene (the walls of a "
+                 "room or enclosure modelled as an outward box, as check lists them; furniture inside keeps its "
+                 "winding), 'all' every polygon. View factors are taken on fronts only, so for them this, not "
+                 "--two-sided, is the fix")
+      ->check(CLI::IsMember({"all", "outward"}));
+}
+
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"auto", "jacobi", "gauss-seidel", "progressive", "hierarchical"};
@@ -323,6 +335,7 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_flag("--two-sided", a.two_sided,
                "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
                "models whose polygons face inconsistently or outwards");
+  add_reverse_winding_option(cmd, a.reverse_winding);
 }
 
 inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
@@ -378,11 +391,33 @@ inline rad::Scene load(const std::string& path, bool strict = false, bool photom
   return rad::load_scene(path, options);
 }
 
-/// load(), then every material two-sided when `two_sided` (`--two-sided`: models with
-/// unreliable winding; Scene::make_two_sided()).
-inline rad::Scene load(const std::string& path, bool strict, bool two_sided, bool photometric) {
+/// What the command line changes in a scene once it is loaded.
+struct SceneEdits {
+  bool two_sided = false;       ///< `--two-sided`: Scene::make_two_sided()
+  std::string reverse_winding;  ///< `--reverse-winding`: "" (none), "all" or "outward"
+};
+
+/// Applies `--reverse-winding` (Scene::reverse_winding()) and says what it turned.
+inline void reverse_winding(rad::Scene& scene, const std::string& which) {
+  if (which.empty()) return;
+  if (which == "all") {
+    scene.reverse_winding();
+    std::fprintf(stderr, "reversed the winding of all %zu polygons (--reverse-winding all)\n", scene.polygons().size());
+    return;
+  }
+  const rad::OutwardFacing outward = rad::find_polygons_facing_outward(scene);
+  scene.reverse_winding(outward.polygons);
+  std::fprintf(stderr,
+               "reversed the winding of %zu of %zu polygons, those whose front sees nothing and whose back sees the "
+               "scene (--reverse-winding outward)\n",
+               outward.polygons.size(), scene.polygons().size());
+}
+
+/// load(), then the edits (models with unreliable winding).
+inline rad::Scene load(const std::string& path, bool strict, bool photometric, const SceneEdits& edits) {
   rad::Scene scene = load(path, strict, photometric);
-  if (two_sided) scene.make_two_sided();
+  reverse_winding(scene, edits.reverse_winding);
+  if (edits.two_sided) scene.make_two_sided();
   return scene;
 }
 

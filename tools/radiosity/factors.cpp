@@ -43,6 +43,7 @@ struct FactorsArgs {
   float max_patch_area = 0.0f, max_element_area = 0.0f;
   bool strict = false;
   bool photometric = false;
+  std::string reverse_winding;
   float epsilon = rad::ViewFactorOptions{}.epsilon;
 };
 
@@ -167,8 +168,9 @@ int run_factors(const FactorsArgs& a) {
       scene = std::move(file.scene);
       control = file.control;
       title = file.title;
+      reverse_winding(scene, a.reverse_winding);
     } else {
-      scene = load(a.scene, a.strict, a.photometric);
+      scene = load(a.scene, a.strict, a.photometric, {false, a.reverse_winding});
     }
     print_warnings(scene.warnings());
     rad::ViewFactorOptions o;
@@ -299,7 +301,8 @@ int run_factors(const FactorsArgs& a) {
       if (blind > 0)
         std::fprintf(stderr,
                      "warning: factors: %zu of %zu rows see no surface in front of them (polygons send and receive "
-                     "on their fronts only: if the scene is closed, its polygons may face outward)\n",
+                     "on their fronts only: if the scene is closed, its polygons may face outward: --reverse-winding outward "
+                     "turns them over)\n",
                      blind, m.rows());
       const rad::ViewFactorCorrectionReport& c = m.correction;
       std::fprintf(stderr,
@@ -388,6 +391,7 @@ Command add_factors_command(CLI::App& app) {
       ->check(non_negative<float>());
   add_strict_flag(*cmd, a.strict);
   add_photometric_flag(*cmd, a.photometric);
+  add_reverse_winding_option(*cmd, a.reverse_winding);
   CLI::Option* level = cmd->get_option("--level");
   CLI::Option* correction = cmd->get_option("--correction");
   return Command{cmd, [args, level, correction] {

@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   return run_guarded([&] {
     ProgressBar bar;
     if (*render) {
-      rad::Scene scene = load(render_args.scene, render_args.strict, render_args.two_sided, render_args.photometric);
+      rad::Scene scene = load(render_args.scene, render_args.strict, render_args.photometric, {render_args.two_sided, render_args.reverse_winding});
       print_warnings(scene.warnings());
       std::optional<rad::Camera> camera;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
         std::printf("wrote %s (sRGB preview, exposure %g)\n", std::filesystem::absolute(png).c_str(), exposure);
       }
     } else if (*solve) {
-      rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.two_sided, solve_args.photometric);
+      rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.photometric, {solve_args.two_sided, solve_args.reverse_winding});
       print_warnings(scene.warnings());
       const rad::SolveOptions options = to_options(solve_args, bar);
 #if RADIOSITY_HAS_MPI
