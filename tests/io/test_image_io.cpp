@@ -163,7 +163,7 @@ TEST_CASE("read_exr errors name the path: missing file - not an EXR - truncated 
   CHECK(contains(no_rgb.what(), "Y"));
 }
 
-TEST_CASE("read_exr refuses a data window its file cannot hold before allocating it - a flat image at ZIP's best ratio reads") {
+TEST_CASE("read_exr refuses a data window its file cannot hold before allocating it, or OpenEXR its line buffers - a flat image at ZIP's best ratio reads") {
   // cornell_path_64.exr (64 x 64, ZIP, 48 KB) with its dataWindow made 20 000 x 20 000: read_exr
   // asked for 4.8 GB before OpenEXR found the pixels missing (found in session 25 by looking at
   // the fuzz target's profile: its time went to allocating and zeroing such images).
@@ -180,6 +180,24 @@ TEST_CASE("read_exr refuses a data window its file cannot hold before allocating
   CHECK(e.code() == ErrorCode::parse_error);
   CHECK(contains(e.what(), "huge_window.exr': its 20000 x 20000 data window (4.8e+09 bytes of pixels) cannot be in a "
                            "file of " + std::to_string(bytes.size()) + " bytes, even at its compression's best ratio (4096 : 1)"));
+  // One line, wide enough that its pixels would fit at ZIP's best ratio but not OpenEXR's line
+  // buffers, 16 lines of that width at a time, three of them: a fuzzed few-KB file made it
+  // allocate 3 x 1.1 GB that way (session 30). Now refused before OpenEXR reads the header.
+  const std::int32_t wide = static_cast<std::int32_t>(4096.0 * static_cast<double>(bytes.size()) / 24.0);
+  const std::int32_t line[4] = {0, 0, wide - 1, 0};
+  bytes.replace(at + key.size() + 4, 16, reinterpret_cast<const char*>(line), 16);
+  std::ofstream(kTmp / "wide_line.exr", std::ios::binary) << bytes;
+  const Error w = error_of([] { radiosity::read_exr(kTmp / "wide_line.exr"); });
+  CHECK(w.code() == ErrorCode::parse_error);
+  CHECK(contains(w.what(), "wide_line.exr': its " + std::to_string(wide) + " x 1 data window has OpenEXR allocate "));
+  CHECK(contains(w.what(), " bytes of buffers (16 lines at a time), more than 256 MiB and more than its pixels could "
+                           "take in a file of " + std::to_string(bytes.size()) + " bytes"));
+  // A real image one line high and wide reads.
+  Image strip(20000, 1);
+  for (std::size_t i = 0; i < strip.pixels.size(); ++i) strip.pixels[i] = Rgb(static_cast<float>(i % 7));
+  radiosity::write_exr(strip, kTmp / "strip.exr");
+  CHECK(radiosity::read_exr(kTmp / "strip.exr").pixels[19999].x == 19999 % 7);
+
   // What compresses best, a flat image (one value everywhere), still reads: ZIP stores these
   // 2048 x 2048 FLOAT pixels (48 MiB) in well under a thousandth of that.
   Image flat(2048, 2048);

@@ -60,6 +60,105 @@ void check_image(const Image& image, const std::filesystem::path& path) {
   }
 }
 
+/// The most a compression can shrink pixel data (raw bytes over stored bytes), with room to
+/// spare: zlib's deflate at best about 1032 : 1 (ZIP, ZIPS, PXR24 after its rounding), PIZ's
+/// Huffman runs (at most 255 repeats of a 16-bit symbol per code) about 450 : 1, RLE 64 : 1
+/// (128 bytes in 2), B44 32 : 3 (a flat 4 x 4 block of halves); DWAA/DWAB compress each 8 x 8
+/// block's coefficients with run lengths and then zlib, so a flat image can reach some
+/// 30 000 : 1, and a compression this reader does not know gets the same.
+double max_compression_ratio(Imf::Compression c) {
+  switch (c) {
+    case Imf::NO_COMPRESSION: return 1.0;
+    case Imf::RLE_COMPRESSION: return 128.0;
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION: return 64.0;
+    case Imf::ZIPS_COMPRESSION:
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PIZ_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 4096.0;
+    default: return 1e5;
+  }
+}
+
+/// How many scan lines OpenEXR 3.1 decodes at a time for a compression (ImfCompression.h's
+/// getCompressionNumScanlines): it allocates its line buffers for that many lines of the widest
+/// line, whatever the window's height. 1 for a value it does not know (it refuses those).
+int lines_per_chunk(int compression) {
+  switch (compression) {
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 16;
+    case Imf::PIZ_COMPRESSION:
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION:
+    case Imf::DWAA_COMPRESSION: return 32;
+    case Imf::DWAB_COMPRESSION: return 256;
+    default: return 1;
+  }
+}
+
+/// What check_exr_header() reads of a header for check_exr_pixels().
+struct ExrLayout {
+  bool has_window = false;
+  std::int32_t min_x = 0, min_y = 0, max_x = 0, max_y = 0;  ///< dataWindow
+  int compression = -1;                                      ///< -1 until read
+  std::uint32_t tile_x = 0, tile_y = 0;                      ///< a tiled file's tile size, else 0
+  struct Channel {
+    std::int32_t type = 0, x_sampling = 1, y_sampling = 1;
+  };
+  std::vector<Channel> channels;
+};
+
+/// Refuses, before OpenEXR or read_exr() allocates for them, a data window whose pixels the file
+/// cannot hold at its compression's best ratio (a 48 KB file that declared 20 000 x 20 000 pixels
+/// made read_exr() ask for 4.8 GB), and one whose buffers in OpenEXR (a block of lines of the
+/// widest line, or a tile, of every channel) pass 256 MiB and what the file could hold (a
+/// few-KB fuzzed file with a window 18 million pixels wide and 1 high made OpenEXR's InputFile
+/// allocate three line buffers of 1.1 GB each, 16 lines of ZIP at a time, before reading a
+/// pixel; session 30).
+void check_exr_pixels(const std::filesystem::path& path, std::uintmax_t size, const ExrLayout& layout) {
+  if (!layout.has_window || layout.compression < 0 || layout.channels.empty()) return;  // OpenEXR refuses it
+  const double w = static_cast<double>(layout.max_x) - layout.min_x + 1.0;
+  const double h = static_cast<double>(layout.max_y) - layout.min_y + 1.0;
+  if (w <= 0.0 || h <= 0.0) return;  // read_exr() refuses it
+  // Per pixel over the window (subsampled channels count their share), per line at its widest,
+  // and per full-resolution pixel of every channel.
+  double bytes_per_pixel = 0.0, line_bytes = 0.0, pixel_bytes = 0.0;
+  for (const ExrLayout::Channel& c : layout.channels) {
+    const double bytes = c.type == Imf::HALF ? 2.0 : 4.0;
+    const double xs = std::max(c.x_sampling, 1), ys = std::max(c.y_sampling, 1);
+    bytes_per_pixel += bytes / (xs * ys);
+    line_bytes += std::ceil(w / xs) * bytes;
+    pixel_bytes += bytes;
+  }
+  const int lines = lines_per_chunk(layout.compression);
+  // A tiled file's buffers hold a tile of every channel (OpenEXR's TiledInputFile).
+  const double tile_bytes = static_cast<double>(layout.tile_x) * layout.tile_y * pixel_bytes;
+  const double window_bytes = w * h * bytes_per_pixel, buffer_bytes = std::max(line_bytes * lines, tile_bytes);
+  const double ratio = max_compression_ratio(static_cast<Imf::Compression>(layout.compression));
+  const double most = static_cast<double>(size) * ratio;
+  const std::string at_best = "a file of " + std::to_string(size) + " bytes, even at its compression's best ratio (" +
+                              std::to_string(static_cast<long long>(ratio)) + " : 1)";
+  char figures[200];
+  if (window_bytes > most) {
+    std::snprintf(figures, sizeof figures, "%.0f x %.0f data window (%.4g bytes of pixels)", w, h, window_bytes);
+    throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': its " + figures + " cannot be in " +
+                                            at_best + ": a corrupted header");
+  }
+  // The buffers may exceed what the file holds when the window is lower than a block of lines;
+  // that is refused only beyond kBufferFloor (a 20 000 x 1 strip of 883 bytes reads).
+  constexpr double kBufferFloor = 256.0 * 1024.0 * 1024.0;
+  if (buffer_bytes > std::max(most, kBufferFloor)) {
+    const std::string how = tile_bytes > line_bytes * lines
+                                ? "tiles of " + std::to_string(layout.tile_x) + " x " + std::to_string(layout.tile_y)
+                                : std::to_string(lines) + " lines at a time";
+    std::snprintf(figures, sizeof figures, "%.0f x %.0f data window has OpenEXR allocate %.4g bytes of buffers", w, h,
+                  buffer_bytes);
+    throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': its " + figures + " (" + how +
+                                            "), more than 256 MiB and more than its pixels could take in " + at_best +
+                                            ": a corrupted header");
+  }
+}
+
 /// How many value bytes OpenEXR 3.1's reader takes for an attribute of a type it knows with a
 /// fixed-size value (ImfTypedAttribute's readers read the value and ignore the declared size),
 /// or -1 for a type whose value it reads otherwise.
@@ -113,6 +212,13 @@ void check_exr_header(const std::filesystem::path& path) {
   };
   auto left = [&] { return static_cast<std::int64_t>(size) - static_cast<std::int64_t>(in.tellg()); };
   std::string name, type, channel;
+  ExrLayout layout;
+  auto read_i32 = [&](std::int32_t& out) {
+    std::uint32_t u = 0;
+    if (!read_u32(u)) return false;
+    out = static_cast<std::int32_t>(u);
+    return true;
+  };
   auto refuse = [&](const char* verb, std::int64_t bytes, std::int64_t remaining) {
     throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': header attribute '" + name + "' (" + type +
                                             ") " + verb + " " + std::to_string(bytes) + " bytes, but " +
@@ -129,12 +235,27 @@ void check_exr_header(const std::filesystem::path& path) {
       const int fixed = fixed_value_bytes(type);
       if (type == "chlist") {
         // Channels to an empty name, each a name and 16 bytes, whatever the declared size.
+        // The "channels" list's types and samplings are kept for check_exr_pixels().
         for (;;) {
           if (!read_name(channel)) return;
           if (channel.empty()) break;
-          if (left() < 16) return;
-          in.seekg(16, std::ios::cur);
+          ExrLayout::Channel c;
+          if (!read_i32(c.type)) return;
+          in.seekg(4, std::ios::cur);  // pLinear and 3 reserved bytes
+          if (!read_i32(c.x_sampling) || !read_i32(c.y_sampling)) return;
+          if (name == "channels") layout.channels.push_back(c);
         }
+      } else if (name == "dataWindow" && type == "box2i") {
+        if (!read_i32(layout.min_x) || !read_i32(layout.min_y) || !read_i32(layout.max_x) || !read_i32(layout.max_y))
+          return;
+        layout.has_window = true;
+      } else if (name == "tiles" && type == "tiledesc") {
+        if (!read_u32(layout.tile_x) || !read_u32(layout.tile_y)) return;
+        in.seekg(1, std::ios::cur);  // the level and rounding modes
+      } else if (name == "compression" && type == "compression") {
+        char c = 0;
+        if (!in.get(c)) return;
+        layout.compression = static_cast<unsigned char>(c);
       } else if (fixed >= 0) {
         if (fixed > left()) return;  // OpenEXR reports the file's end
         in.seekg(fixed, std::ios::cur);
@@ -161,53 +282,10 @@ void check_exr_header(const std::filesystem::path& path) {
         in.seekg(declared, std::ios::cur);
       }
     }
-    if (!in || !multipart || !any) return;
-  }
-}
-
-/// The most a compression can shrink pixel data (raw bytes over stored bytes), with room to
-/// spare: zlib's deflate at best about 1032 : 1 (ZIP, ZIPS, PXR24 after its rounding), PIZ's
-/// Huffman runs (at most 255 repeats of a 16-bit symbol per code) about 450 : 1, RLE 64 : 1
-/// (128 bytes in 2), B44 32 : 3 (a flat 4 x 4 block of halves); DWAA/DWAB compress each 8 x 8
-/// block's coefficients with run lengths and then zlib, so a flat image can reach some
-/// 30 000 : 1, and a compression this reader does not know gets the same.
-double max_compression_ratio(Imf::Compression c) {
-  switch (c) {
-    case Imf::NO_COMPRESSION: return 1.0;
-    case Imf::RLE_COMPRESSION: return 128.0;
-    case Imf::B44_COMPRESSION:
-    case Imf::B44A_COMPRESSION: return 64.0;
-    case Imf::ZIPS_COMPRESSION:
-    case Imf::ZIP_COMPRESSION:
-    case Imf::PIZ_COMPRESSION:
-    case Imf::PXR24_COMPRESSION: return 4096.0;
-    default: return 1e5;
-  }
-}
-
-/// Refuses a data window whose pixels the file cannot hold at its compression's best ratio,
-/// before the image is allocated: a 48 KB file that declared 20 000 x 20 000 pixels made
-/// read_exr() ask for 4.8 GB (a corrupted header; OpenEXR would only fail on reading the
-/// pixels, after the allocation).
-void check_exr_pixels(const std::filesystem::path& path, const Imf::Header& header, long long w, long long h) {
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) return;
-  double bytes_per_pixel = 0.0;
-  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-    const Imf::Channel& c = it.channel();
-    const double sampling = static_cast<double>(std::max(c.xSampling, 1)) * static_cast<double>(std::max(c.ySampling, 1));
-    bytes_per_pixel += (c.type == Imf::HALF ? 2.0 : 4.0) / sampling;
-  }
-  const double raw = static_cast<double>(w) * static_cast<double>(h) * bytes_per_pixel;
-  const double ratio = max_compression_ratio(header.compression());
-  if (raw > static_cast<double>(size) * ratio) {
-    char figures[160];
-    std::snprintf(figures, sizeof figures, "%lld x %lld data window (%.4g bytes of pixels)", w, h, raw);
-    throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': its " + figures +
-                                            " cannot be in a file of " + std::to_string(size) +
-                                            " bytes, even at its compression's best ratio (" +
-                                            std::to_string(static_cast<long long>(ratio)) + " : 1): a corrupted header");
+    if (!in) return;
+    check_exr_pixels(path, size, layout);  // each part's header: its own window and channels
+    if (!multipart || !any) return;
+    layout = ExrLayout{};
   }
 }
 
@@ -258,7 +336,6 @@ Image read_exr(const std::filesystem::path& path) {
     if (w <= 0 || h <= 0 || w * h > (1ll << 31))
       throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "': unusable data window " +
                                               std::to_string(w) + " x " + std::to_string(h));
-    check_exr_pixels(path, header, w, h);
     Image image(static_cast<int>(w), static_cast<int>(h));
 
     // Layers: every prefix P of a channel P.R, P.G or P.B (OpenEXR sorts them by name).
