@@ -96,11 +96,11 @@ int lines_per_chunk(int compression) {
   }
 }
 
-/// What check_exr_header() reads of a header for check_exr_pixels().
+/// What check_exr_header() reads of a header for check_exr_pixels(). A header without a
+/// dataWindow or compression attribute gets OpenEXR's defaults (Imf::Header(): 64 x 64, ZIP).
 struct ExrLayout {
-  bool has_window = false;
-  std::int32_t min_x = 0, min_y = 0, max_x = 0, max_y = 0;  ///< dataWindow
-  int compression = -1;                                      ///< -1 until read
+  std::int32_t min_x = 0, min_y = 0, max_x = 63, max_y = 63;  ///< dataWindow
+  int compression = Imf::ZIP_COMPRESSION;
   std::uint32_t tile_x = 0, tile_y = 0;                      ///< a tiled file's tile size, else 0
   struct Channel {
     std::int32_t type = 0, x_sampling = 1, y_sampling = 1;
@@ -116,7 +116,7 @@ struct ExrLayout {
 /// allocate three line buffers of 1.1 GB each, 16 lines of ZIP at a time, before reading a
 /// pixel; session 30).
 void check_exr_pixels(const std::filesystem::path& path, std::uintmax_t size, const ExrLayout& layout) {
-  if (!layout.has_window || layout.compression < 0 || layout.channels.empty()) return;  // OpenEXR refuses it
+  if (layout.channels.empty()) return;  // read_exr() refuses it
   const double w = static_cast<double>(layout.max_x) - layout.min_x + 1.0;
   const double h = static_cast<double>(layout.max_y) - layout.min_y + 1.0;
   if (w <= 0.0 || h <= 0.0) return;  // read_exr() refuses it
@@ -248,7 +248,6 @@ void check_exr_header(const std::filesystem::path& path) {
       } else if (name == "dataWindow" && type == "box2i") {
         if (!read_i32(layout.min_x) || !read_i32(layout.min_y) || !read_i32(layout.max_x) || !read_i32(layout.max_y))
           return;
-        layout.has_window = true;
       } else if (name == "tiles" && type == "tiledesc") {
         if (!read_u32(layout.tile_x) || !read_u32(layout.tile_y)) return;
         in.seekg(1, std::ios::cur);  // the level and rounding modes
@@ -330,6 +329,18 @@ Image read_exr(const std::filesystem::path& path) {
       throw Error(ErrorCode::parse_error, "read_exr: '" + path.string() + "' has no R, G or B channel (channels: " +
                                               (found.empty() ? "none" : found) + ")");
     }
+
+    // The same check on the header as OpenEXR read it, before the image is allocated: should
+    // the walk above have read another header than OpenEXR (as it once did, session 29), the
+    // image at least is not allocated for pixels the file cannot hold.
+    ExrLayout read;
+    read.min_x = window.min.x, read.min_y = window.min.y, read.max_x = window.max.x, read.max_y = window.max.y;
+    read.compression = header.compression();
+    for (auto it = channels.begin(); it != channels.end(); ++it)
+      read.channels.push_back({it.channel().type, it.channel().xSampling, it.channel().ySampling});
+    std::error_code size_error;
+    const std::uintmax_t size = std::filesystem::file_size(path, size_error);
+    if (!size_error) check_exr_pixels(path, size, read);
 
     const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
     const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
