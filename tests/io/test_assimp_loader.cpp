@@ -541,6 +541,25 @@ TEST_CASE("Assimp broken FBX: a model property of a type Assimp cannot keep as m
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
 }
 
+TEST_CASE("Assimp broken FBX: a cycle among the connections is refused before Assimp's converter recurses into it") {
+  // Found by radiosity_fuzz_fbx (session 30, 144 118 inputs into chunk 50 of its long run): the
+  // exported room with `C: "OO", 1000010, 1000010`, a model connected to itself. Assimp 5.2's
+  // converter walks the graph by its connections without remembering where it has been: a stack
+  // overflow, a segmentation fault in an ordinary build.
+  const Error e = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "fbx" / "connection_to_itself.fbx");
+  CHECK(e.code() == ErrorCode::parse_error);
+  CHECK(contains(e.what(), "connection_to_itself.fbx:308:2: the connections form a cycle: object 1000010 is its own parent"));
+  // A longer cycle (a model the child of its own child), and the room with its connections as
+  // written, which loads.
+  const std::string room = read_text(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx");
+  const std::size_t first = room.find("\tC: \"OO\", ");
+  REQUIRE(first != std::string::npos);
+  std::string cycle = room;
+  cycle.insert(first, "\tC: \"OO\", 7000001, 7000002\n\tC: \"OO\", 7000002, 7000003\n\tC: \"OO\", 7000003, 7000001\n");
+  CHECK(contains(load_error(write("connection_cycle.fbx", cycle)).what(), "is its own ancestor"));
+  CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
+}
+
 TEST_CASE("Assimp broken COLLADA: primitives whose index lists do not match their counts are refused before Assimp aborts") {
   // Found by radiosity_fuzz_dae (session 20): the exported room with one <polylist>'s index list
   // (<p>) erased. Assimp 5.2's parser asserts that a primitive element read as many primitives

@@ -617,6 +617,12 @@ void check_collada(const fs::path& path) {
 /// template held GlobalSettings' `TimeSpanStart`, a KTime). No exporter writes either type on a
 /// node, so a `P:` of one of these types inside a `Model:` object or the Model property template
 /// is refused, with its line. The scopes are followed by their braces, as Assimp's parser does.
+///
+/// The converter walks the scene graph from the root by the connections (`C: "OO", child,
+/// parent`), recursively and without remembering where it has been, so a cycle among them (an
+/// object connected to itself, found by radiosity_fuzz_fbx in session 30, or to its own
+/// descendant) recurses until the stack overflows: a segmentation fault. A cycle is refused,
+/// with the line of one of its connections.
 /// Binary FBX files are not checked.
 void check_fbx_text(const fs::path& path) {
   const std::string text = read_file(path, "FBX file");
@@ -633,11 +639,17 @@ void check_fbx_text(const fs::path& path) {
   std::string last_key;
   std::string last_key_value;
   bool key_has_value = false;
+  // The connections, child -> parent, with where each was written.
+  struct Connection {
+    std::string child, parent;
+    std::size_t at = 0;
+  };
+  std::vector<Connection> connections;
   for (std::size_t at = 0; at < text.size(); ++at) {
     const char c = text[at];
     if (c == '"') {  // a string: skipped whole
       const std::size_t close = text.find('"', at + 1);
-      if (close == std::string::npos) return;  // Assimp says what is wrong
+      if (close == std::string::npos) break;  // Assimp says what is wrong
       if (!key_has_value) last_key_value = text.substr(at + 1, close - at - 1);
       key_has_value = true;
       at = close;
@@ -656,7 +668,7 @@ void check_fbx_text(const fs::path& path) {
     }
     if (c == ';') {  // a comment, to the end of the line
       const std::size_t eol = text.find('\n', at);
-      if (eol == std::string::npos) return;
+      if (eol == std::string::npos) break;
       at = eol;
       continue;
     }
@@ -695,7 +707,53 @@ void check_fbx_text(const fs::path& path) {
           fail(at, "a model's property of type " + type + " (Assimp 5.2 cannot keep it as node metadata and aborts)");
       }
     }
+    if (last_key == "C") {
+      // `C: "OO", child, parent` (or "OP", child, parent, "property"): the two ids after the type.
+      std::size_t next = text.find_first_not_of(" \t", end + 1);
+      if (next != std::string::npos && text[next] == '"') next = text.find('"', next + 1);
+      std::string ids[2];
+      for (std::string& id : ids) {
+        if (next == std::string::npos) break;
+        next = text.find_first_not_of(" \t,", next + 1);
+        if (next == std::string::npos) break;
+        const std::size_t id_end = text.find_first_of(" \t,\r\n", next);
+        id = text.substr(next, id_end == std::string::npos ? std::string::npos : id_end - next);
+        next = id_end == std::string::npos ? id_end : id_end - 1;
+      }
+      if (!ids[0].empty() && !ids[1].empty()) connections.push_back({ids[0], ids[1], at});
+    }
     at = end;
+  }
+
+  // A cycle among the connections: follow each object's parents depth first, marking objects
+  // on the current walk (1) and those already cleared (2).
+  std::map<std::string, std::vector<std::size_t>> parents_of;  // child -> its connections
+  for (std::size_t k = 0; k < connections.size(); ++k) parents_of[connections[k].child].push_back(k);
+  std::map<std::string, int> state;
+  for (const auto& start : parents_of) {
+    if (state[start.first] != 0) continue;
+    // (object, index of the next of its connections to follow)
+    std::vector<std::pair<std::string, std::size_t>> walk = {{start.first, 0}};
+    state[start.first] = 1;
+    while (!walk.empty()) {
+      auto& [object, next] = walk.back();
+      const auto found = parents_of.find(object);
+      if (found == parents_of.end() || next == found->second.size()) {
+        state[object] = 2;
+        walk.pop_back();
+        continue;
+      }
+      const Connection& c = connections[found->second[next++]];
+      int& s = state[c.parent];
+      if (s == 1)
+        fail(c.at, "the connections form a cycle: object " + c.parent + " is its own " +
+                       (c.parent == c.child ? "parent" : "ancestor") +
+                       " (a scene graph has none; Assimp 5.2 follows one until its stack overflows)");
+      if (s == 0) {
+        s = 1;
+        walk.emplace_back(c.parent, 0);
+      }
+    }
   }
 }
 

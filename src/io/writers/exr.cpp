@@ -66,8 +66,10 @@ void check_image(const Image& image, const std::filesystem::path& path) {
 /// (128 bytes in 2), B44 32 : 3 (a flat 4 x 4 block of halves); DWAA/DWAB compress each 8 x 8
 /// block's coefficients with run lengths and then zlib, so a flat image can reach some
 /// 30 000 : 1, and a compression this reader does not know gets the same.
-double max_compression_ratio(Imf::Compression c) {
-  switch (c) {
+/// The compression as the file's byte gives it: an int, since a value outside Imf::Compression's
+/// enumerators is not an Imf::Compression (UBSan's invalid enum load; found by the fuzz target).
+double max_compression_ratio(int compression) {
+  switch (compression) {
     case Imf::NO_COMPRESSION: return 1.0;
     case Imf::RLE_COMPRESSION: return 128.0;
     case Imf::B44_COMPRESSION:
@@ -134,7 +136,7 @@ void check_exr_pixels(const std::filesystem::path& path, std::uintmax_t size, co
   // A tiled file's buffers hold a tile of every channel (OpenEXR's TiledInputFile).
   const double tile_bytes = static_cast<double>(layout.tile_x) * layout.tile_y * pixel_bytes;
   const double window_bytes = w * h * bytes_per_pixel, buffer_bytes = std::max(line_bytes * lines, tile_bytes);
-  const double ratio = max_compression_ratio(static_cast<Imf::Compression>(layout.compression));
+  const double ratio = max_compression_ratio(layout.compression);
   const double most = static_cast<double>(size) * ratio;
   const std::string at_best = "a file of " + std::to_string(size) + " bytes, even at its compression's best ratio (" +
                               std::to_string(static_cast<long long>(ratio)) + " : 1)";
@@ -335,7 +337,7 @@ Image read_exr(const std::filesystem::path& path) {
     // image at least is not allocated for pixels the file cannot hold.
     ExrLayout read;
     read.min_x = window.min.x, read.min_y = window.min.y, read.max_x = window.max.x, read.max_y = window.max.y;
-    read.compression = header.compression();
+    read.compression = static_cast<int>(header.compression());
     for (auto it = channels.begin(); it != channels.end(); ++it)
       read.channels.push_back({it.channel().type, it.channel().xSampling, it.channel().ySampling});
     std::error_code size_error;
