@@ -558,6 +558,23 @@ TEST_CASE("Assimp broken FBX: a cycle among the connections is refused before As
   cycle.insert(first, "\tC: \"OO\", 7000001, 7000002\n\tC: \"OO\", 7000002, 7000003\n\tC: \"OO\", 7000003, 7000001\n");
   CHECK(contains(load_error(write("connection_cycle.fbx", cycle)).what(), "is its own ancestor"));
   CHECK(load(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room.fbx").polygons().size() > 0);
+  // The same in a binary FBX, whose records are walked for their connections alone: the room
+  // as Assimp 5.2 writes it, its second connection (a "C" record: the type "OO", child, parent)
+  // made to name its child as its parent. The cycle is refused at its record's byte, before the
+  // tokenizer's own complaint about this file (its block offsets; the test above).
+  std::string binary = read_text(fs::path(RADIOSITY_TEST_DATA) / "assimp" / "room_binary_assimp52.fbx");
+  const std::string c_record("\x01" "CS\x02\x00\x00\x00OO", 9);  // name length 1, "C", 'S' of length 2
+  const std::size_t c1 = binary.find(c_record);
+  REQUIRE(c1 != std::string::npos);
+  const std::size_t c2 = binary.find(c_record, c1 + 1);
+  REQUIRE(c2 != std::string::npos);
+  const std::size_t child = c2 + c_record.size();  // 'L' and the child's 8 bytes, then the parent's
+  REQUIRE(binary[child] == 'L');
+  REQUIRE(binary[child + 9] == 'L');
+  binary.replace(child + 10, 8, binary.substr(child + 1, 8));
+  const Error b = load_error(write("connection_cycle_binary.fbx", binary));
+  CHECK(contains(b.what(), "connection_cycle_binary.fbx: at byte "));
+  CHECK(contains(b.what(), "is its own parent"));
 }
 
 TEST_CASE("Assimp broken COLLADA: primitives whose index lists do not match their counts are refused before Assimp aborts") {

@@ -600,6 +600,108 @@ void check_collada(const fs::path& path) {
   check_collada_primitives(text, fail);
 }
 
+/// One FBX connection, `C: "OO", child, parent` (or "OP" with a property), and where it is:
+/// the byte offset of its record (binary) or of its key (text).
+struct FbxConnection {
+  std::string child, parent;
+  std::size_t at = 0;
+};
+
+/// A connection on a cycle among `connections` (an object its own parent or ancestor), or null.
+/// Depth first from each object along its parents, marking the objects on the current walk (1)
+/// and those already cleared (2). Cost: linear in the connections (times a map's log).
+const FbxConnection* fbx_connection_cycle(const std::vector<FbxConnection>& connections) {
+  std::map<std::string, std::vector<std::size_t>> parents_of;  // child -> its connections
+  for (std::size_t k = 0; k < connections.size(); ++k) parents_of[connections[k].child].push_back(k);
+  std::map<std::string, int> state;
+  for (const auto& start : parents_of) {
+    if (state[start.first] != 0) continue;
+    // (object, index of the next of its connections to follow)
+    std::vector<std::pair<std::string, std::size_t>> walk = {{start.first, 0}};
+    state[start.first] = 1;
+    while (!walk.empty()) {
+      auto& [object, next] = walk.back();
+      const auto found = parents_of.find(object);
+      if (found == parents_of.end() || next == found->second.size()) {
+        state[object] = 2;
+        walk.pop_back();
+        continue;
+      }
+      const FbxConnection& c = connections[found->second[next++]];
+      int& seen = state[c.parent];
+      if (seen == 1) return &c;
+      if (seen == 0) {
+        seen = 1;
+        walk.emplace_back(c.parent, 0);
+      }
+    }
+  }
+  return nullptr;
+}
+
+std::string fbx_cycle_text(const FbxConnection& c) {
+  return "object " + c.parent + " is its own " + (c.parent == c.child ? "parent" : "ancestor") +
+         " (a scene graph has none; Assimp 5.2 follows one until its stack overflows)";
+}
+
+/// The connections of a binary FBX (the records "C" under the top-level record "Connections";
+/// Autodesk's format as Blender's and Assimp's readers document it: after the 27-byte header,
+/// records of an end offset, a property count and a property-list length, 64-bit from version
+/// 7500 and 32-bit before, a name, the properties, then nested records). Best effort: what it
+/// cannot read it leaves to Assimp, returning what it found so far.
+std::vector<FbxConnection> binary_fbx_connections(const std::string& bytes) {
+  std::vector<FbxConnection> out;
+  if (bytes.size() < 27) return out;
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(k)]);
+    return v;
+  };
+  auto u64 = [&](std::size_t at) { return std::uint64_t{u32(at)} | std::uint64_t{u32(at + 4)} << 32; };
+  const bool wide = u32(23) >= 7500;
+  const std::size_t head = wide ? 25 : 13;  // end offset, property count and list length, name length
+  // A record at `at`: its end, property count, where its properties start and end, its name.
+  struct Record {
+    std::uint64_t end = 0, properties = 0;
+    std::size_t first = 0, after = 0;
+    std::string name;
+  };
+  auto record = [&](std::size_t at, Record& r) {
+    if (at + head > bytes.size()) return false;
+    r.end = wide ? u64(at) : u32(at);
+    r.properties = wide ? u64(at + 8) : u32(at + 4);
+    const std::uint64_t list = wide ? u64(at + 16) : u32(at + 8);
+    const std::size_t name_length = static_cast<unsigned char>(bytes[at + head - 1]);
+    r.first = at + head + name_length;
+    // Ends after it starts (so a walk always moves on), within the file, past its name and list.
+    if (r.end <= at || r.end > bytes.size() || r.first > r.end || list > r.end - r.first) return false;
+    r.after = r.first + static_cast<std::size_t>(list);
+    r.name.assign(bytes, at + head, name_length);
+    return true;
+  };
+  Record top;
+  for (std::size_t at = 27; record(at, top); at = static_cast<std::size_t>(top.end)) {
+    if (top.name != "Connections") continue;
+    Record c;
+    for (std::size_t child = top.after; child < top.end && record(child, c); child = static_cast<std::size_t>(c.end)) {
+      if (c.name != "C" || c.properties < 3) continue;
+      // The type ('S': a 32-bit length and the text), then the two ids ('L': 64-bit integers).
+      std::size_t p = c.first;
+      if (p + 5 > c.after || bytes[p] != 'S') continue;
+      p += 5 + u32(p + 1);
+      std::string ids[2];
+      for (std::string& id : ids) {
+        if (p + 9 > c.after || bytes[p] != 'L') break;
+        id = std::to_string(static_cast<std::int64_t>(u64(p + 1)));
+        p += 9;
+      }
+      if (!ids[0].empty() && !ids[1].empty()) out.push_back({ids[0], ids[1], child});
+    }
+    break;
+  }
+  return out;
+}
+
 /// What Assimp 5.2's FBX reader trusts and should not: in a text FBX, a mesh's `Layer:`
 /// element names its index as its first value, and the reader takes that value without
 /// checking there is one (it reads the first of an empty token list): a `Layer:` whose next
@@ -622,11 +724,17 @@ void check_collada(const fs::path& path) {
 /// parent`), recursively and without remembering where it has been, so a cycle among them (an
 /// object connected to itself, found by radiosity_fuzz_fbx in session 30, or to its own
 /// descendant) recurses until the stack overflows: a segmentation fault. A cycle is refused,
-/// with the line of one of its connections.
-/// Binary FBX files are not checked.
-void check_fbx_text(const fs::path& path) {
+/// with the line of one of its connections; in a binary FBX (whose other checks above do not
+/// apply) with the byte where that connection's record starts.
+void check_fbx(const fs::path& path) {
   const std::string text = read_file(path, "FBX file");
-  if (text.rfind("Kaydara FBX Binary", 0) == 0) return;
+  if (text.rfind("Kaydara FBX Binary", 0) == 0) {
+    const std::vector<FbxConnection> connections = binary_fbx_connections(text);
+    if (const FbxConnection* c = fbx_connection_cycle(connections))
+      throw Error(ErrorCode::parse_error, path.string() + ": at byte " + std::to_string(c->at) +
+                                              ": the connections form a cycle: " + fbx_cycle_text(*c));
+    return;
+  }
   auto name_char = [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '|';
   };
@@ -639,12 +747,7 @@ void check_fbx_text(const fs::path& path) {
   std::string last_key;
   std::string last_key_value;
   bool key_has_value = false;
-  // The connections, child -> parent, with where each was written.
-  struct Connection {
-    std::string child, parent;
-    std::size_t at = 0;
-  };
-  std::vector<Connection> connections;
+  std::vector<FbxConnection> connections;
   for (std::size_t at = 0; at < text.size(); ++at) {
     const char c = text[at];
     if (c == '"') {  // a string: skipped whole
@@ -725,36 +828,8 @@ void check_fbx_text(const fs::path& path) {
     at = end;
   }
 
-  // A cycle among the connections: follow each object's parents depth first, marking objects
-  // on the current walk (1) and those already cleared (2).
-  std::map<std::string, std::vector<std::size_t>> parents_of;  // child -> its connections
-  for (std::size_t k = 0; k < connections.size(); ++k) parents_of[connections[k].child].push_back(k);
-  std::map<std::string, int> state;
-  for (const auto& start : parents_of) {
-    if (state[start.first] != 0) continue;
-    // (object, index of the next of its connections to follow)
-    std::vector<std::pair<std::string, std::size_t>> walk = {{start.first, 0}};
-    state[start.first] = 1;
-    while (!walk.empty()) {
-      auto& [object, next] = walk.back();
-      const auto found = parents_of.find(object);
-      if (found == parents_of.end() || next == found->second.size()) {
-        state[object] = 2;
-        walk.pop_back();
-        continue;
-      }
-      const Connection& c = connections[found->second[next++]];
-      int& s = state[c.parent];
-      if (s == 1)
-        fail(c.at, "the connections form a cycle: object " + c.parent + " is its own " +
-                       (c.parent == c.child ? "parent" : "ancestor") +
-                       " (a scene graph has none; Assimp 5.2 follows one until its stack overflows)");
-      if (s == 0) {
-        s = 1;
-        walk.emplace_back(c.parent, 0);
-      }
-    }
-  }
+  if (const FbxConnection* c = fbx_connection_cycle(connections))
+    fail(c->at, "the connections form a cycle: " + fbx_cycle_text(*c));
 }
 
 glm::dmat4 to_glm(const aiMatrix4x4& m) {
@@ -1183,7 +1258,7 @@ Scene load_assimp(const fs::path& path, const LoadOptions& options) {
   if (lower_extension(path) == ".ply") check_ply(path);
   if (lower_extension(path) == ".dae") check_collada(path);
   if (lower_extension(path) == ".3ds") check_3ds_tracks(path);
-  if (lower_extension(path) == ".fbx") check_fbx_text(path);
+  if (lower_extension(path) == ".fbx") check_fbx(path);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
   if (!scene) throw Error(ErrorCode::parse_error, path.string() + ": " + importer.GetErrorString());

@@ -65,9 +65,9 @@ void check_image(const Image& image, const std::filesystem::path& path) {
 /// Huffman runs (at most 255 repeats of a 16-bit symbol per code) about 450 : 1, RLE 64 : 1
 /// (128 bytes in 2), B44 32 : 3 (a flat 4 x 4 block of halves); DWAA/DWAB compress each 8 x 8
 /// block's coefficients with run lengths and then zlib, so a flat image can reach some
-/// 30 000 : 1, and a compression this reader does not know gets the same.
-/// The compression as the file's byte gives it: an int, since a value outside Imf::Compression's
-/// enumerators is not an Imf::Compression (UBSan's invalid enum load; found by the fuzz target).
+/// 30 000 : 1, and a compression this reader does not know gets the same. It takes the
+/// compression as the file's byte gives it, an int: a value outside Imf::Compression's
+/// enumerators is no Imf::Compression (casting it is undefined; found by the fuzz target).
 double max_compression_ratio(int compression) {
   switch (compression) {
     case Imf::NO_COMPRESSION: return 1.0;
