@@ -8,6 +8,9 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <vector>
+
+#include <glm/geometric.hpp>
 
 #include "cli_mpi.hpp"
 #include "factors_format.hpp"
@@ -295,15 +298,36 @@ int run_factors(const FactorsArgs& a) {
       std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s%s, %.3f s%s%s\n", m.rows(),
                    level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), processes_text.c_str(), m.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
-      // Rows that see nothing: one-sided polygons whose fronts face away from everything.
-      std::size_t blind = 0;
-      for (std::size_t i = 0; i < m.rows(); ++i) blind += m.row_offsets[i + 1] == m.row_offsets[i] ? 1 : 0;
+      // Rows that see nothing: one-sided polygons whose fronts face away from everything, or
+      // (per polygon, told apart) polygons lying against another, in contact: a box's bottom on
+      // a floor, hidden as it should be.
+      std::size_t blind = 0, in_contact = 0;
+      std::vector<bool> touching;
+      if (level == "polygon") {
+        touching.assign(scene.polygons().size(), false);
+        for (const rad::PolygonOverlap& p : rad::find_overlaps(scene))
+          if (p.kind == rad::OverlapKind::coincident &&
+              glm::dot(scene.polygons()[p.first].normal, scene.polygons()[p.second].normal) < 0.0f)
+            touching[p.first] = touching[p.second] = true;
+      }
+      for (std::size_t i = 0; i < m.rows(); ++i) {
+        if (m.row_offsets[i + 1] != m.row_offsets[i]) continue;
+        if (!touching.empty() && touching[m.ids[i]])
+          ++in_contact;
+        else
+          ++blind;
+      }
       if (blind > 0)
         std::fprintf(stderr,
                      "warning: factors: %zu of %zu rows see no surface in front of them (polygons send and receive "
                      "on their fronts only: if the scene is closed, its polygons may face outward: --reverse-winding outward "
                      "turns them over)\n",
                      blind, m.rows());
+      if (in_contact > 0)
+        std::fprintf(stderr,
+                     "factors: %zu rows see nothing because their polygons lie against others, in contact (a box's "
+                     "bottom on a floor): hidden, as they should be\n",
+                     in_contact);
       const rad::ViewFactorCorrectionReport& c = m.correction;
       std::fprintf(stderr,
                    "factors: before correction: reciprocity error up to %.3g, row sums off by up to %.3g (rms %.3g)\n",
