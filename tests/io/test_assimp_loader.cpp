@@ -493,6 +493,74 @@ TEST_CASE("Assimp broken PLY: a list count its line or file cannot hold - header
                  "upper.ply:5: a PLY property of the type 'FLOAT', which is no PLY type"));
 }
 
+TEST_CASE("Assimp broken PLY: an ASCII body that Assimp would read past its lines' values - a last line without its line end") {
+  // Found by radiosity_fuzz_ply (session 30, 397 982 inputs into its long run): a 4-line body
+  // for 10 vertices and 8 faces. At the end of the file Assimp 5.2's line reader leaves its
+  // buffer as it was, so the last line, "444444444445 ...", was read again for every vertex and
+  // face still to come, and that number (modulo 2^32) as each face's list count: 16 GB and 94 s
+  // in `radiosity check`.
+  const Error found = load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "ply" / "body_shorter_than_counts.ply");
+  CHECK(found.code() == ErrorCode::parse_error);
+  CHECK(contains(found.what(), "body_shorter_than_counts.ply:11: the PLY body ends here, after 4 of the 10 'vertex' "
+                               "lines its header declares (a truncated file or a wrong count; the PLY reader, Assimp "
+                               "5.2, would read the last line again for each one missing)"));
+  // The square declaring a second face it does not have: Assimp made it a copy of the first
+  // (two coincident quads), silently.
+  std::string two = kPly;
+  two.replace(two.find("element face 1"), 14, "element face 2");
+  CHECK(contains(load_error(write("face_missing.ply", two)).what(),
+                 "face_missing.ply:15: the PLY body ends here, after 1 of the 2 'face' lines"));
+  // A vertex line short of a value: Assimp read z from what the longer lines before it (the
+  // header's) left in its buffer.
+  std::string short_vertex = kPly;
+  short_vertex.replace(short_vertex.find("\n1 0 0\n"), 7, "\n1 0\n");
+  CHECK(contains(load_error(write("short_vertex.ply", short_vertex)).what(),
+                 "short_vertex.ply:12: PLY element 'vertex' 1: its line holds 2 values, fewer than the element's "
+                 "properties ask for"));
+  // Values a parser would take part of, the rest read as the next value: an int item "2-1"
+  // (2, then -1), a uchar count "+4" (strtoul10 reads no digit: 0, then 4 as the first item).
+  std::string minus = kPly;
+  minus.replace(minus.find("4 0 1 2 3"), 9, "4 0 1 2-1 3");
+  CHECK(contains(load_error(write("item_minus.ply", minus)).what(),
+                 "item_minus.ply:15: PLY element 'face' 0: the value '2-1' is not a PLY int (the PLY reader, Assimp "
+                 "5.2, would read part of it and the rest as the next value)"));
+  std::string plus = kPly;
+  plus.replace(plus.find("4 0 1 2 3"), 9, "+4 0 1 2 3");
+  CHECK(contains(load_error(write("count_plus.ply", plus)).what(),
+                 "count_plus.ply:15: PLY element 'face' 0: the value '+4' is not a PLY uchar"));
+  // What exporters write still loads: signs, exponents, decimal commas and nan in a face's
+  // float property, a blank line (read as zeros) in an element after the faces, tabs.
+  std::string quality = kPly;
+  quality.replace(quality.find("property list"), 0, "property float quality\n");
+  quality.replace(quality.find("4 0 1 2 3"), 9, "-1.5e-3\t4 0 1 2 3");
+  CHECK(load(write("face_quality.ply", quality)).polygons().size() == 2);
+  for (const char* value : {"+2", "1,5", ".5", "7.", "NaN", "-inf", "1E+10"}) {
+    std::string q = quality;
+    q.replace(q.find("-1.5e-3"), 7, value);
+    INFO(value);
+    CHECK(load(write("face_quality_value.ply", q)).polygons().size() == 2);
+  }
+  for (const char* value : {"1.5x", "e5", "123456789012345678901"}) {
+    std::string q = quality;
+    q.replace(q.find("-1.5e-3"), 7, value);
+    INFO(value);
+    CHECK(contains(load_error(write("face_quality_bad.ply", q)).what(), "is not a PLY float"));
+  }
+
+  // A last line without its line end, after a longer one: Assimp 5.2 read "3 2 3 4" as
+  // "3 2 3 41" (the previous line's last digit), out of range here and silently another vertex
+  // where the index exists. The reader now gives Assimp the line end: both triangles, areas 5
+  // and 1.
+  std::string unended = "ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int i = 0; i < 12; ++i) unended += std::to_string(i) + " " + std::to_string(i % 2) + " 0\n";
+  unended += "3 0 1 11\n3 2 3 4";
+  const radiosity::Scene s = load(write("unended.ply", unended));
+  REQUIRE(s.polygons().size() == 2);
+  CHECK(s.polygons()[0].area + s.polygons()[1].area == doctest::Approx(6.0));
+  CHECK(std::min(s.polygons()[0].area, s.polygons()[1].area) == doctest::Approx(1.0));
+}
+
 TEST_CASE("Assimp broken FBX: a text FBX Layer element without its index is refused before Assimp reads it") {
   // Found by radiosity_fuzz_fbx (session 23, in the README's test command's 10 s run): the
   // exported room with one `Layer: 0 {` made `Layer:   {`. Assimp 5.2's FBX reader takes the

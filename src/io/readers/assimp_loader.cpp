@@ -17,6 +17,8 @@
 // its count) are refused before Assimp opens them. Other
 // corruptions of formats read by Assimp are in its hands: its parsers are not hardened the way
 // the glTF reader is.
+#include <assimp/DefaultIOSystem.h>
+#include <assimp/IOStream.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -75,7 +77,8 @@ std::size_t ply_type_size(const std::string& type) {
 /// `type` and whose items are of `item_size` bytes.
 struct PlyProperty {
   bool list = false;
-  std::string type;
+  std::string type;       ///< a scalar's type, or a list's count type
+  std::string item_type;  ///< a list's item type
   std::size_t size = 0;
   std::size_t item_size = 0;
 };
@@ -89,6 +92,62 @@ struct PlyElement {
 
 bool has_list(const PlyElement& e) {
   return std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.list; });
+}
+
+/// Whether Assimp 5.2 parses the values of an ASCII element (it skips the lines of an element
+/// whose name it does not know, or that has no properties).
+bool assimp_parses(const PlyElement& e) {
+  const bool known = e.name == "vertex" || e.name == "face" || e.name == "tristrips" || e.name == "edge" ||
+                     e.name == "material";
+  return known && !e.properties.empty();
+}
+
+/// Whether Assimp 5.2's ASCII PLY reader takes `token` whole as a value of `type`. It parses a
+/// value where it stands (strtoul10 for the unsigned types: digits only; strtol10 for the
+/// signed ones: a sign, then digits; fast_atoreal_move for float and double) and skips only
+/// spaces after it, so what a parser leaves of a token is where it parses the next value:
+/// "1-7" for an int and a list count after it is 1, then the count -7, 4 billion unsigned.
+/// A float's digit run of more than 19 digits overflows fast_atoreal_move's 64-bit integer,
+/// which then returns without moving: refused too.
+bool ply_value_whole(std::string_view t, const std::string& type) {
+  const auto digit = [&](std::size_t i) { return i < t.size() && t[i] >= '0' && t[i] <= '9'; };
+  // The digits from i; false when they would overflow 64 bits (leading zeros do not count).
+  const auto digits = [&](std::size_t& i) {
+    while (digit(i) && t[i] == '0') ++i;
+    const std::size_t start = i;
+    while (digit(i)) ++i;
+    return i - start <= 19;
+  };
+  std::size_t i = 0;
+  const bool is_unsigned = type == "uchar" || type == "uint8" || type == "ushort" || type == "uint16" || type == "uint" ||
+                           type == "uint32";
+  const bool is_signed = type == "char" || type == "int8" || type == "short" || type == "int16" || type == "int" ||
+                         type == "int32";
+  if (is_unsigned || is_signed) {
+    if (is_signed && !t.empty() && (t[0] == '+' || t[0] == '-')) ++i;
+    if (!digit(i)) return false;
+    while (digit(i)) ++i;
+    return i == t.size();
+  }
+  if (!t.empty() && (t[0] == '+' || t[0] == '-')) ++i;
+  std::string rest(t.substr(i));
+  for (char& c : rest) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (rest == "nan" || rest == "inf" || rest == "infinity") return true;
+  const auto point = [&](std::size_t at) { return at < t.size() && (t[at] == '.' || t[at] == ','); };
+  if (!digit(i) && !(point(i) && digit(i + 1))) return false;  // Assimp throws: its error
+  if (!digits(i)) return false;
+  if (point(i) && digit(i + 1)) {
+    ++i;
+    while (digit(i)) ++i;  // it reads 15 decimals and skips the rest
+  } else if (i < t.size() && t[i] == '.') {
+    ++i;
+  }
+  if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+    ++i;
+    if (i < t.size() && (t[i] == '+' || t[i] == '-')) ++i;
+    if (!digit(i) || !digits(i)) return false;
+  }
+  return i == t.size();
 }
 
 /// A PLY header as Assimp 5.2's reader takes it, or refused where it would take it otherwise
@@ -252,6 +311,7 @@ PlyHeader read_ply_header(const fs::path& path) {
         std::string item;
         words >> type >> item;
         property.list = true;
+        property.item_type = item;
         property.item_size = ply_type_size(item);
         if (property.item_size == 0) refuse("PLY list items of the type '" + item + "', which is no PLY type");
       }
@@ -300,9 +360,9 @@ PlyHeader read_ply_header(const fs::path& path) {
 ///   4444444444444444444444444444440 (radiosity_fuzz_ply, session 25) took 7.5 GB and 15 s from
 ///   a 219-byte file. An ASCII element is one line for Assimp, so a list's items must be on its
 ///   line (a NUL there ends the line for Assimp: refused too); in a binary file they must fit in
-///   the bytes left.
-void check_ply(const fs::path& path) {
-  const PlyHeader header = read_ply_header(path);
+///   the bytes left;
+/// - an ASCII body that makes it read other bytes than its lines' values (below).
+void check_ply(const fs::path& path, const PlyHeader& header) {
   std::error_code size_error;
   const std::uintmax_t size = fs::file_size(path, size_error);
   if (size_error) return;  // Assimp will say what is wrong
@@ -375,20 +435,44 @@ void check_ply(const fs::path& path) {
     }
     return;
   }
-  // ASCII: one line per element instance, values separated by spaces and tabs.
+  // ASCII: one line per element instance (PlyLines), its values separated by spaces and tabs.
+  // Assimp's line reader keeps one buffer for every line, written over from its start, and the
+  // PLY reader skips line ends as it skips spaces after a value; so it reads bytes that are not
+  // the line's values, left there by earlier (longer) lines, in three cases, each refused:
+  // - a body shorter than its counts: at the end of the file the line reader fails and leaves
+  //   the buffer as it was, and the last line is read again for every instance still to come
+  //   (a 205-byte file whose 4-line body ended in "444444444445 ..." declared 8 faces: that
+  //   number, modulo 2^32, became each face's list count, 16 GB; radiosity_fuzz_ply, session
+  //   30). A truncated file, or a wrong count: Assimp would make the missing vertices and faces
+  //   copies of the last line's;
+  // - a line with some values, but fewer than its element's properties ask for: the missing
+  //   ones would be read past its line end, in what the longer lines before it left there (a
+  //   line with no value at all is read as zeros, without going past it);
+  // - in an element with a list, a value its type's parser does not take whole
+  //   (ply_value_whole()): the rest would be read as the next value, a list count among them.
+  // An element Assimp does not parse (assimp_parses()) has its lines skipped, whatever they hold.
   PlyLines lines(in, header.body_line);
   std::string line;
-  std::size_t number = 0;
+  std::size_t number = header.body_line - 1;
   std::vector<std::string_view> values;
   for (const PlyElement& e : header.elements) {
+    if (!assimp_parses(e)) {
+      for (double k = 0.0; k < e.count; k += 1.0)
+        if (!lines.next(line, number)) return;
+      continue;
+    }
     const bool lists = has_list(e);
     for (double k = 0.0; k < e.count; k += 1.0) {
-      if (!lines.next(line, number)) return;  // a short body is Assimp's to report
-      if (!lists) continue;
+      if (!lines.next(line, number))
+        throw Error(ErrorCode::parse_error,
+                    path.string() + ":" + std::to_string(number) + ": the PLY body ends here, after " + whole(k) + " of the " +
+                        whole(e.count) + " '" + e.name + "' lines its header declares (a truncated file or a wrong count; "
+                        "the PLY reader, Assimp 5.2, would read the last line again for each one missing)");
       const std::string where = path.string() + ":" + std::to_string(number) + ": PLY element '" + e.name + "' " + whole(k) + ": ";
-      if (const std::size_t at = control_byte(line); at != std::string::npos)
-        throw Error(ErrorCode::parse_error, where + "a control byte (column " + std::to_string(at + 1) +
-                                                ") in ASCII data (a corrupted or binary file)");
+      if (lists)
+        if (const std::size_t at = control_byte(line); at != std::string::npos)
+          throw Error(ErrorCode::parse_error, where + "a control byte (column " + std::to_string(at + 1) +
+                                                  ") in ASCII data (a corrupted or binary file)");
       values.clear();
       for (std::size_t i = 0; i < line.size();) {
         while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
@@ -396,10 +480,22 @@ void check_ply(const fs::path& path) {
         while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
         if (i > start) values.emplace_back(line.data() + start, i - start);
       }
+      if (values.empty()) continue;  // read as zeros
+      const auto short_line = [&] {
+        return Error(ErrorCode::parse_error, where + "its line holds " + std::to_string(values.size()) +
+                                                 " values, fewer than the element's properties ask for (a corrupted file; "
+                                                 "the PLY reader, Assimp 5.2, would read the missing ones from the lines before it)");
+      };
+      const auto not_whole = [&](std::string_view value, const std::string& type) {
+        return Error(ErrorCode::parse_error, where + "the value '" + std::string(value.substr(0, 40)) + "' is not a PLY " + type +
+                                                 " (the PLY reader, Assimp 5.2, would read part of it and the rest as the "
+                                                 "next value)");
+      };
       std::size_t v = 0;
       for (const PlyProperty& p : e.properties) {
-        if (v >= values.size()) break;  // a short line is Assimp's to read (as zeros)
+        if (v >= values.size()) throw short_line();
         if (!p.list) {
+          if (lists && !ply_value_whole(values[v], p.type)) throw not_whole(values[v], p.type);
           ++v;
           continue;
         }
@@ -409,11 +505,13 @@ void check_ply(const fs::path& path) {
         if (*end != '\0' || !(count >= 0.0) || count != std::floor(count))
           throw Error(ErrorCode::parse_error, where + "the list count '" + count_text.substr(0, 40) +
                                                   "' is not a number of items");
+        if (!ply_value_whole(count_text, p.type)) throw not_whole(count_text, p.type);
         const double left = static_cast<double>(values.size() - v);
         if (count > left)
           throw Error(ErrorCode::parse_error, where + "a list of " + whole(count) + " items, but its line holds " +
                                                   whole(left) + " values after the count (a corrupted file or a wrong count)");
-        v += static_cast<std::size_t>(count);
+        for (std::size_t item = 0; item < static_cast<std::size_t>(count); ++item, ++v)
+          if (!ply_value_whole(values[v], p.item_type)) throw not_whole(values[v], p.item_type);
       }
     }
   }
@@ -1250,16 +1348,86 @@ std::string assimp_extensions() {
   return out;
 }
 
+/// A file read with a line end after its last byte, for an ASCII PLY file that has none.
+/// Assimp 5.2's line reader (IOStreamBuffer::getNextLine) returns at the end of the file
+/// before it ends the line in its buffer, and that buffer still holds what longer lines before
+/// left there: the PLY reader reads the last line on into them ("3 0 1 2" after "3 1 2 345" is
+/// read as "3 0 1 245", and a count "3" after "34444444444 ..." as 34444444444, modulo 2^32).
+class LineEndedStream : public Assimp::IOStream {
+ public:
+  explicit LineEndedStream(Assimp::IOStream* file) : file_(file), size_(file->FileSize() + 1) {}
+  ~LineEndedStream() override { delete file_; }
+  LineEndedStream(const LineEndedStream&) = delete;
+  LineEndedStream& operator=(const LineEndedStream&) = delete;
+
+  size_t Read(void* buffer, size_t size, size_t count) override {
+    if (size == 0 || count == 0) return 0;
+    char* out = static_cast<char*>(buffer);
+    const size_t wanted = size * count;
+    size_t got = 0;
+    if (at_ + 1 < size_) {
+      if (file_->Seek(at_, aiOrigin_SET) != aiReturn_SUCCESS) return 0;
+      got = file_->Read(out, 1, std::min(wanted, size_ - 1 - at_));
+      at_ += got;
+    }
+    if (got < wanted && at_ + 1 == size_) {
+      out[got++] = '\n';
+      ++at_;
+    }
+    return got / size;
+  }
+  size_t Write(const void*, size_t, size_t) override { return 0; }
+  aiReturn Seek(size_t offset, aiOrigin origin) override {
+    const size_t base = origin == aiOrigin_CUR ? at_ : origin == aiOrigin_END ? size_ : 0;
+    if (origin == aiOrigin_END ? offset > size_ : offset > size_ - base) return aiReturn_FAILURE;
+    at_ = origin == aiOrigin_END ? size_ - offset : base + offset;
+    return aiReturn_SUCCESS;
+  }
+  size_t Tell() const override { return at_; }
+  size_t FileSize() const override { return size_; }
+  void Flush() override {}
+
+ private:
+  Assimp::IOStream* file_;  // owned
+  size_t size_;             // the file's bytes and the line end
+  size_t at_ = 0;
+};
+
+/// The files Assimp opens, each with a line end after its last byte (LineEndedStream).
+class LineEndedFiles : public Assimp::DefaultIOSystem {
+ public:
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    Assimp::IOStream* stream = DefaultIOSystem::Open(file, mode);
+    return stream ? new LineEndedStream(stream) : nullptr;
+  }
+  void Close(Assimp::IOStream* stream) override { delete stream; }
+};
+
+/// Whether a file's last byte is something else than a line end ('\r' or '\n').
+bool ends_unended(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  if (!file || file.tellg() <= 0) return false;
+  file.seekg(-1, std::ios::end);
+  const int last = file.get();
+  return last != '\n' && last != '\r';
+}
+
 Scene load_assimp(const fs::path& path, const LoadOptions& options) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
     throw Error(ErrorCode::file_not_found, "load_scene: cannot open model file '" + path.string() +
                                                (fs::exists(path, ec) ? "': not a regular file" : "': no such file"));
-  if (lower_extension(path) == ".ply") check_ply(path);
+  bool add_line_end = false;
+  if (lower_extension(path) == ".ply") {
+    const PlyHeader header = read_ply_header(path);
+    check_ply(path, header);
+    add_line_end = !header.binary && ends_unended(path);
+  }
   if (lower_extension(path) == ".dae") check_collada(path);
   if (lower_extension(path) == ".3ds") check_3ds_tracks(path);
   if (lower_extension(path) == ".fbx") check_fbx(path);
   Assimp::Importer importer;
+  if (add_line_end) importer.SetIOHandler(new LineEndedFiles);  // the importer owns it
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
   if (!scene) throw Error(ErrorCode::parse_error, path.string() + ": " + importer.GetErrorString());
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
