@@ -355,7 +355,8 @@ PlyHeader read_ply_header(const fs::path& path) {
 ///   data shifted (vertices and faces from the wrong values);
 /// - it allocates what the element counts ask for before reading them (a count of four
 ///   billion in a 1 kB file is tens of GB): each element needs at least its fixed-size
-///   properties in a binary file, two characters per property in an ASCII one (but the last);
+///   properties in a binary file, two characters per property in an ASCII one (but the last),
+///   and one byte when it has no properties;
 /// - it reserves a list's count before reading its items: an ASCII face whose count was
 ///   4444444444444444444444444444440 (radiosity_fuzz_ply, session 25) took 7.5 GB and 15 s from
 ///   a 219-byte file. An ASCII element is one line for Assimp, so a list's items must be on its
@@ -371,6 +372,11 @@ void check_ply(const fs::path& path, const PlyHeader& header) {
   for (const PlyElement& e : header.elements) {
     double per = 0.0;
     for (const PlyProperty& p : e.properties) per += header.binary ? static_cast<double>(p.size) : 2.0;
+    // An element without properties is still read instance by instance, a line each in an
+    // ASCII file: a count of billions is minutes of Assimp skipping lines the file does not
+    // have (a face element of 48888888888888888888888888888888, radiosity_fuzz_ply, session 31:
+    // a hang, or a segmentation fault when those lines were carriage returns). A byte each.
+    if (e.properties.empty()) per = 1.0;
     needed += e.count * per;
   }
   if (!header.binary && needed > 0.0) needed -= 1.0;  // the last value may end the file without a separator
