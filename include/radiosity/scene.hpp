@@ -456,6 +456,10 @@ struct OutwardFacing {
 /// (a fixed seed). Cost: a BVH over the scene, 32 rays per one-sided polygon, and find_overlaps(). Throws Error{internal} if Embree cannot create a
 /// device. Thread safety: concurrent calls are safe.
 RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene);
+/// The same, with find_overlaps(scene)'s result that the caller already has (it is most of the
+/// cost for a large scene: 0.5 s at 246k polygons). Throws Error{invalid_argument} when an
+/// overlap names a polygon the scene does not have.
+RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene, const std::vector<PolygonOverlap>& overlaps);
 
 /// Adds the parallelogram origin, origin + edge_u, origin + edge_u + edge_v, origin + edge_v,
 /// facing edge_u x edge_v (counter-clockwise seen from that side). Units are scene units.

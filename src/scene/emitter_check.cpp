@@ -205,6 +205,10 @@ namespace radiosity {
 inline namespace v1 {
 
 OutwardFacing find_polygons_facing_outward(const Scene& scene) {
+  return find_polygons_facing_outward(scene, find_overlaps(scene));
+}
+
+OutwardFacing find_polygons_facing_outward(const Scene& scene, const std::vector<PolygonOverlap>& overlaps) {
   constexpr std::size_t kSide = 4, kRays = kSide * kSide;
   const std::vector<Polygon>& polygons = scene.polygons();
   OutwardFacing out;
@@ -236,9 +240,13 @@ OutwardFacing find_polygons_facing_outward(const Scene& scene) {
   // leave every coincident pair facing opposite ways (in contact) rather than the same way
   // (z-fighting): of a pair that faces the same way, one is turned (the larger when both were
   // found: the room's floor, not the box standing on it); of a pair in contact, both or none.
-  for (const PolygonOverlap& o : find_overlaps(scene)) {
+  for (const PolygonOverlap& o : overlaps) {
     if (o.kind != OverlapKind::coincident) continue;
     const PolygonId a = o.first, b = o.second;
+    if (a >= polygons.size() || b >= polygons.size())
+      throw Error(ErrorCode::invalid_argument, "find_polygons_facing_outward: an overlap names polygon " +
+                                                   std::to_string(std::max(a, b)) + " of a scene of " +
+                                                   std::to_string(polygons.size()) + " (overlaps of another scene?)");
     if (glm::dot(polygons[a].normal, polygons[b].normal) > 0.0f) {
       if (outward[a] && outward[b]) (polygons[a].area >= polygons[b].area ? outward[b] : outward[a]) = 0;
     } else if (outward[a] != outward[b]) {

@@ -109,6 +109,16 @@ TEST_SUITE("io") {
     // under the floor), but the pair must end in contact, not z-fighting.
     const rad::OutwardFacing found = rad::find_polygons_facing_outward(scene);
     CHECK(found.polygons == std::vector<rad::PolygonId>{0, 1, 2, 3, 4, 5});
+    // The same from the overlaps the caller has (radiosity check), and without them the box's
+    // bottom is turned with the floor (z-fighting): so they are used. Overlaps naming a
+    // polygon beyond the scene are refused.
+    const std::vector<rad::PolygonOverlap> overlaps = rad::find_overlaps(scene);
+    CHECK(rad::find_polygons_facing_outward(scene, overlaps).polygons == found.polygons);
+    CHECK(rad::find_polygons_facing_outward(scene, {}).polygons == std::vector<rad::PolygonId>{0, 1, 2, 3, 4, 5, 9});
+    std::vector<rad::PolygonOverlap> foreign = overlaps;
+    REQUIRE(!foreign.empty());
+    foreign[0].second = 1000;
+    CHECK_THROWS_AS(rad::find_polygons_facing_outward(scene, foreign), rad::Error);
     scene.reverse_winding(found.polygons);
     CHECK(rad::find_polygons_facing_outward(scene).polygons.empty());
     for (const rad::PolygonOverlap& o : rad::find_overlaps(scene))

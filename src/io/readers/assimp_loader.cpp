@@ -533,11 +533,9 @@ void check_ply(const fs::path& path, const PlyHeader& header) {
 /// that hold tracks are walked (the main chunk, the keyframer, its object nodes).
 void check_3ds_tracks(const fs::path& path) {
   const std::string bytes = read_file(path, "3DS file");
-  auto u16 = [&](std::size_t at) {
-    return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at])) |
-           static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 1])) << 8;
-  };
-  auto u32 = [&](std::size_t at) { return u16(at) | u16(at + 2) << 16; };
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  auto u16 = [&](std::size_t at) { return std::uint32_t{le16(data + at)}; };
+  auto u32 = [&](std::size_t at) { return le32(data + at); };
   // A track: the chunk header (id, length), 2 bytes of flags, 8 unknown, then the key count.
   constexpr std::size_t kHeader = 6, kTrackHead = 16, kMinKey = 6;
   auto walk = [&](auto&& self, std::size_t begin, std::size_t end, int depth) -> void {
@@ -756,12 +754,9 @@ std::string fbx_cycle_text(const FbxConnection& c) {
 std::vector<FbxConnection> binary_fbx_connections(const std::string& bytes) {
   std::vector<FbxConnection> out;
   if (bytes.size() < 27) return out;
-  auto u32 = [&](std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(k)]);
-    return v;
-  };
-  auto u64 = [&](std::size_t at) { return std::uint64_t{u32(at)} | std::uint64_t{u32(at + 4)} << 32; };
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  auto u32 = [&](std::size_t at) { return le32(data + at); };
+  auto u64 = [&](std::size_t at) { return le64(data + at); };
   const bool wide = u32(23) >= 7500;
   const std::size_t head = wide ? 25 : 13;  // end offset, property count and list length, name length
   // A record at `at`: its end, property count, where its properties start and end, its name.

@@ -23,10 +23,6 @@
 
 namespace radiosity::detail {
 
-inline std::uint32_t le32(const unsigned char* p) {
-  return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
-}
-
 inline bool is_data_uri(std::string_view uri) { return uri.compare(0, 5, "data:") == 0; }
 
 /// Where `count` elements of `size` bytes, `stride` apart, starting at `offset`, fit in `length`

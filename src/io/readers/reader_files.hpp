@@ -3,11 +3,20 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
 
 namespace radiosity::detail {
+
+/// Little-endian integers from a binary file's bytes (GLB, 3DS, binary FBX), whatever the host's
+/// byte order. The caller checks that the bytes are there.
+inline std::uint16_t le16(const unsigned char* p) { return static_cast<std::uint16_t>(p[0] | p[1] << 8); }
+inline std::uint32_t le32(const unsigned char* p) {
+  return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
+}
+inline std::uint64_t le64(const unsigned char* p) { return std::uint64_t{le32(p)} | std::uint64_t{le32(p + 4)} << 32; }
 
 /// The bytes of the file at `path`. Throws Error{file_not_found} "load_scene: cannot open
 /// <what> '<path>': no such file" (or ": not a regular file"), or "cannot read" when reading
