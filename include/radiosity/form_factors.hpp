@@ -89,6 +89,12 @@ struct FormFactorOptions {
   /// specular parts are ignored and every polygon is opaque. Glossy lobes are not carried. In
   /// [0, 16].
   std::uint32_t specular_depth = 0;
+  /// With specular_depth > 0: also carry the light that emitting polygons send through
+  /// refracting glass (straight on, weighted as above), which is otherwise left to the second
+  /// pass's photon map. Off for render_two_pass(), whose caustics would count it twice; on where
+  /// no photon pass follows (`radiosity solve` and `bake` set it): without it that light is
+  /// lost, and reported as escaped (a glass pane in a closed room: 20 % of the lamp's power).
+  bool emitted_through_glass = false;
   /// Back sides: diffuse transmission (Rushmeier & Torrance 1990) and two-sided surfaces, for
   /// every method. A patch whose material has diffuse_transmittance > 0 (a translucent thin
   /// sheet) or is two_sided (a single sheet that reflects on both sides: a partition wall, a

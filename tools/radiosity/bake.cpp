@@ -175,11 +175,14 @@ int run_bake(const BakeArgs& a) {
                     scene.meshes().size(), a.make_uvs ? "--make-uvs" : "the others have no UV1", uo.padding);
     }
 
-    const rad::SolveOptions options = to_options(a.solve, bar);
-    const rad::Solution sol = rad::solve(scene, options);
+    rad::SolveOptions options = to_options(a.solve, bar);
+    const rad::SolveOptions plain = options;
+    const std::string extended = extend_first_pass_alone(scene, options, a.solve);
+    const rad::Solution sol = solve_extended(scene, options, plain, extended,
+                                             [](const rad::Scene& s, const rad::SolveOptions& o) { return rad::solve(s, o); });
     bar.finish();
     print_summary(sol);
-    print_estimator(sol, options);
+    print_estimator(sol, options, extended);
     print_solve_warnings(scene, sol);
 
     // `-o lit.glb`: one glTF file with the light baked in, instead of a folder.

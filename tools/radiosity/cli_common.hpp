@@ -184,6 +184,7 @@ struct SolveArgs {
   float max_element_area = 0.0f;
   double tolerance = 1e-3;
   unsigned threads = 0;
+  unsigned memory_budget_mib = 0;  ///< `--memory-budget`, MiB; 0 = the library's default
   std::uint64_t seed = 1;
   int max_iterations = 0;
   bool adaptive = false;
@@ -195,6 +196,10 @@ struct SolveArgs {
   bool two_sided = false;
   std::string reverse_winding;  ///< `--reverse-winding`: "", "all" or "outward"
   bool light_groups = false;
+  // Whether the user gave these (extend_first_pass() chooses them otherwise); set by add_solve_options().
+  const CLI::Option* method_option = nullptr;
+  const CLI::Option* form_factors_option = nullptr;
+  const CLI::Option* specular_depth_option = nullptr;
 };
 
 /// The estimator a `--form-factors` / `--method` name (as the CLI spells it) selects.
@@ -281,13 +286,13 @@ inline void add_reverse_winding_option(CLI::App& cmd, std::string& reverse_windi
 inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = false) {
   std::vector<std::string> methods = {"auto", "jacobi", "gauss-seidel", "progressive", "hierarchical"};
   if (with_path) methods.push_back("path");
-  cmd.add_option("--method", a.method,
+  a.method_option = cmd.add_option("--method", a.method,
                  std::string("Solver (auto: gauss-seidel while its form-factor rows fit the 4 GiB memory budget, else "
                              "hierarchical)") +
                      (with_path ? ", or path for the reference path tracer" : ""))
       ->check(CLI::IsMember(methods))
       ->capture_default_str();
-  cmd.add_option("--form-factors", a.form_factors,
+  a.form_factors_option = cmd.add_option("--form-factors", a.form_factors,
                  with_path ? "Form-factor estimator (two-pass mode on a scene with mirrors or glass: monte-carlo)"
                            : "Form-factor estimator")
       ->check(CLI::IsMember(form_factor_names()))
@@ -295,12 +300,14 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   cmd.add_option("--hemisphere-rays", a.hemisphere_rays, "Monte Carlo estimator: rays per element, 16..1048576")
       ->check(in_range<unsigned>(16u, 1u << 20))
       ->capture_default_str();
-  cmd.add_option("--specular-depth", a.specular_depth,
-                 std::string("Monte Carlo estimator: mirror reflections and window passages carried between "
-                             "diffuse surfaces (extended form factors), 0..16") +
-                     (with_path ? " (two-pass mode on a scene with mirrors or glass: 1 with monte-carlo)" : ""))
-      ->check(in_range<unsigned>(0u, 16u))
-      ->capture_default_str();
+  a.specular_depth_option =
+      cmd.add_option("--specular-depth", a.specular_depth,
+                     std::string("Monte Carlo estimator: mirror reflections and window passages carried between "
+                                 "diffuse surfaces (extended form factors), 0..16; by default 1 with monte-carlo ") +
+                         (with_path ? "in two-pass mode " : "") +
+                         "on a scene with mirror or glass materials (unless --form-factors or --method hierarchical "
+                         "is given, or the rows would exceed the memory budget), else 0")
+          ->check(in_range<unsigned>(0u, 16u));
   cmd.add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(non_negative<float>());
   cmd.add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
@@ -323,6 +330,10 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
       ->check(in_range<float>(1e-6f, 1.0f))
       ->capture_default_str();
   cmd.add_option("--threads", a.threads, "Worker threads (0 = all cores)")->check(any_number<unsigned>());
+  cmd.add_option("--memory-budget", a.memory_budget_mib,
+                 "The most memory the form factors may take, MiB (0 = 4096): beyond it a matrix method is refused "
+                 "with the figure before it starts, and --method auto takes hierarchical")
+      ->check(in_range<unsigned>(0u, 1u << 24));
   cmd.add_option("--seed", a.seed, "Random seed (results are identical for a seed at any thread count)")
       ->check(any_number<std::uint64_t>())
       ->capture_default_str();
@@ -336,6 +347,57 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
                "Make every material two-sided (reflect and emit on both sides, each with its own radiosity): for "
                "models whose polygons face inconsistently or outwards");
   add_reverse_winding_option(cmd, a.reverse_winding);
+}
+
+/// The extended first pass where the scene has mirror or glass materials
+/// (rad::prepare_two_pass(): Monte Carlo form factors carrying mirror reflections and window
+/// passages between diffuse surfaces), unless the user chose otherwise: a --specular-depth, a
+/// --form-factors other than monte-carlo, or --method hierarchical (whose links carry none).
+/// Without it the light that reaches a mirror or a pane stops there: a room's glass pane took a
+/// quarter of its lamp's power (`solve`, session 31). A --specular-depth above 0 without
+/// --form-factors selects the Monte Carlo estimator (the only one that carries it). Returns why
+/// `options` was extended, or "" when it was not.
+inline std::string extend_first_pass(const rad::Scene& scene, rad::SolveOptions& options, const SolveArgs& a) {
+  auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };
+  if (given(a.specular_depth_option)) {
+    if (a.specular_depth > 0 && !given(a.form_factors_option))
+      options.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    return "";
+  }
+  if (!rad::needs_extended_first_pass(scene)) return "";
+  if (given(a.form_factors_option) && options.form_factors.method != rad::FormFactorMethod::monte_carlo) return "";
+  if (given(a.method_option) && options.method == rad::SolverMethod::hierarchical) return "";
+  rad::prepare_two_pass(scene, options);
+  return "the scene has mirror or glass materials";
+}
+
+/// For a solve that no photon pass follows (solve, bake): the extended first pass carries the
+/// emitters' light through glass too (FormFactorOptions::emitted_through_glass).
+inline std::string extend_first_pass_alone(const rad::Scene& scene, rad::SolveOptions& options, const SolveArgs& a) {
+  std::string why = extend_first_pass(scene, options, a);
+  if (options.form_factors.specular_depth > 0) options.form_factors.emitted_through_glass = true;
+  return why;
+}
+
+/// solve() with the extended first pass that extend_first_pass() chose, or, when its rows would
+/// exceed the memory budget and the method is automatic (which then takes hierarchical, whose
+/// links carry no mirror paths), without it, said on stdout. `run` is the solve (rad::solve, or
+/// its MPI form).
+inline rad::Solution solve_extended(const rad::Scene& scene, rad::SolveOptions& options, const rad::SolveOptions& plain,
+                                    const std::string& extended,
+                                    const std::function<rad::Solution(const rad::Scene&, const rad::SolveOptions&)>& run) {
+  if (extended.empty()) return run(scene, options);
+  try {
+    return run(scene, options);
+  } catch (const rad::Error& e) {
+    if (e.code() != rad::ErrorCode::memory_budget || plain.method != rad::SolverMethod::automatic) throw;
+    std::printf("specular depth: 0 after all: the extended first pass's rows exceed the memory budget (%s); light "
+                "reaching mirrors and glass stops there\n",
+                e.what());
+    std::fflush(stdout);
+    options = plain;
+    return run(scene, options);
+  }
 }
 
 inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
@@ -353,6 +415,7 @@ inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
   o.tolerance = a.tolerance;
   o.max_iterations = a.max_iterations;
   o.threads = a.threads;
+  o.memory_budget_bytes = std::size_t{a.memory_budget_mib} << 20;
   o.seed = a.seed;
   o.adaptive.enabled = a.adaptive;
   o.adaptive.threshold = a.adaptive_threshold;
@@ -458,14 +521,21 @@ inline void print_summary(const rad::Solution& sol) {
     std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
 }
 
-/// Says which estimator ran, and why when the choice was automatic.
-inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
+/// Says which estimator ran, and why when the choice was automatic (`extended`: why
+/// extend_first_pass() chose the extended first pass, or "").
+inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options, const std::string& extended = "") {
   const rad::SolveReport& r = sol.report();
   if (!r.method_choice.empty())
     std::printf("method: %s (automatic: %s; --method overrides)\n",
                 r.method == rad::SolverMethod::hierarchical ? "hierarchical" : "gauss-seidel", r.method_choice.c_str());
   if (!r.estimator_ran()) {
     std::printf("form factors: links of the hierarchy (point-to-polygon and cluster transport, shadow rays)\n");
+    return;
+  }
+  if (!extended.empty() && r.specular_depth > 0) {
+    std::printf("form factors: %s, specular depth %u (automatic: %s, whose light it carries between diffuse "
+                "surfaces; --specular-depth 0 turns it off)\n",
+                rad::to_string(r.form_factor_method), static_cast<unsigned>(r.specular_depth), extended.c_str());
     return;
   }
   if (options.form_factors.method != rad::FormFactorMethod::automatic) {
