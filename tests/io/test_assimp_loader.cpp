@@ -51,6 +51,13 @@ const char* const kPly =
     "ply\nformat ascii 1.0\ncomment a unit square\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
 
+/// kPly with its first `from` replaced by `to`.
+std::string ply_with(const std::string& from, const std::string& to) {
+  std::string s = kPly;
+  s.replace(s.find(from), from.size(), to);
+  return s;
+}
+
 std::string binary_ply() {
   std::string s =
       "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
@@ -513,33 +520,24 @@ TEST_CASE("Assimp broken PLY: an ASCII body that Assimp would read past its line
                               "least 4.88889e+31 bytes, but the file holds 194 after its header"));
   // The square declaring a second face it does not have: Assimp made it a copy of the first
   // (two coincident quads), silently.
-  std::string two = kPly;
-  two.replace(two.find("element face 1"), 14, "element face 2");
-  CHECK(contains(load_error(write("face_missing.ply", two)).what(),
+  CHECK(contains(load_error(write("face_missing.ply", ply_with("element face 1", "element face 2"))).what(),
                  "face_missing.ply:15: the PLY body ends here, after 1 of the 2 'face' lines"));
   // A vertex line short of a value: Assimp read z from what the longer lines before it (the
   // header's) left in its buffer.
-  std::string short_vertex = kPly;
-  short_vertex.replace(short_vertex.find("\n1 0 0\n"), 7, "\n1 0\n");
-  CHECK(contains(load_error(write("short_vertex.ply", short_vertex)).what(),
+  CHECK(contains(load_error(write("short_vertex.ply", ply_with("\n1 0 0\n", "\n1 0\n"))).what(),
                  "short_vertex.ply:12: PLY element 'vertex' 1: its line holds 2 values, fewer than the element's "
                  "properties ask for"));
   // Values a parser would take part of, the rest read as the next value: an int item "2-1"
   // (2, then -1), a uchar count "+4" (strtoul10 reads no digit: 0, then 4 as the first item).
-  std::string minus = kPly;
-  minus.replace(minus.find("4 0 1 2 3"), 9, "4 0 1 2-1 3");
-  CHECK(contains(load_error(write("item_minus.ply", minus)).what(),
+  CHECK(contains(load_error(write("item_minus.ply", ply_with("4 0 1 2 3", "4 0 1 2-1 3"))).what(),
                  "item_minus.ply:15: PLY element 'face' 0: the value '2-1' is not a PLY int (the PLY reader, Assimp "
                  "5.2, would read part of it and the rest as the next value)"));
-  std::string plus = kPly;
-  plus.replace(plus.find("4 0 1 2 3"), 9, "+4 0 1 2 3");
-  CHECK(contains(load_error(write("count_plus.ply", plus)).what(),
+  CHECK(contains(load_error(write("count_plus.ply", ply_with("4 0 1 2 3", "+4 0 1 2 3"))).what(),
                  "count_plus.ply:15: PLY element 'face' 0: the value '+4' is not a PLY uchar"));
-  // What exporters write still loads: signs, exponents, decimal commas and nan in a face's
-  // float property, a blank line (read as zeros) in an element after the faces, tabs.
-  std::string quality = kPly;
+  // What exporters write still loads: signs, exponents, decimal commas, nan and inf in a
+  // face's float property, a tab between values.
+  std::string quality = ply_with("4 0 1 2 3", "-1.5e-3\t4 0 1 2 3");
   quality.replace(quality.find("property list"), 0, "property float quality\n");
-  quality.replace(quality.find("4 0 1 2 3"), 9, "-1.5e-3\t4 0 1 2 3");
   CHECK(load(write("face_quality.ply", quality)).polygons().size() == 2);
   for (const char* value : {"+2", "1,5", ".5", "7.", "NaN", "-inf", "1E+10"}) {
     std::string q = quality;
