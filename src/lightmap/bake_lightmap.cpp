@@ -20,6 +20,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <optional>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -259,6 +260,12 @@ class FinalGather {
     const detail::EmitterWeights weights =
         detail::emitter_weights(scene, solution, options.light_group, "bake_lightmap");
     lights_ = detail::SceneLights(scene.lights(), &weights.light);
+    // The delta lights through windows and glass, as pass 1 took them (the extended pass).
+    // Gather rays still stop at a pane: the sky and the radiosity beyond it are not gathered.
+    if (solution.report().specular_depth > 0) {
+      detail::PassThrough through(scene, true, h_);
+      if (through.any()) through_ = std::move(through);
+    }
     if (options.light_group < 0) {
       front_ = solution.vertex_radiosity();
       back_ = solution.vertex_back_radiosity();
@@ -288,7 +295,8 @@ class FinalGather {
     Light out;
     const std::vector<PolygonId> exact = direct_exact(x, n, texel, out.direct);
     // Point, spot and directional lights (Scene::lights()) exactly, a shadow ray each.
-    if (!lights_.delta().empty()) out.direct += detail::delta_irradiance_at(lights_, leaves_, x, n, epsilon_);
+    if (!lights_.delta().empty())
+      out.direct += detail::delta_irradiance_at(lights_, leaves_, x, n, epsilon_, through_ ? &*through_ : nullptr);
 
     // Hemisphere rays, cosine-distributed: H = pi * mean(L) = mean(B) over the hits.
     const auto rays = static_cast<std::uint32_t>(options_.gather_rays);
@@ -381,6 +389,7 @@ class FinalGather {
   const Scene& scene_;
   const PatchHierarchy& h_;
   const detail::RayScene& leaves_;
+  std::optional<detail::PassThrough> through_;
   const LightmapOptions& options_;
   float epsilon_;
   std::vector<Rgb> front_, back_;  ///< pass 1's radiosity per hierarchy vertex

@@ -138,6 +138,7 @@ class PathTracer {
         camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
         rays_(detail::RayScene::from_polygons(scene)),
         lights_(scene.lights()),
+        through_(scene, false),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
     // Each material's model is built once here; the render only reads it.
     for (const Material& m : scene.materials()) shading_.push_back(make_shading(m));
@@ -549,7 +550,7 @@ class PathTracer {
       detail::Incidence in;
       if (!detail::incidence(l, x, in)) continue;
       const float cos_x = glm::dot(n, in.wi);
-      if (cos_x > 0.0f && detail::unoccluded(rays_, offset_origin, l.position, in)) E += in.irradiance * cos_x;
+      if (cos_x > 0.0f) E += in.irradiance * cos_x * detail::light_transmittance(rays_, through(), offset_origin, l.position, in, epsilon_);
     }
     return E;
   }
@@ -565,7 +566,8 @@ class PathTracer {
       float pdf = 0.0f, cos_x = 0.0f;
       const Rgb f = bsdf(in.wi, pdf, cos_x);
       if (!(max_component(f) > 0.0f)) continue;
-      if (detail::unoccluded(rays_, offset_towards(x, normal, in.wi), l.position, in)) out += f * in.irradiance * cos_x;
+      out += f * in.irradiance * cos_x *
+             detail::light_transmittance(rays_, through(), offset_towards(x, normal, in.wi), l.position, in, epsilon_);
     }
     return out;
   }
@@ -622,6 +624,12 @@ class PathTracer {
   detail::PinholeCamera camera_;
   detail::RayScene rays_;
   detail::SceneLights lights_;  ///< Scene::lights(): delta lights sampled at every vertex, the sky seen by escaping rays
+  /// The delta lights' shadow rays pass windows (ior 1: straight through, times their
+  /// transmittance, which is what the window's own model does to a ray), so a lamp or the sun
+  /// behind a pane is found; glass is left as the refracting interface it is (a delta light
+  /// beyond it has no sampling strategy).
+  detail::PassThrough through_;
+  const detail::PassThrough* through() const { return through_.any() ? &through_ : nullptr; }
   int g_;
   float epsilon_ = 0.0f;
   std::vector<Surface> surfaces_;

@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
 #include "core/assert.hpp"
+#include "core/color.hpp"
+#include "radiosity/brdf.hpp"
 #include "core/constants.hpp"
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
@@ -110,6 +113,64 @@ bool incidence(const PreparedLight& light, const glm::vec3& x, Incidence& out) {
   return light.power != Rgb(0.0f);
 }
 
+PassThrough::PassThrough(const Scene& scene, bool glass) {
+  const std::vector<Polygon>& polygons = scene.polygons();
+  tau_.assign(polygons.size(), Rgb(0.0f));
+  ior_.assign(polygons.size(), 1.0f);
+  for (std::size_t p = 0; p < polygons.size(); ++p) {
+    const Material& m = scene.material(polygons[p].material);
+    if (!(max_channel(m.transmittance) > 0.0f) || (m.ior != 1.0f && !glass)) continue;
+    tau_[p] = m.transmittance;
+    ior_[p] = m.ior;
+    any_ = true;
+  }
+}
+
+PassThrough::PassThrough(const Scene& scene, bool glass, const PatchHierarchy& hierarchy) : PassThrough(scene, glass) {
+  std::vector<Rgb> tau(hierarchy.elements().size(), Rgb(0.0f));
+  std::vector<float> ior(tau.size(), 1.0f);
+  for (std::size_t e = 0; e < tau.size(); ++e) {
+    const std::uint32_t polygon = hierarchy.patches()[hierarchy.element(static_cast<std::uint32_t>(e)).patch].polygon;
+    tau[e] = tau_[polygon];
+    ior[e] = ior_[polygon];
+  }
+  tau_ = std::move(tau);
+  ior_ = std::move(ior);
+}
+
+Rgb PassThrough::transmittance(const RayScene& polygons, const glm::vec3& origin, const glm::vec3& dir, float tnear,
+                               float tfar, float step) const {
+  Rgb T(1.0f);
+  constexpr int kMaxCrossings = 16;
+  for (int crossing = 0; crossing <= kMaxCrossings; ++crossing) {
+    const std::optional<RayScene::Hit> h = polygons.intersect(origin, dir, tnear, tfar);
+    if (!h) return T;
+    if (crossing == kMaxCrossings || h->id >= tau_.size() || !(max_channel(tau_[h->id]) > 0.0f)) return Rgb(0.0f);
+    T *= tau_[h->id];
+    if (ior_[h->id] != 1.0f) {
+      const float cos_in = glm::dot(glm::normalize(dir), glm::normalize(h->geometric_normal));
+      T *= 1.0f - fresnel_dielectric(-cos_in, ior_[h->id]);
+    }
+    if (!(max_channel(T) > 0.0f)) return Rgb(0.0f);
+    tnear = h->t + step;
+  }
+  return Rgb(0.0f);
+}
+
+Rgb light_transmittance(const RayScene& occluders, const PassThrough* through, const glm::vec3& origin,
+                        const glm::vec3& light_position, const Incidence& in, float epsilon) {
+  if (unoccluded(occluders, origin, light_position, in)) return Rgb(1.0f);
+  if (!through || !through->any()) return Rgb(0.0f);
+  // A directional light's or the sky's ray runs along its unit direction; a point's or spot's
+  // along the segment to the light (parametric), so its step is epsilon over that length.
+  if (std::isinf(in.distance))
+    return through->transmittance(occluders, origin, in.wi, 0.0f, std::numeric_limits<float>::infinity(), epsilon);
+  const glm::vec3 to_light = light_position - origin;
+  const float length = glm::length(to_light);
+  if (!(length > 0.0f)) return Rgb(0.0f);
+  return through->transmittance(occluders, origin, to_light, 0.0f, kShadowEnd, epsilon / length);
+}
+
 bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::vec3& light_position,
                 const Incidence& in) {
   if (std::isinf(in.distance)) return !occluders.occluded(origin, in.wi, 0.0f, std::numeric_limits<float>::infinity());
@@ -117,7 +178,7 @@ bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::v
 }
 
 Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
-                        float epsilon) {
+                        float epsilon, const PassThrough* through) {
   Rgb H(0.0f);
   const glm::vec3 origin = x + epsilon * n;
   for (const PreparedLight& l : lights.delta()) {
@@ -125,25 +186,28 @@ Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, co
     if (!incidence(l, x, in)) continue;
     const float cos_x = glm::dot(n, in.wi);
     if (!(cos_x > 0.0f)) continue;
-    if (unoccluded(occluders, origin, l.position, in)) H += in.irradiance * cos_x;
+    H += in.irradiance * cos_x * light_transmittance(occluders, through, origin, l.position, in, epsilon);
   }
   return H;
 }
 
 Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
-                      float epsilon, const glm::vec2& u_sky) {
+                      float epsilon, const glm::vec2& u_sky, const PassThrough* through) {
   if (!lights.has_sky()) return Rgb(0.0f);
   // Cosine-weighted: L cos / pdf = pi L.
   const glm::vec3 w = glm::normalize(Frame(n).to_world(cosine_hemisphere(u_sky)));
   const Rgb L = lights.sky_radiance(w);
-  if (L == Rgb(0.0f) || occluders.occluded(x + epsilon * n, w, 0.0f, std::numeric_limits<float>::infinity()))
-    return Rgb(0.0f);
-  return kPi * L;
+  if (L == Rgb(0.0f)) return Rgb(0.0f);
+  Incidence in;
+  in.wi = w;
+  in.distance = std::numeric_limits<float>::infinity();
+  return kPi * L * light_transmittance(occluders, through, x + epsilon * n, glm::vec3(0.0f), in, epsilon);
 }
 
 Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x,
-                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky) {
-  return delta_irradiance_at(lights, occluders, x, n, epsilon) + sky_irradiance_at(lights, occluders, x, n, epsilon, u_sky);
+                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky, const PassThrough* through) {
+  return delta_irradiance_at(lights, occluders, x, n, epsilon, through) +
+         sky_irradiance_at(lights, occluders, x, n, epsilon, u_sky, through);
 }
 
 }  // namespace radiosity::detail

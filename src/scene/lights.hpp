@@ -24,6 +24,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "radiosity/mesh.hpp"
 #include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
@@ -100,6 +101,43 @@ class SceneLights {
 /// the light).
 bool incidence(const PreparedLight& light, const glm::vec3& x, Incidence& out);
 
+/// What a light's shadow ray keeps through the scene's windows and glass, per polygon: the
+/// extended first pass's treatment (FormFactorOptions::specular_depth > 0), straight on. A window
+/// (a transmitting material with ior 1) passes its transmittance; refracting glass (ior != 1)
+/// its transmittance times the interface's Fresnel transmission at the crossing angle, the
+/// bending ignored (exact in direction for a pane's two parallel faces; the ray's displacement
+/// is not); any other polygon stops the ray. Without it every polygon stops shadow rays, and a
+/// glazed window kept the sun and the sky out of a room. Built once per scene; read-only after.
+class PassThrough {
+ public:
+  /// `glass`: refracting glass passes too (else only windows: the path tracer, whose reference
+  /// must stay exact, takes glass as the interface it is).
+  PassThrough(const Scene& scene, bool glass);
+  /// The same for a RayScene of `hierarchy`'s leaves (RayScene::from_leaves(): ids are element
+  /// ids), each element as its polygon.
+  PassThrough(const Scene& scene, bool glass, const PatchHierarchy& hierarchy);
+  /// Whether some polygon passes light (else transmittance() is never more than 0).
+  bool any() const { return any_; }
+  /// The transmittance along origin + t dir, t in (tnear, tfar), through `polygons` (the
+  /// RayScene whose ids this was built for): 1 when nothing is hit, 0 when a polygon that does
+  /// not pass light is, else the product over the crossings (at most 16). `step` (parametric,
+  /// > 0) moves each next search past the polygon just crossed. Thread safety: may be called
+  /// concurrently.
+  Rgb transmittance(const RayScene& polygons, const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
+                    float step) const;
+
+ private:
+  std::vector<Rgb> tau_;     ///< per id: its polygon's transmittance, 0 where it passes nothing
+  std::vector<float> ior_;   ///< per id: 1 for a window, else the glass's
+  bool any_ = false;
+};
+
+/// The transmittance from `origin` (already lifted off its surface) to the light of `in`:
+/// 1 or 0 as unoccluded() says, or through `through`'s windows and glass when it is given
+/// (`epsilon`, in scene units, steps each search past the polygon just crossed).
+Rgb light_transmittance(const RayScene& occluders, const PassThrough* through, const glm::vec3& origin,
+                        const glm::vec3& light_position, const Incidence& in, float epsilon);
+
 /// True when nothing in `occluders` lies between `origin` (a point already lifted off its
 /// surface) and the light of `in`: for a point or spot up to just short of the light (the
 /// shadow-ray convention of visibility.hpp, tfar = 1 - 1e-4 of the segment), for a directional
@@ -110,18 +148,19 @@ bool unoccluded(const RayScene& occluders, const glm::vec3& origin, const glm::v
 /// The irradiance (W/m^2) at x, on the side its unit normal n faces, from the delta lights: each
 /// exactly, with a shadow ray from x lifted by `epsilon` along n. Thread safety: may be called
 /// concurrently.
+/// With `through`, shadow rays pass its windows and glass (PassThrough).
 Rgb delta_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
-                        float epsilon);
+                        float epsilon, const PassThrough* through = nullptr);
 /// One-sample estimate of the irradiance at x from the skies: one cosine-weighted direction from
 /// `u_sky`, pi L V (unbiased); 0 without a sky. Thread safety: may be called concurrently.
 Rgb sky_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x, const glm::vec3& n,
-                      float epsilon, const glm::vec2& u_sky);
+                      float epsilon, const glm::vec2& u_sky, const PassThrough* through = nullptr);
 
 /// One-sample estimate of the irradiance (W/m^2) that arrives at x, on the side its unit normal n
 /// faces, straight from the lights: every delta light exactly, with a shadow ray each (x lifted
 /// by `epsilon` along n), and the sky by one cosine-weighted direction from `u_sky` (pi L V:
 /// unbiased). Thread safety: may be called concurrently.
 Rgb light_irradiance_at(const SceneLights& lights, const RayScene& occluders, const glm::vec3& x,
-                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky);
+                        const glm::vec3& n, float epsilon, const glm::vec2& u_sky, const PassThrough* through = nullptr);
 
 }  // namespace radiosity::detail

@@ -131,7 +131,7 @@ Rgb unoccluded_cell_irradiance(const PreparedLight& light, const glm::vec3* corn
 }
 
 LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
-                           std::uint32_t sky_rays)
+                           std::uint32_t sky_rays, bool through_windows)
     : hierarchy_(hierarchy),
       lights_(scene.lights()),
       occluders_(RayScene::from_polygons(scene)),
@@ -143,6 +143,10 @@ LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, 
   patch_has_back_.resize(hierarchy.patches().size());
   for (std::size_t p = 0; p < patch_has_back_.size(); ++p)
     patch_has_back_[p] = pass1_has_back(scene.material(hierarchy.patches()[p].material)) ? 1 : 0;
+  if (through_windows) {
+    PassThrough through(scene, true);
+    if (through.any()) through_ = std::move(through);
+  }
 }
 
 Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays,
@@ -166,9 +170,13 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
     const bool to_point = light.type == LightType::point || light.type == LightType::spot;
     const LightRayBudget budget = sky ? sky_budget_ : kDeltaLightRays;
     // Generates and traces one pass of `points` rays; returns how many were traced and how many
-    // of those were clear, adding their weights to the sums.
-    double weight_sum = 0.0, visible_sum = 0.0;
+    // of those were clear, adding their weights to the sums. A ray's transmittance T is 1 when
+    // clear, 0 when blocked, and between through windows and glass (through_).
+    double weight_sum = 0.0;
+    glm::dvec3 visible_sum(0.0);
     std::uint32_t traced_total = 0, clear_total = 0, drawn = 0;
+    bool agree = true;  // every ray's T so far the same (first_T)
+    Rgb first_T(0.0f);
     // A sky's rays: points and directions from one randomised Halton set in four dimensions,
     // the second pass continuing the first's points (core/halton.hpp).
     const std::optional<ShiftedHalton4> halton = sky ? std::optional<ShiftedHalton4>(rng) : std::nullopt;
@@ -218,29 +226,38 @@ Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint6
                             to_point ? kShadowEnd : std::numeric_limits<float>::infinity(), r.blocked.data());
       rays += traced;
       clear = 0;
+      const float tfar = to_point ? kShadowEnd : std::numeric_limits<float>::infinity();
       for (std::uint32_t k = 0; k < traced; ++k) {
-        const bool visible = r.blocked[k] == 0;
-        clear += visible ? 1u : 0u;
+        Rgb T(r.blocked[k] == 0 ? 1.0f : 0.0f);
+        if (r.blocked[k] != 0 && through_) {
+          const float step = to_point ? epsilon_ / glm::length(r.direction[k]) : epsilon_;
+          T = through_->transmittance(occluders_, r.origin[k], r.direction[k], 0.0f, tfar, step);
+        }
+        if (traced_total + k == 0) first_T = T;
+        agree = agree && T == first_T;
+        clear += r.blocked[k] == 0 ? 1u : 0u;
         weight_sum += r.weight[k];
-        visible_sum += visible ? r.weight[k] : 0.0;
+        visible_sum += static_cast<double>(r.weight[k]) * glm::dvec3(T);
       }
       traced_total += traced;
       clear_total += clear;
     };
     std::uint32_t traced = 0, clear = 0;
     pass(budget.first, traced, clear);
-    double V = 1.0;
-    if (traced > 0 && clear == 0) {
-      V = 0.0;
-    } else if (traced == 0 || clear < traced) {
+    Rgb V(1.0f);
+    if (traced > 0 && agree) {
+      V = first_T;  // all clear, all blocked, or all through the same panes alike
+    } else {
       // A penumbra (or, for a sky seen nearly edge-on, no direction above the horizon yet).
       pass(budget.penumbra, traced, clear);
       if (traced_total == 0)
-        V = 1.0;  // the lune of sky this side sees is too thin to sample: taken as unoccluded
+        V = Rgb(1.0f);  // the lune of sky this side sees is too thin to sample: taken as unoccluded
+      else if (weight_sum > 0.0)
+        V = Rgb(visible_sum / weight_sum);
       else
-        V = weight_sum > 0.0 ? visible_sum / weight_sum : static_cast<double>(clear_total) / traced_total;
+        V = Rgb(static_cast<float>(clear_total) / static_cast<float>(traced_total));
     }
-    H += unoccluded * static_cast<float>(V);
+    H += unoccluded * V;
   }
   return H;
 }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/progress.hpp"
@@ -69,9 +70,11 @@ struct LightShot {
 class LightShooter {
  public:
   /// `seed` keys the random streams (Stream::light_front/light_back); `threads` and `sky_rays`
-  /// as SolveOptions'. Builds a BVH over the scene's polygons (Embree).
+  /// as SolveOptions'. Builds a BVH over the scene's polygons (Embree). `through_windows` (the
+  /// extended first pass, FormFactorOptions::specular_depth > 0): shadow rays pass windows and
+  /// glass (PassThrough), else every polygon stops them.
   LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
-               std::uint32_t sky_rays);
+               std::uint32_t sky_rays, bool through_windows = false);
 
   bool empty() const { return lights_.empty(); }
 
@@ -102,6 +105,7 @@ class LightShooter {
   std::uint64_t seed_ = 0;
   unsigned threads_ = 0;
   std::vector<std::uint8_t> patch_has_back_;
+  std::optional<PassThrough> through_;  ///< with through_windows, when some polygon passes light
 };
 
 /// The mean over a planar triangle or convex quad (`corners`, counter-clockwise seen from its

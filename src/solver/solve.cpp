@@ -225,7 +225,8 @@ bool Problem::Impl::shoot_lights(const std::vector<std::uint32_t>& elements, det
   if (scene.lights().empty()) return true;
   if (!light_shooter)
     light_shooter =
-        std::make_unique<detail::LightShooter>(scene, hierarchy, options.seed, options.threads, options.sky_rays);
+        std::make_unique<detail::LightShooter>(scene, hierarchy, options.seed, options.threads, options.sky_rays,
+                                               options.form_factors.specular_depth > 0);
   return shoot(elements, light_shot, gate);
 }
 

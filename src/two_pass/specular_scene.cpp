@@ -25,7 +25,8 @@ namespace {
 
 }  // namespace
 
-SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights)
+SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights,
+                             bool through_windows)
     : hierarchy_(&hierarchy),
       rays_(RayScene::from_leaves(hierarchy, RayScene::backs_inside(scene, hierarchy))),
       lights_(scene.lights(), weights ? &weights->light : nullptr) {
@@ -33,6 +34,10 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
   for (const Patch& p : hierarchy.patches())
     if (p.polygon >= polygons.size())
       throw Error(ErrorCode::invalid_argument, "render_two_pass: the solution was not made from this scene");
+  if (through_windows) {
+    PassThrough through(scene, true, hierarchy);
+    if (through.any()) through_ = std::move(through);
+  }
 
   // The specular part of a material is its model without the Lambertian term: make_brdf() of the
   // same material with zero diffuse reflectance (pass 1 carries the diffuse term). A material

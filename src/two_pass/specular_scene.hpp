@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -59,7 +60,10 @@ class SpecularScene {
   /// Each emitting polygon and light shines at its weight in `weights` (emitter_weights(): a
   /// relit solution's light groups), a polygon or light of weight 0 not at all; null: all at 1.
   /// Throws Error{invalid_argument} if the hierarchy refers to polygons `scene` does not have.
-  SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights = nullptr);
+  /// `through_windows` (pass 1 was the extended one: SolveReport::specular_depth > 0): the
+  /// lights' shadow rays pass windows and glass, as they did in pass 1 (PassThrough).
+  SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy, const EmitterWeights* weights = nullptr,
+                bool through_windows = false);
 
   const RayScene& rays() const { return rays_; }
   const PatchHierarchy& hierarchy() const { return *hierarchy_; }
@@ -90,15 +94,15 @@ class SpecularScene {
   /// each delta light exactly with a shadow ray, the sky by one cosine-weighted ray from
   /// `u_sky` (light_irradiance_at()).
   Rgb light_irradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec2& u_sky) const {
-    return light_irradiance_at(lights_, rays_, x, n, epsilon_, u_sky);
+    return light_irradiance_at(lights_, rays_, x, n, epsilon_, u_sky, through());
   }
   /// The delta lights' part of it (no random numbers).
   Rgb delta_light_irradiance(const glm::vec3& x, const glm::vec3& n) const {
-    return delta_irradiance_at(lights_, rays_, x, n, epsilon_);
+    return delta_irradiance_at(lights_, rays_, x, n, epsilon_, through());
   }
   /// The sky's part of it, one cosine-weighted ray from `u_sky`.
   Rgb sky_light_irradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec2& u_sky) const {
-    return sky_irradiance_at(lights_, rays_, x, n, epsilon_, u_sky);
+    return sky_irradiance_at(lights_, rays_, x, n, epsilon_, u_sky, through());
   }
 
  private:
@@ -117,6 +121,8 @@ class SpecularScene {
   std::vector<Emitter> emitters_;
   DiscreteDistribution emitter_choice_;  ///< over emitters_, by power summed over channels
   SceneLights lights_;
+  std::optional<PassThrough> through_;  ///< with through_windows, when some polygon passes light
+  const PassThrough* through() const { return through_ ? &*through_ : nullptr; }
   Rgb emitted_power_{0.0f};
   float epsilon_ = 0.0f;
   bool has_specular_ = false;

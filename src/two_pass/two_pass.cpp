@@ -65,7 +65,7 @@ using detail::seconds_since;
 /// groups (all 1 unless pass 1 was relit).
 detail::SpecularScene traced_scene(const Scene& scene, const Solution& pass1) {
   const detail::EmitterWeights weights = detail::emitter_weights(scene, pass1, -1, "render_two_pass");
-  return detail::SpecularScene(scene, pass1.hierarchy(), &weights);
+  return detail::SpecularScene(scene, pass1.hierarchy(), &weights, pass1.report().specular_depth > 0);
 }
 
 /// The four layers of one camera ray.

@@ -248,6 +248,76 @@ TEST_SUITE("solver") {
     CHECK_THROWS_AS(rad::solve(scene, bad), rad::Error);
   }
 
+  TEST_CASE("lights: with the extended first pass the sun and the sky reach a floor through a window pane times its "
+            "transmittance, through glass times its Fresnel transmission") {
+    // A floor of side 4 under a level pane of side 8 at height 0.5: every sun ray from the floor
+    // crosses the pane once, at the sun's angle theta, so H = E cos(theta) tau for a window
+    // (ior 1) and E cos(theta) (1 - F(theta)) for clear glass (n = 1.5), exactly. The sky comes
+    // through the pane times tau where the pane covers it: E (1 - F_pane + tau F_pane), F_pane
+    // the point factor to the pane. Without the extended first pass the pane is opaque.
+    const glm::vec3 sun_direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
+    const float cos_theta = -sun_direction.y;
+    const glm::vec3 pane[] = {{-4, 0.5f, -4}, {4, 0.5f, -4}, {4, 0.5f, 4}, {-4, 0.5f, 4}};
+    auto scene_with = [&](const rad::Material& glazing, rad::LightType type) {
+      rad::Scene scene = plane_scene(4.0f);
+      const rad::MaterialId g = scene.add_material(glazing);
+      rad::add_quad(scene, pane[0], {8, 0, 0}, {0, 0, 8}, g, "pane");  // facing down
+      rad::Light light;
+      light.type = type;
+      light.intensity = 1.0f;
+      if (type == rad::LightType::directional) light.direction = sun_direction;
+      scene.add_light(light);
+      return scene;
+    };
+    rad::Material window;
+    window.reflectance = rad::Rgb(0.0f);
+    window.transmittance = rad::Rgb(0.7f, 0.6f, 0.5f);
+    window.ior = 1.0f;
+    rad::Material glass = window;
+    glass.transmittance = rad::Rgb(1.0f);
+    glass.ior = 1.5f;
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 1.0f;
+    o.mesh.max_element_area = 0.25f;
+    o.form_factors.specular_depth = 1;
+    auto floor_irradiance = [&](const rad::Solution& sol, const auto& check) {
+      const rad::PatchHierarchy& h = sol.hierarchy();
+      int count = 0;
+      for (std::uint32_t e : h.leaves()) {
+        if (h.patches()[h.element(e).patch].group != 0) continue;
+        check(h, e, sol.direct_irradiance()[e]);
+        ++count;
+      }
+      CHECK(count == 64);
+    };
+    const double fresnel = rad::fresnel_dielectric(cos_theta, 1.5f);
+    floor_irradiance(rad::solve(scene_with(window, rad::LightType::directional), o),
+                     [&](const rad::PatchHierarchy&, std::uint32_t, const rad::Rgb& H) {
+                       CHECK(H.x == doctest::Approx(cos_theta * 0.7).epsilon(1e-5));
+                       CHECK(H.y == doctest::Approx(cos_theta * 0.6).epsilon(1e-5));
+                       CHECK(H.z == doctest::Approx(cos_theta * 0.5).epsilon(1e-5));
+                     });
+    floor_irradiance(rad::solve(scene_with(glass, rad::LightType::directional), o),
+                     [&](const rad::PatchHierarchy&, std::uint32_t, const rad::Rgb& H) {
+                       CHECK(H.y == doctest::Approx(cos_theta * (1.0 - fresnel)).epsilon(1e-5));
+                     });
+    double worst = 0.0;
+    floor_irradiance(rad::solve(scene_with(window, rad::LightType::sky), o),
+                     [&](const rad::PatchHierarchy& h, std::uint32_t e, const rad::Rgb& H) {
+                       const double covered = element_mean(h, e, [&](const glm::vec3& x) {
+                         return rad::point_to_polygon_factor(x, glm::vec3(0, 1, 0), pane, 4);
+                       }, 16);
+                       const double expected = 1.0 - covered + 0.6 * covered;
+                       worst = std::max(worst, std::fabs(H.y - expected));
+                       CHECK(std::fabs(H.y - expected) < 0.02);
+                     });
+    MESSAGE("sky through a window pane of 0.6: worst element error " << worst << " E");
+    // The classic first pass: the pane stops the sun.
+    o.form_factors.specular_depth = 0;
+    floor_irradiance(rad::solve(scene_with(window, rad::LightType::directional), o),
+                     [&](const rad::PatchHierarchy&, std::uint32_t, const rad::Rgb& H) { CHECK(H.y == 0.0f); });
+  }
+
   TEST_CASE("lights: in a closed box lit by a point light every solver and estimator gives B = rho H and absorbs 4 pi I"
             * test::release_only) {
     // Every ray of the light meets a wall: the walls receive 4 pi I (the solid angles of the
