@@ -260,8 +260,8 @@ class FinalGather {
     const detail::EmitterWeights weights =
         detail::emitter_weights(scene, solution, options.light_group, "bake_lightmap");
     lights_ = detail::SceneLights(scene.lights(), &weights.light);
-    // The delta lights through windows and glass, as pass 1 took them (the extended pass).
-    // Gather rays still stop at a pane: the sky and the radiosity beyond it are not gathered.
+    // The delta lights and the gather rays through windows and glass, as pass 1 took them
+    // (the extended pass).
     if (solution.report().specular_depth > 0) {
       detail::PassThrough through(scene, true, h_);
       if (through.any()) through_ = std::move(through);
@@ -316,23 +316,41 @@ class FinalGather {
     leaves_.intersect(rays, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                       hits.data(), found.data());
     Rgb direct(0.0f), indirect(0.0f);
+    constexpr int kMaxCrossings = 16;
     for (std::uint32_t r = 0; r < rays; ++r) {
-      if (!found[r]) {
-        // Into the sky: its light is direct, pi L per cosine-weighted ray.
-        if (lights_.has_sky()) direct += detail::kPi * lights_.sky_radiance(glm::normalize(direction[r]));
-        continue;
+      // A ray goes on through windows and glass (through_: the extended pass), each pane's
+      // own radiosity counted first, what lies beyond times what the panes passed (T).
+      Rgb T(1.0f);
+      bool crossed = false;
+      std::optional<detail::RayScene::Hit> at;
+      if (found[r]) at = hits[r];
+      for (int crossing = 0;; ++crossing) {
+        if (!at) {
+          // Into the sky: its light is direct, pi L per cosine-weighted ray.
+          if (lights_.has_sky()) direct += T * detail::kPi * lights_.sky_radiance(glm::normalize(direction[r]));
+          break;
+        }
+        const detail::RayScene::Hit& hit = *at;
+        const bool front = glm::dot(h_.normal(hit.id), direction[r]) < 0.0f;
+        if (front || !back_.empty()) {
+          const std::uint32_t* tri = leaves_.triangle(hit.triangle);
+          const std::vector<Rgb>& field = front ? front_ : back_;
+          const Rgb B = (1.0f - hit.u - hit.v) * field[tri[0]] + hit.u * field[tri[1]] + hit.v * field[tri[2]];
+          const PolygonId q = h_.patches()[h_.element(hit.id).patch].polygon;
+          const Rgb E =
+              (front || scene_.material(scene_.polygons()[q].material).two_sided) ? emission_[q] : Rgb(0.0f);
+          // An exact emitter's own light was counted above (unless seen through a pane, which
+          // its shadow rays do not pass); what it reflects is indirect light.
+          if (crossed || std::find(exact.begin(), exact.end(), q) == exact.end()) direct += T * E;
+          indirect += T * glm::max(B - E, Rgb(0.0f));
+        }
+        const Rgb pass = through_ && crossing < kMaxCrossings ? through_->crossing(hit.id, direction[r], hit.geometric_normal)
+                                                             : Rgb(0.0f);
+        if (!(detail::max_channel(pass) > 0.0f)) break;
+        T *= pass;
+        crossed = true;
+        at = leaves_.intersect(origin[r], direction[r], hit.t + epsilon_, std::numeric_limits<float>::infinity());
       }
-      const detail::RayScene::Hit& hit = hits[r];
-      const bool front = glm::dot(h_.normal(hit.id), direction[r]) < 0.0f;
-      if (!front && back_.empty()) continue;
-      const std::uint32_t* tri = leaves_.triangle(hit.triangle);
-      const std::vector<Rgb>& field = front ? front_ : back_;
-      const Rgb B = (1.0f - hit.u - hit.v) * field[tri[0]] + hit.u * field[tri[1]] + hit.v * field[tri[2]];
-      const PolygonId q = h_.patches()[h_.element(hit.id).patch].polygon;
-      const Rgb E = (front || scene_.material(scene_.polygons()[q].material).two_sided) ? emission_[q] : Rgb(0.0f);
-      // An exact emitter's own light was counted above; what it reflects is indirect light.
-      if (std::find(exact.begin(), exact.end(), q) == exact.end()) direct += E;
-      indirect += glm::max(B - E, Rgb(0.0f));
     }
     out.direct += direct / static_cast<float>(rays);
     out.indirect = indirect / static_cast<float>(rays);

@@ -145,16 +145,19 @@ Rgb PassThrough::transmittance(const RayScene& polygons, const glm::vec3& origin
   for (int crossing = 0; crossing <= kMaxCrossings; ++crossing) {
     const std::optional<RayScene::Hit> h = polygons.intersect(origin, dir, tnear, tfar);
     if (!h) return T;
-    if (crossing == kMaxCrossings || h->id >= tau_.size() || !(max_channel(tau_[h->id]) > 0.0f)) return Rgb(0.0f);
-    T *= tau_[h->id];
-    if (ior_[h->id] != 1.0f) {
-      const float cos_in = glm::dot(glm::normalize(dir), glm::normalize(h->geometric_normal));
-      T *= 1.0f - fresnel_dielectric(-cos_in, ior_[h->id]);
-    }
+    if (crossing == kMaxCrossings) return Rgb(0.0f);
+    T *= this->crossing(h->id, dir, h->geometric_normal);
     if (!(max_channel(T) > 0.0f)) return Rgb(0.0f);
     tnear = h->t + step;
   }
   return Rgb(0.0f);
+}
+
+Rgb PassThrough::crossing(std::uint32_t id, const glm::vec3& dir, const glm::vec3& geometric_normal) const {
+  if (id >= tau_.size() || !(max_channel(tau_[id]) > 0.0f)) return Rgb(0.0f);
+  if (ior_[id] == 1.0f) return tau_[id];
+  const float cos_in = glm::dot(glm::normalize(dir), glm::normalize(geometric_normal));
+  return tau_[id] * (1.0f - fresnel_dielectric(-cos_in, ior_[id]));
 }
 
 Rgb light_transmittance(const RayScene& occluders, const PassThrough* through, const glm::vec3& origin,

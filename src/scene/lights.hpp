@@ -125,6 +125,9 @@ class PassThrough {
   /// concurrently.
   Rgb transmittance(const RayScene& polygons, const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,
                     float step) const;
+  /// What a ray along `dir` keeps crossing the polygon of `id` (`geometric_normal` the hit's,
+  /// any length): 0 when it passes no light.
+  Rgb crossing(std::uint32_t id, const glm::vec3& dir, const glm::vec3& geometric_normal) const;
 
  private:
   std::vector<Rgb> tau_;     ///< per id: its polygon's transmittance, 0 where it passes nothing

@@ -298,6 +298,67 @@ TEST_SUITE("lightmap") {
     }
   }
 
+  TEST_CASE("bake_lightmap: under a window pane the floor bakes tau I cos / r^2 + E (1 - F + tau F), interpolated "
+            "and gathered") {
+    // The floor of the test above under a window pane (transmittance (0.7, 0.6, 0.5), ior 1,
+    // black) of side 3 at z = 0.3, the lamp above it: with the extended first pass the lamp's
+    // shadow rays and the final gather's rays pass the pane times tau (F the point factor from
+    // the floor to the pane). Before session 31 the pane stopped the gather's rays and the
+    // lamp's shadow rays: the sky and the lamp were baked as the 1 - F the pane leaves open.
+    rad::Scene scene;
+    Floor mesh;
+    rad::Material white, window;
+    white.reflectance = rad::Rgb(0.5f);
+    window.reflectance = rad::Rgb(0.0f);
+    window.transmittance = rad::Rgb(0.7f, 0.6f, 0.5f);
+    window.ior = 1.0f;
+    const rad::MeshId floor = scene.add_mesh(mesh.desc(scene.add_material(white)));
+    const glm::vec3 pane[] = {{-1, -1, 0.3f}, {-1, 2, 0.3f}, {2, 2, 0.3f}, {2, -1, 0.3f}};  // facing down
+    scene.add_polygon({pane[0], pane[1], pane[2], pane[3]}, scene.add_material(window), "pane");
+    rad::Light lamp, sky;
+    lamp.intensity = 2.0f;
+    lamp.position = {0.4f, 0.6f, 1.0f};
+    sky.type = rad::LightType::sky;
+    sky.direction = {0.0f, 0.0f, 1.0f};
+    sky.intensity = 3.0f;
+    scene.add_light(lamp);
+    scene.add_light(sky);
+    rad::SolveOptions so;
+    so.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    so.form_factors.hemisphere_rays = 64;
+    so.form_factors.specular_depth = 1;
+    so.mesh.max_patch_area = 0.01f;
+    so.mesh.max_element_area = 0.0025f;
+    const rad::Solution sol = rad::solve(scene, so);
+    const rad::Rgb tau = window.transmittance;
+    for (bool gather : {false, true}) {
+      CAPTURE(gather);
+      rad::LightmapOptions o;
+      o.width = o.height = 32;
+      o.final_gather = gather;
+      o.gather_rays = 1024;
+      const rad::Lightmap map = rad::bake_lightmap(scene, sol, floor, o);
+      double worst = 0.0;
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+          const glm::vec3 p = Floor::point(x, y, 32);
+          if (std::min({p.x, p.y, 1.0f - p.x, 1.0f - p.y}) < 0.05f) continue;
+          const glm::vec3 d = lamp.position - p;
+          const double F = rad::point_to_polygon_factor(p, glm::vec3(0, 0, 1), pane, 4);
+          for (int c = 0; c < 3; ++c) {
+            const double expected = tau[c] * lamp.intensity * d.z / std::pow(glm::dot(d, d), 1.5) +
+                                    sky.intensity * (1.0 - F + tau[c] * F);
+            worst = std::max(worst, std::abs(map.image.at(x, y)[c] - expected) / expected);
+          }
+        }
+      MESSAGE("under a window pane, largest relative error, " << (gather ? "final gather: " : "interpolated: ") << worst);
+      // Gathered: the lamp exact at the texel's point; the sky by 1024 stratified rays, each
+      // through the pane (tau pi L) or past its edge (pi L): measured 1.0 % (14 % at 16 rays,
+      // falling as their noise does). Interpolated: 0.26 % (pass 1's first shot is exact here).
+      CHECK(worst < (gather ? 0.02 : 0.01));
+    }
+  }
+
   TEST_CASE("bake_lightmap: a furnace cube whose faces are separate charts has no dark seams after dilation") {
     // An inward cube of 24 vertices (each face its own 4), every face a chart in a 3 x 2 grid of
     // 16 x 16 texel cells with the chart inset by 2 texels.
