@@ -427,6 +427,7 @@ py::dict report_dict(const rad::Solution& s) {
   d["refined_elements"] = r.refined_elements;
   d["form_factor_bytes"] = r.form_factor_bytes;
   d["link_count"] = r.link_count;
+  d["specular_depth"] = r.specular_depth;
   d["emitted_power"] = vec3(r.emitted_power);
   d["light_power"] = vec3(r.light_power);
   d["absorbed_power"] = vec3(r.absorbed_power);
@@ -448,7 +449,7 @@ double total_seconds(const rad::SolveReport& r) {
 PySolution solve(const rad::Scene& scene, const std::string& method, double tolerance, int max_iterations,
                  unsigned threads, std::uint64_t seed, const std::string& form_factors, double max_patch_area,
                  double max_element_area, std::uint32_t hemisphere_rays, bool adaptive, double epsilon,
-                 std::size_t memory_budget_bytes, const py::object& progress) {
+                 std::size_t memory_budget_bytes, const py::object& specular_depth, const py::object& progress) {
   rad::SolveOptions o;
   o.method = parse("method", method, kSolverMethods);
   o.tolerance = tolerance;
@@ -463,10 +464,28 @@ PySolution solve(const rad::Scene& scene, const std::string& method, double tole
   o.hierarchical.epsilon = static_cast<float>(epsilon);
   o.memory_budget_bytes = memory_budget_bytes;
   o.on_progress = progress_function(progress);
+  // The extended first pass on a scene with mirrors or glass, as `radiosity solve` takes it
+  // (docs/CLI.md): unless a depth is given, the estimator is one that cannot carry it, or the
+  // method is hierarchical; beyond the memory budget, under method 'auto', without it. No
+  // photon pass follows a solve here, so the emitters' light through glass counts too.
+  const bool automatic_depth = specular_depth.is_none();
+  if (!automatic_depth) o.form_factors.specular_depth = specular_depth.cast<std::uint32_t>();
+  const rad::SolveOptions plain = o;
+  if (automatic_depth && rad::needs_extended_first_pass(scene) && o.method != rad::SolverMethod::hierarchical &&
+      (o.form_factors.method == rad::FormFactorMethod::automatic ||
+       o.form_factors.method == rad::FormFactorMethod::monte_carlo))
+    rad::prepare_two_pass(scene, o);
+  if (o.form_factors.specular_depth > 0) o.form_factors.emitted_through_glass = true;
+  const bool extended = automatic_depth && o.form_factors.specular_depth > 0;
   PySolution out;
   out.polygon_count = scene.polygons().size();
   py::gil_scoped_release release;
-  out.solution = rad::solve(scene, o);
+  try {
+    out.solution = rad::solve(scene, o);
+  } catch (const rad::Error& e) {
+    if (!extended || e.code() != rad::ErrorCode::memory_budget || o.method != rad::SolverMethod::automatic) throw;
+    out.solution = rad::solve(scene, plain);
+  }
   return out;
 }
 
@@ -600,6 +619,11 @@ random stream. form_factors: 'auto', 'ray-cast', 'hemicube', 'analytic', 'monte-
 max_patch_area, max_element_area: meshing, scene units^2 (0 = derived from the scene).
 hemisphere_rays: Monte Carlo rays per element. adaptive: adaptive subdivision. epsilon: the
 hierarchical solver's link refinement threshold. memory_budget_bytes: 0 = 4 GiB.
+specular_depth: mirror reflections and window or glass passages carried between diffuse
+surfaces (extended form factors, Monte Carlo only), and the lights' shadow rays through windows
+and glass; None (the default) = 1 on a scene with mirror or glass materials, unless
+form_factors names another estimator or method is 'hierarchical' (or, under method 'auto', its
+rows would exceed the memory budget), else 0; report['specular_depth'] says which ran.
 progress: optional callable(dict) with keys phase, fraction, iteration, residual, called on the
 calling thread at phase boundaries and at most every ~50 ms; return False to cancel (the
 Solution's status is then 'cancelled'). An exception it raises, and Ctrl-C, propagate.
@@ -933,7 +957,7 @@ PYBIND11_MODULE(radiosity, m) {
         py::arg("tolerance") = 1e-3, py::arg("max_iterations") = 0, py::arg("threads") = 0u, py::arg("seed") = 1u,
         py::arg("form_factors") = "auto", py::arg("max_patch_area") = 0.0, py::arg("max_element_area") = 0.0,
         py::arg("hemisphere_rays") = 1024u, py::arg("adaptive") = false, py::arg("epsilon") = 0.05,
-        py::arg("memory_budget_bytes") = 0u, py::arg("progress") = py::none());
+        py::arg("memory_budget_bytes") = 0u, py::arg("specular_depth") = py::none(), py::arg("progress") = py::none());
   m.def("view_factor_matrix", &view_factor_matrix, kViewFactorDoc, py::arg("scene"), py::arg("level") = "polygon",
         py::kw_only(), py::arg("method") = "auto", py::arg("correction") = "none",
         py::arg("hemisphere_rays") = 1024u, py::arg("seed") = 1u, py::arg("threads") = 0u,

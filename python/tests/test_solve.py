@@ -1,10 +1,14 @@
 """solve(): the furnace test on a closed cube, the Cornell box's energy balance, progress,
 cancel and errors."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import radiosity
 from conftest import unit_cube_arrays
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "scenes"
 
 
 def test_furnace_closed_cube_gives_e_over_1_minus_rho():
@@ -79,6 +83,22 @@ def test_progress_can_cancel_and_its_exceptions_propagate(cube):
 
     with pytest.raises(KeyError, match="from the callback"):
         radiosity.solve(scene, progress=fail)
+
+
+def test_glazed_window_lets_the_sun_in_by_default_and_not_at_depth_0():
+    # The sunlit room with its window glazed: the extended first pass is taken for the glass,
+    # and the lights' shadow rays pass the pane (floor B 30.0 in red, 34.6 unglazed); at
+    # specular_depth=0 the pane keeps the sun and the sky out (the lamp alone: 2.2).
+    scene = radiosity.load_scene(str(EXAMPLES / "sunlit_room_glazed.json"))
+    default = radiosity.solve(scene, max_patch_area=0.5)
+    assert default.report["specular_depth"] == 1
+    assert default.form_factor_method == "monte-carlo"
+    assert 25 < default.group_radiosity("floor")[0] < 40
+    classic = radiosity.solve(scene, max_patch_area=0.5, specular_depth=0)
+    assert classic.report["specular_depth"] == 0
+    assert 1 < classic.group_radiosity("floor")[0] < 3.5
+    # A hierarchical solve carries no specular paths: it is left at 0.
+    assert radiosity.solve(scene, "hierarchical", max_patch_area=0.5).report["specular_depth"] == 0
 
 
 def test_solve_errors():
