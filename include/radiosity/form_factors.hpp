@@ -83,11 +83,13 @@ struct FormFactorOptions {
   /// between diffuse surfaces through ideal mirrors (Material::specular with specular_exponent
   /// 0; at most this many reflections on a path, weighted by the mean specular reflectance) and
   /// through transmitting polygons, straight on: windows (ior 1, weighted by the mean
-  /// transmittance) and refracting glass (ior != 1, also weighted by the Fresnel transmission of
-  /// each interface; only light that left a non-emitting surface, since the second pass's photon
-  /// map carries emitted light through glass as sharp caustics). 0 = classic radiosity:
-  /// specular parts are ignored and every polygon is opaque. Glossy lobes are not carried. In
-  /// [0, 16].
+  /// transmittance) and refracting glass (ior != 1: at each interface reflected as by a mirror
+  /// with the Fresnel reflectance as probability, else straight on; only light that left a
+  /// non-emitting surface unless emitted_through_glass, since the second pass's photon map
+  /// carries emitted light through glass as sharp caustics). The lights' first shot then
+  /// passes windows and glass too (its shadow rays straight on, times each pane's transmittance
+  /// and Fresnel transmission; docs/LIGHTS.md). 0 = classic radiosity: specular parts are
+  /// ignored and every polygon is opaque. Glossy lobes are not carried. In [0, 16].
   std::uint32_t specular_depth = 0;
   /// With specular_depth > 0: also carry the light that emitting polygons send through
   /// refracting glass (straight on, weighted as above), which is otherwise left to the second
