@@ -10,6 +10,7 @@
 #include <radiosity/radiosity.hpp>
 
 #include "image/camera.hpp"
+#include "support/path_tracer_reference.hpp"
 #include "support/pixel_groups.hpp"
 #include "support/scenes.hpp"
 #include "support/build.hpp"
@@ -56,37 +57,13 @@ TEST_SUITE("path_tracer") {
     ro.spp = 16;
     const rad::Image display = rad::render(scene, sol, ro);
 
-    rad::PathTraceOptions po;
-    po.width = po.height = kSize;
-    po.spp = 1024;
-    const rad::Image a = rad::render_path_traced(scene, po);
-    po.seed = 2;
-    const rad::Image b = rad::render_path_traced(scene, po);
-
     // Group means over the pixels that show one group only. The path tracer's noise is
     // estimated from the two seeds (sigma of their mean = |a - b| / 2); on top of 4 sigma the
     // radiosity display may differ by 2 %, its own discretisation (patches and elements of
     // 1/1024 m^2, the display's interpolation of the sun patch's edges). Measured: floor +0.34
     // to +0.40 % (the seeds differ by 0.05 to 0.07 %), walls -1.5 to +0.8 % (0.24 to 1.3 %).
-    const std::vector<int> groups = test::pixel_groups(scene, scene.camera(), kSize, kSize);
-    std::vector<int> counts;
-    const std::vector<rad::Rgb> mr = test::group_means(display, groups, scene.groups().size(), &counts);
-    const std::vector<rad::Rgb> ma = test::group_means(a, groups, scene.groups().size());
-    const std::vector<rad::Rgb> mb = test::group_means(b, groups, scene.groups().size());
-    int compared = 0;
-    for (std::size_t g = 0; g < scene.groups().size(); ++g) {
-      if (counts[g] < 50) continue;
-      ++compared;
-      for (int c = 0; c < 3; ++c) {
-        const double path = 0.5 * (ma[g][c] + mb[g][c]), sigma = std::fabs(ma[g][c] - mb[g][c]) / 2.0;
-        CAPTURE(scene.groups()[g]);
-        CAPTURE(c);
-        MESSAGE(scene.groups()[g] << " channel " << c << " (" << counts[g] << " pixels): radiosity " << mr[g][c]
-                                  << ", path " << path << " (" << (mr[g][c] / path - 1.0) * 100
-                                  << " %), seeds differ by " << std::fabs(ma[g][c] - mb[g][c]) / path * 100 << " %");
-        CHECK(std::fabs(mr[g][c] - path) <= 0.02 * path + 4.0 * sigma);
-      }
-    }
+    const int compared =
+        test::check_against_path_tracer(scene, kSize, {{"radiosity", &display}}, test::path_traced_twice(scene, kSize), 0.02);
     CHECK(compared == 4);  // floor, right, left and back walls
   }
 
