@@ -50,6 +50,9 @@ struct Estimate {
   std::size_t default_bytes = 0;
   /// default_bytes is over the memory budget: the default solve is hierarchical.
   bool default_hierarchical = false;
+  /// The default solve's specular depth: 1 on a scene with mirror or glass materials (the
+  /// extended first pass, extend_first_pass()), 0 otherwise or when it is hierarchical.
+  unsigned default_specular_depth = 0;
 };
 
 struct CheckResult {
@@ -95,7 +98,10 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
   const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
   e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
-  e.default_method = rad::choose_form_factor_method(hierarchy, rad::FormFactorOptions{});
+  rad::FormFactorOptions default_options;
+  if (rad::needs_extended_first_pass(scene)) default_options.specular_depth = 1;  // as solve takes it
+  e.default_specular_depth = default_options.specular_depth;
+  e.default_method = rad::choose_form_factor_method(hierarchy, default_options);
   const bool monte_carlo = e.default_method == rad::FormFactorMethod::monte_carlo;
   e.default_dense = !monte_carlo && back_patches == 0;
   e.default_bytes = e.default_dense ? e.dense_matrix_bytes
@@ -159,6 +165,7 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   // Over the budget the default solve (--method auto) takes the hierarchical solver, which keeps
   // no rows (SolverMethod::automatic).
   r.estimate->default_hierarchical = r.estimate->default_bytes > kDefaultMemoryBudget;
+  if (r.estimate->default_hierarchical) r.estimate->default_specular_depth = 0;  // its links carry no mirror paths
   return r;
 }
 
@@ -213,6 +220,10 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
       std::printf("default solve: gauss-seidel, %s form factors (automatic), %s: %zu bytes (%s)\n",
                   rad::to_string(e.default_method), e.default_dense ? "dense matrix" : "sparse rows up to",
                   e.default_bytes, mib(e.default_bytes).c_str());
+    if (e.default_specular_depth > 0)
+      std::printf("default first pass: extended, specular depth %u (automatic: the scene has mirror or glass "
+                  "materials, whose light it carries between diffuse surfaces)\n",
+                  e.default_specular_depth);
   }
   if (r.error.empty())
     std::printf("result: ok, the scene can be solved\n");
@@ -258,7 +269,8 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
                          {"default_form_factors", rad::to_string(e.default_method)},
                          {"default_storage", e.default_dense ? "dense" : "sparse"},
                          {"default_bytes", e.default_bytes},
-                         {"default_solver", e.default_hierarchical ? "hierarchical" : "gauss-seidel"}};
+                         {"default_solver", e.default_hierarchical ? "hierarchical" : "gauss-seidel"},
+                         {"default_specular_depth", e.default_specular_depth}};
   } else {
     j["estimate"] = nullptr;
   }
