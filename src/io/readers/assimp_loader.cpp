@@ -343,6 +343,26 @@ PlyHeader read_ply_header(const fs::path& path) {
                 path.string() + ": the PLY header has no end_header line (a truncated file?)");
   header.body = in.offset();
   header.body_line = number + 1;
+  // Assimp 5.2 keeps one array of vertices and one of faces (a tristrip's too), sized by the
+  // first element that fills it: a second one writes its instances into it, past its end when
+  // it has more (a heap overflow, seen by valgrind; under AddressSanitizer, which does not
+  // instrument Assimp, it corrupted the allocator's own records and stopped two fuzz runs,
+  // session 31).
+  {
+    std::size_t vertex_line = 0, face_line = 0;
+    for (const PlyElement& e : header.elements) {
+      const bool faces = e.name == "face" || e.name == "tristrips";
+      if (e.name != "vertex" && !faces) continue;
+      std::size_t& first = faces ? face_line : vertex_line;
+      if (first != 0) {
+        number = e.line;
+        refuse("a second PLY element of " + std::string(faces ? "faces ('face' or 'tristrips')" : "vertices") +
+               " (the first is on line " + std::to_string(first) + "); the PLY reader (Assimp 5.2) would write its "
+               "instances into the first one's storage, past its end when it has more");
+      }
+      first = e.line;
+    }
+  }
   // Assimp 5.2 reads no data for an element it does not know (ply_element_known()) and goes
   // on with the next element's: one before the faces shifts every vertex or face after it.
   bool faces_after = false;
