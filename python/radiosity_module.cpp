@@ -428,6 +428,7 @@ py::dict report_dict(const rad::Solution& s) {
   d["form_factor_bytes"] = r.form_factor_bytes;
   d["link_count"] = r.link_count;
   d["specular_depth"] = r.specular_depth;
+  d["specular_depth_choice"] = r.specular_depth_choice;
   d["emitted_power"] = vec3(r.emitted_power);
   d["light_power"] = vec3(r.light_power);
   d["absorbed_power"] = vec3(r.absorbed_power);
@@ -464,28 +465,17 @@ PySolution solve(const rad::Scene& scene, const std::string& method, double tole
   o.hierarchical.epsilon = static_cast<float>(epsilon);
   o.memory_budget_bytes = memory_budget_bytes;
   o.on_progress = progress_function(progress);
-  // The extended first pass on a scene with mirrors or glass, as `radiosity solve` takes it
-  // (docs/CLI.md): unless a depth is given, the estimator is one that cannot carry it, or the
-  // method is hierarchical; beyond the memory budget, under method 'auto', without it. No
-  // photon pass follows a solve here, so the emitters' light through glass counts too.
-  const bool automatic_depth = specular_depth.is_none();
-  if (!automatic_depth) o.form_factors.specular_depth = specular_depth.cast<std::uint32_t>();
-  const rad::SolveOptions plain = o;
-  if (automatic_depth && rad::needs_extended_first_pass(scene) && o.method != rad::SolverMethod::hierarchical &&
-      (o.form_factors.method == rad::FormFactorMethod::automatic ||
-       o.form_factors.method == rad::FormFactorMethod::monte_carlo))
-    rad::prepare_two_pass(scene, o);
-  if (o.form_factors.specular_depth > 0) o.form_factors.emitted_through_glass = true;
-  const bool extended = automatic_depth && o.form_factors.specular_depth > 0;
+  // specular_depth None: solve() chooses (rad::SpecularPaths::automatic, as `radiosity solve`:
+  // the extended first pass on a scene with mirrors or glass, docs/CLI.md).
+  if (!specular_depth.is_none()) {
+    o.specular_paths = rad::SpecularPaths::as_given;
+    o.form_factors.specular_depth = specular_depth.cast<std::uint32_t>();
+    o.form_factors.emitted_through_glass = true;  // no photon pass follows
+  }
   PySolution out;
   out.polygon_count = scene.polygons().size();
   py::gil_scoped_release release;
-  try {
-    out.solution = rad::solve(scene, o);
-  } catch (const rad::Error& e) {
-    if (!extended || e.code() != rad::ErrorCode::memory_budget || o.method != rad::SolverMethod::automatic) throw;
-    out.solution = rad::solve(scene, plain);
-  }
+  out.solution = rad::solve(scene, o);
   return out;
 }
 
@@ -623,7 +613,8 @@ specular_depth: mirror reflections and window or glass passages carried between 
 surfaces (extended form factors, Monte Carlo only), and the lights' shadow rays through windows
 and glass; None (the default) = 1 on a scene with mirror or glass materials, unless
 form_factors names another estimator or method is 'hierarchical' (or, under method 'auto', its
-rows would exceed the memory budget), else 0; report['specular_depth'] says which ran.
+rows would exceed the memory budget), else 0; report['specular_depth'] says which ran and
+report['specular_depth_choice'] why.
 progress: optional callable(dict) with keys phase, fraction, iteration, residual, called on the
 calling thread at phase boundaries and at most every ~50 ms; return False to cancel (the
 Solution's status is then 'cancelled'). An exception it raises, and Ctrl-C, propagate.

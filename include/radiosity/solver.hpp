@@ -29,10 +29,29 @@ enum class SolverMethod {
   /// links' memory grows about linearly with the scene (docs/HIERARCHICAL.md).
   hierarchical,
   /// The default: gauss_seidel while its form-factor rows fit SolveOptions::memory_budget_bytes,
-  /// else hierarchical (which keeps no rows), unless form_factors.specular_depth > 0 (only the
-  /// rows carry mirror paths: then the budget error stands). Chosen by a Problem's first solve;
+  /// else hierarchical (which keeps no rows); with form_factors.specular_depth > 0 (only the
+  /// rows carry mirror paths) it does so only under SpecularPaths::automatic, dropping the
+  /// specular paths, else the budget error stands. Chosen by a Problem's first solve;
   /// SolveReport::method says which ran and SolveReport::method_choice why.
   automatic,
+};
+
+/// How solve() chooses FormFactorOptions::specular_depth (mirror reflections and window and
+/// glass passages carried between diffuse surfaces: the extended first pass, docs/TWO_PASS.md).
+enum class SpecularPaths : std::uint8_t {
+  /// The default. When form_factors.specular_depth is 0 and the scene has mirror or glass
+  /// materials in use (needs_extended_first_pass()), solve() takes specular depth 1 with Monte
+  /// Carlo form factors and FormFactorOptions::emitted_through_glass, unless form_factors.method
+  /// names another estimator (only Monte Carlo rows carry them) or method is hierarchical (its
+  /// links carry none). Without it the light that reaches a mirror or a pane stops there: a
+  /// pane in a closed room takes a quarter of its lamp's power. Under SolverMethod::automatic,
+  /// when the rows with specular paths (a depth chosen here or given) would exceed
+  /// memory_budget_bytes, the solve goes on without them (depth 0, hierarchical) and says so in
+  /// a warning. SolveReport::specular_depth_choice says what was chosen and why.
+  automatic,
+  /// form_factors.specular_depth and emitted_through_glass as given; over the memory budget
+  /// with specular_depth > 0 the solve is refused (Error{memory_budget}).
+  as_given,
 };
 
 /// SolverMethod::hierarchical's refinement (docs/HIERARCHICAL.md).
@@ -88,6 +107,8 @@ struct SolveOptions {
   /// to hierarchical), progressive's cache of columns (it keeps what fits), hierarchical's links
   /// (refinement stops with Error{memory_budget} before a round that would pass it).
   std::size_t memory_budget_bytes = 0;
+  /// Whether solve() may choose form_factors.specular_depth for the scene (SpecularPaths).
+  SpecularPaths specular_paths = SpecularPaths::automatic;
   /// Shadow rays per element side toward each sky light (Light::sky) where the sky is partly
   /// covered, >= 5: a first fifth decides (all clear or all blocked: no more rays), the rest
   /// estimate the visible part. Points and directions come from one randomised 4D Halton set,
@@ -161,6 +182,14 @@ struct SolveReport {
   /// passages the solution carries between diffuse surfaces (0: classic radiosity). The
   /// two-pass compositor reads it so that its photon map leaves those paths out.
   std::uint32_t specular_depth = 0;
+  /// Whether the factors carried the emitters' light through glass
+  /// (FormFactorOptions::emitted_through_glass): render_two_pass() then leaves those paths out
+  /// of its caustics.
+  bool emitted_through_glass = false;
+  /// With SpecularPaths::automatic, what solve() did with the specular depth and why (e.g.
+  /// "1 (automatic: the scene has mirror or glass materials)"); empty with SpecularPaths::as_given
+  /// or when the scene has no mirror or glass in use.
+  std::string specular_depth_choice;
   /// sum A E over the emitting sides plus light_power, W per channel: the scene's lights count
   /// with the power they put onto the surfaces (docs/LIGHTS.md).
   Rgb emitted_power{0.0f};

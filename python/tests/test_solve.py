@@ -92,13 +92,17 @@ def test_glazed_window_lets_the_sun_in_by_default_and_not_at_depth_0():
     scene = radiosity.load_scene(str(EXAMPLES / "sunlit_room_glazed.json"))
     default = radiosity.solve(scene, max_patch_area=0.5)
     assert default.report["specular_depth"] == 1
+    assert default.report["specular_depth_choice"] == "1 (automatic: the scene has mirror or glass materials)"
     assert default.form_factor_method == "monte-carlo"
     assert 25 < default.group_radiosity("floor")[0] < 40
     classic = radiosity.solve(scene, max_patch_area=0.5, specular_depth=0)
     assert classic.report["specular_depth"] == 0
+    assert classic.report["specular_depth_choice"] == ""
     assert 1 < classic.group_radiosity("floor")[0] < 3.5
     # A hierarchical solve carries no specular paths: it is left at 0.
-    assert radiosity.solve(scene, "hierarchical", max_patch_area=0.5).report["specular_depth"] == 0
+    links = radiosity.solve(scene, "hierarchical", max_patch_area=0.5).report
+    assert links["specular_depth"] == 0
+    assert links["specular_depth_choice"].startswith("0 (automatic: the hierarchical links carry no")
 
 
 def test_solve_errors():

@@ -11,6 +11,7 @@
 #include "scene/emission.hpp"
 #include "core/memory_budget.hpp"
 #include "scene/overlap.hpp"
+#include "radiosity/render.hpp"
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
 #include "form_factors/pass1_material.hpp"
@@ -147,6 +148,11 @@ struct Problem::Impl {
   /// SolverMethod::automatic: chosen by the first solve (choose_method()), said in every report.
   bool automatic_method = false;
   std::string method_choice;
+  /// SpecularPaths::automatic: what the constructor and choose_method() did with the specular
+  /// depth, and the estimator asked for before it (the drop back to depth 0 resolves that one).
+  std::string specular_depth_choice;
+  bool automatic_specular_paths = false;
+  FormFactorMethod given_form_factors = FormFactorMethod::automatic;
   PatchHierarchy hierarchy;
   std::vector<std::string> warnings;  ///< the scene's and the z-fighting check's, for every report
   double seconds_meshing = 0.0;       ///< reported by the first solve only
@@ -182,8 +188,12 @@ struct Problem::Impl {
   /// Each light group's own solve (SolveOptions::separate_light_groups) on the current
   /// hierarchy, without refinement; empty when one is cancelled.
   std::vector<LightGroupSolution> solve_light_groups(const std::vector<Rgb>* emission);
+  /// SpecularPaths::automatic, in the constructor: the extended first pass on a scene with
+  /// mirror or glass materials, where the options let it run (SpecularPaths).
+  void choose_specular_depth();
   /// SolverMethod::automatic, at the first solve: Gauss-Seidel while its rows fit the memory
-  /// budget, else hierarchical (unless mirror paths need the rows). Makes the estimator.
+  /// budget, else hierarchical (dropping specular paths under SpecularPaths::automatic; given
+  /// ones need the rows). Makes the estimator.
   void choose_method();
   /// The lights' first shot for `elements` that lack it; false when cancelled.
   bool shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate);
@@ -192,6 +202,31 @@ struct Problem::Impl {
   bool shoot(const std::vector<std::uint32_t>& elements, detail::LightShot& shot, detail::ProgressGate& gate,
              const std::vector<char>* only = nullptr);
 };
+
+void Problem::Impl::choose_specular_depth() {
+  SolveOptions& o = options;
+  if (o.specular_paths != SpecularPaths::automatic || !needs_extended_first_pass(scene)) return;
+  automatic_specular_paths = true;
+  given_form_factors = o.form_factors.method;
+  if (o.form_factors.specular_depth > 0) return;  // given: kept, but dropped over the budget under automatic
+  const FormFactorMethod f = o.form_factors.method;
+  if (f != FormFactorMethod::automatic && f != FormFactorMethod::monte_carlo) {
+    specular_depth_choice = std::string("0 (automatic: the ") + to_string(f) +
+                            " estimator carries no mirror or glass paths; light reaching them stops there)";
+    return;
+  }
+  if (o.method == SolverMethod::hierarchical) {
+    specular_depth_choice = "0 (automatic: the hierarchical links carry no mirror or glass paths; light reaching them "
+                            "stops there)";
+    return;
+  }
+  // No photon pass follows a solve of its own, so the emitters' light through glass is counted
+  // here; render_two_pass() leaves it out of its caustics (SolveReport::emitted_through_glass).
+  o.form_factors.method = FormFactorMethod::monte_carlo;
+  o.form_factors.specular_depth = 1;
+  o.form_factors.emitted_through_glass = true;
+  specular_depth_choice = "1 (automatic: the scene has mirror or glass materials)";
+}
 
 void Problem::Impl::choose_method() {
   if (!automatic_method || !method_choice.empty()) return;
@@ -212,6 +247,16 @@ void Problem::Impl::choose_method() {
   auto mib = [](std::size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
   const std::string figure = mib(bytes) + (bytes > o.memory_budget_bytes ? ", over" : ", within") +
                              " the memory budget of " + mib(o.memory_budget_bytes);
+  if (bytes > o.memory_budget_bytes && o.form_factors.specular_depth > 0 && automatic_specular_paths) {
+    // The hierarchical links carry no specular paths: without them, rather than no solve.
+    warnings.push_back("specular depth 0 after all: the rows with mirror and glass paths could need " + figure +
+                       "; light reaching mirrors and glass stops there (SpecularPaths::automatic)");
+    specular_depth_choice = "0 (automatic: the rows with mirror and glass paths could need " + figure + ")";
+    o.form_factors.specular_depth = 0;
+    o.form_factors.emitted_through_glass = false;
+    o.form_factors.method = given_form_factors;
+    o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
+  }
   if (bytes > o.memory_budget_bytes && o.form_factors.specular_depth == 0) {
     o.method = SolverMethod::hierarchical;
     estimator.reset();  // links need none
@@ -323,6 +368,7 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given, const detail::Com
   if (!meshing_cancelled)
     hierarchy = meshing_progress ? PatchHierarchy(scene, o.mesh, meshing_progress) : PatchHierarchy(scene, o.mesh);
   seconds_meshing = seconds_since(t0);
+  choose_specular_depth();
   o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
   if (o.max_iterations == 0)
     o.max_iterations =
@@ -434,6 +480,11 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   choose_method();
   report.method = o.method;
   report.method_choice = method_choice;
+  report.warnings = warnings;  // choose_method() may add one
+  report.specular_depth = o.form_factors.specular_depth;
+  report.emitted_through_glass = o.form_factors.specular_depth > 0 && o.form_factors.emitted_through_glass;
+  report.specular_depth_choice = specular_depth_choice;
+  report.form_factor_method = o.form_factors.method;
   const bool hierarchical = o.method == SolverMethod::hierarchical;
   if (!estimator && !hierarchical) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
   if (o.method != SolverMethod::progressive && !hierarchical && store.rows.empty() && !translucency) {

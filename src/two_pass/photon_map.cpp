@@ -44,8 +44,8 @@ glm::vec3 cosine_direction(const glm::vec3& n, const glm::vec2& u) {
 }
 
 /// Traces photon `index` and appends its landings to `out`.
-void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth, std::uint64_t seed,
-                  std::size_t index, std::vector<Photon>& out) {
+void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth, bool pass1_glass,
+                  std::uint64_t seed, std::size_t index, std::vector<Photon>& out) {
   Rng rng(seed, index, stream_key(Stream::photon));
   const float u_emitter = rng.uniform();
   const glm::vec2 u_point = rng.uniform2();
@@ -57,7 +57,8 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
   glm::vec3 origin = y.position + scene.epsilon() * y.normal;
   const RayScene& rays = scene.rays();
   // Whether every specular event so far is one that pass 1 carries (mirror reflection, window
-  // passage); with at most `pass1_depth` mirror reflections, pass 1 already has this landing.
+  // passage, and with `pass1_glass` glass either way); with at most `pass1_depth` reflections,
+  // pass 1 already has this landing.
   bool pass1_kind = true;
   int mirrors = 0;
   for (int specular = 0;;) {
@@ -78,14 +79,18 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
     if (!s.specular || specular >= options.max_bounces) return;
     const glm::vec3 n = (!front && s.two_sided) ? -s.normal : s.normal;
     const ShadingFrame frame = ShadingFrame::from_normal(n);
-    const auto sample = s.specular->sample(frame.to_local(-dir), rng.uniform2());
+    const glm::vec3 wo = frame.to_local(-dir);
+    const auto sample = s.specular->sample(wo, rng.uniform2());
     if (!sample) return;
     // Russian roulette by the event's weight keeps the photon's power about constant.
     const float q = std::min(1.0f, max_channel(sample->weight));
     if (!(q > 0.0f) || !(rng.uniform() < q)) return;
     power *= sample->weight / q;
-    const bool reflected = sample->wi.z > 0.0f;
-    pass1_kind = pass1_kind && sample->delta && (reflected ? s.pass1_mirror : s.pass1_window);
+    // Reflected: back to the side it came from (a photon inside a one-sided slab meets its faces
+    // from behind, wo.z < 0).
+    const bool reflected = (sample->wi.z > 0.0f) == (wo.z > 0.0f);
+    const bool glass = pass1_glass && s.pass1_glass;
+    pass1_kind = pass1_kind && sample->delta && (glass || (reflected ? s.pass1_mirror : s.pass1_window));
     mirrors += reflected ? 1 : 0;
     dir = glm::normalize(frame.to_world(sample->wi));
     origin = x + scene.epsilon() * (glm::dot(dir, s.normal) > 0.0f ? s.normal : -s.normal);
@@ -96,7 +101,7 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
 }  // namespace
 
 PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth,
-                                  unsigned threads, std::uint64_t seed) {
+                                  unsigned threads, std::uint64_t seed, bool pass1_glass) {
   PhotonShoot result;
   result.emitted_power = scene.emitted_power();
   if (options.photons == 0 || !scene.has_emitters() || !scene.has_specular()) return result;
@@ -111,7 +116,7 @@ PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOption
   parallel_for(threads, blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const std::size_t last = std::min(options.photons, (b + 1) * kPhotonBlock);
-      for (std::size_t k = b * kPhotonBlock; k < last; ++k) trace_photon(scene, options, pass1_depth, seed, k, stored[b]);
+      for (std::size_t k = b * kPhotonBlock; k < last; ++k) trace_photon(scene, options, pass1_depth, pass1_glass, seed, k, stored[b]);
       const std::size_t now = held.fetch_add(stored[b].size()) + stored[b].size();
       if (now > most)
         refuse_memory("the caustic photon map (" + std::to_string(now) + " photons stored after " +

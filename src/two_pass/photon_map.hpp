@@ -37,11 +37,12 @@ struct PhotonShoot {
 /// specular part (Russian roulette by the event's weight) until `options.max_bounces` specular
 /// events. Landings that the extended pass 1 already carries are not stored: those reached
 /// only through mirror reflections (at most `pass1_depth`, SolveReport::specular_depth) and
-/// window passages (form_factors/pass1_material.hpp); with pass1_depth 0 (classic radiosity) every
-/// landing is stored. Photon k uses the
-/// stream (seed, k), so the result does not depend on `threads`.
+/// window passages (form_factors/pass1_material.hpp), and with `pass1_glass`
+/// (SolveReport::emitted_through_glass) glass passages and reflections too; with pass1_depth 0
+/// (classic radiosity) every landing is stored. Photon k uses the stream (seed, k), so the
+/// result does not depend on `threads`.
 PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOptions& options, int pass1_depth,
-                                  unsigned threads, std::uint64_t seed);
+                                  unsigned threads, std::uint64_t seed, bool pass1_glass = false);
 
 /// A kd-tree over photons (nanoflann) and the density estimate of their irradiance.
 /// Thread safety: immutable after construction; irradiance() may be called concurrently.

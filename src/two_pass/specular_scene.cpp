@@ -73,6 +73,7 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
     s.two_sided = m.two_sided;
     s.pass1_mirror = pass1_mirror(m) > 0.0f;
     s.pass1_window = pass1_window(m) > 0.0f;
+    s.pass1_glass = pass1_glass(m) > 0.0f;
     s.ior = m.ior;
     if (s.specular) has_specular_ = true;
 

@@ -38,8 +38,9 @@ struct SplitSurface {
   bool two_sided = false;
   bool uses_pass1 = true;  ///< false for a material with its own Brdf
   /// What the extended first pass (FormFactorOptions::specular_depth > 0) carries through this
-  /// surface: ideal-mirror reflection and straight window passage (form_factors/pass1_material.hpp).
-  bool pass1_mirror = false, pass1_window = false;
+  /// surface: ideal-mirror reflection and straight window passage (form_factors/pass1_material.hpp),
+  /// and glass (either way, when it carries the emitters' light: SolveReport::emitted_through_glass).
+  bool pass1_mirror = false, pass1_window = false, pass1_glass = false;
   float ior = 1.0f;  ///< index of the back side (Material::ior), for the radiance scale across a refraction
 };
 

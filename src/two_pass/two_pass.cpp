@@ -93,7 +93,8 @@ class TwoPassRenderer {
     start = std::chrono::steady_clock::now();
     if (caustics_) {
       detail::PhotonShoot shot = detail::shoot_caustic_photons(
-          scene_, options.caustics, static_cast<int>(pass1.report().specular_depth), options.threads, options.seed);
+          scene_, options.caustics, static_cast<int>(pass1.report().specular_depth), options.threads, options.seed,
+          pass1.report().emitted_through_glass);
       report.photons_emitted = shot.emitted;
       report.photons_stored = shot.photons.size();
       for (const detail::Photon& p : shot.photons) report.caustic_power += p.power;

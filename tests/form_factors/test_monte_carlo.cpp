@@ -51,6 +51,23 @@ rad::MeshOptions mesh(float patch, float element) {
   return m;
 }
 
+/// A closed unit box whose walls emit E and reflect rho, and inside it a lossless glass pane
+/// (transmittance 1, ior 1.5, no diffuse part), 0.9 x 0.9, level at half height: a furnace,
+/// B = E / (1 - rho) on every wall whatever the pane does, if its Fresnel reflection is carried.
+rad::Scene furnace_with_glass_pane(float rho, float E) {
+  rad::Material wall;
+  wall.reflectance = rad::Rgb(rho);
+  wall.emission = rad::Rgb(E);
+  rad::Scene s = test::closed_box(wall);
+  rad::Material glass;
+  glass.reflectance = rad::Rgb(0.0f);
+  glass.transmittance = rad::Rgb(1.0f);
+  glass.ior = 1.5f;
+  const rad::MaterialId g = s.add_material(glass);
+  s.add_polygon({{0.05f, 0.5f, 0.05f}, {0.05f, 0.5f, 0.95f}, {0.95f, 0.5f, 0.95f}, {0.95f, 0.5f, 0.05f}}, g, "pane");
+  return s;
+}
+
 }  // namespace
 
 TEST_SUITE("form_factors") {
@@ -387,7 +404,15 @@ TEST_SUITE("form_factors") {
       // Without extended form factors the mirror is just a black floor.
       rad::SolveOptions classic = o;
       classic.form_factors.specular_depth = 0;
+      classic.specular_paths = rad::SpecularPaths::as_given;
       CHECK(rad::solve(mirror_room(static_cast<float>(r)), classic).group_radiosity("tile").y == 0.0f);
+      // Left to solve() (SpecularPaths::automatic, the default), the mirror gets depth 1: the
+      // same rows as asked for by name.
+      classic.specular_paths = rad::SpecularPaths::automatic;
+      const rad::Solution chosen = rad::solve(mirror_room(static_cast<float>(r)), classic);
+      CHECK(chosen.report().specular_depth == 1u);
+      CHECK(chosen.report().specular_depth_choice == "1 (automatic: the scene has mirror or glass materials)");
+      CHECK(chosen.group_radiosity("tile").y == got);
     }
   }
 
@@ -441,6 +466,7 @@ TEST_SUITE("form_factors") {
     }
     // Classic radiosity: the pane is opaque and black.
     o.form_factors.specular_depth = 0;
+    o.specular_paths = rad::SpecularPaths::as_given;
     CHECK(rad::solve(room(1.0f), o).group_radiosity("tile").y == 0.0f);
   }
 }
@@ -458,16 +484,7 @@ TEST_SUITE("form_factors") {
     // Light the walls emit through glass is counted only with emitted_through_glass (the
     // two-pass renderer leaves it to its caustics).
     const float rho = 0.8f, E = 1.0f;
-    rad::Material wall;
-    wall.reflectance = rad::Rgb(rho);
-    wall.emission = rad::Rgb(E);
-    rad::Scene s = test::closed_box(wall);
-    rad::Material glass;
-    glass.reflectance = rad::Rgb(0.0f);
-    glass.transmittance = rad::Rgb(1.0f);
-    glass.ior = 1.5f;
-    const rad::MaterialId g = s.add_material(glass);
-    s.add_polygon({{0.05f, 0.5f, 0.05f}, {0.05f, 0.5f, 0.95f}, {0.95f, 0.5f, 0.95f}, {0.95f, 0.5f, 0.05f}}, g, "pane");
+    const rad::Scene s = furnace_with_glass_pane(rho, E);
     rad::SolveOptions o;
     o.form_factors = monte_carlo(2048);
     o.form_factors.specular_depth = 1;
@@ -500,6 +517,77 @@ TEST_SUITE("form_factors") {
     MESSAGE("without emitted_through_glass: B = " << apart);
     CHECK(apart < 0.97 * expected);
     CHECK(caustics_apart.report().escaped_power.y > 0.02f * caustics_apart.report().emitted_power.y);
+  }
+
+  TEST_CASE("specular paths by default (SpecularPaths::automatic): the furnace with a glass pane is right with no "
+            "option set - over the memory budget without them - as_given keeps depth 0") {
+    const float rho = 0.8f, E = 1.0f;
+    const rad::Scene s = furnace_with_glass_pane(rho, E);
+    const double expected = E / (1.0 - rho);
+    const auto wall_mean = [](const rad::Solution& sol) {
+      double mean = 0.0, area = 0.0;
+      for (const std::string& group : sol.groups())
+        if (group != "pane") {
+          mean += sol.group_area(group) * sol.group_radiosity(group).y;
+          area += sol.group_area(group);
+        }
+      return mean / area;
+    };
+    rad::SolveOptions o;  // every choice left to solve()
+    o.mesh = mesh(0.0625f, 0.0625f);
+    o.tolerance = 1e-6;
+    const rad::Solution chosen = rad::solve(s, o);
+    const rad::SolveReport& r = chosen.report();
+    CHECK(r.specular_depth == 1u);
+    CHECK(r.emitted_through_glass);
+    CHECK(r.form_factor_method == rad::FormFactorMethod::monte_carlo);
+    CHECK(r.specular_depth_choice == "1 (automatic: the scene has mirror or glass materials)");
+    MESSAGE("by default: B = " << wall_mean(chosen) << " (expected " << expected << ")");
+    // The default 1024 rays on 96 wall elements: the mean's noise is well under 0.5 %.
+    CHECK(wall_mean(chosen) == doctest::Approx(expected).epsilon(0.005));
+
+    // The same rows as asked for by name (same rays, same streams): bit-identical.
+    rad::SolveOptions named = o;
+    named.specular_paths = rad::SpecularPaths::as_given;
+    named.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    named.form_factors.specular_depth = 1;
+    named.form_factors.emitted_through_glass = true;
+    CHECK(rad::solve(s, named).group_radiosity("y0").y == chosen.group_radiosity("y0").y);
+
+    // as_given at depth 0: the pane is a black absorber.
+    named.form_factors.specular_depth = 0;
+    const rad::Solution plain = rad::solve(s, named);
+    CHECK(plain.report().specular_depth_choice.empty());
+    CHECK(wall_mean(plain) < 0.9 * expected);
+
+    // Estimators and methods that cannot carry specular paths: depth 0, and the report says why.
+    rad::SolveOptions ray_cast = o;
+    ray_cast.form_factors.method = rad::FormFactorMethod::ray_cast;
+    const rad::Solution by_ray_cast = rad::solve(s, ray_cast);
+    CHECK(by_ray_cast.report().specular_depth == 0u);
+    CHECK(by_ray_cast.report().specular_depth_choice.find("0 (automatic: the ray-cast estimator") == 0);
+    rad::SolveOptions hierarchical = o;
+    hierarchical.method = rad::SolverMethod::hierarchical;
+    CHECK(rad::solve(s, hierarchical).report().specular_depth_choice.find("0 (automatic: the hierarchical links") ==
+          0);
+
+    // Over the memory budget: under SolverMethod::automatic, without the specular paths (the
+    // hierarchical solver, a warning); under a named matrix method, refused.
+    // 1 536 patches of one element each: the rows could need 24 MiB, the links about 3.
+    rad::SolveOptions tight = o;
+    tight.mesh = mesh(1.0f / 256.0f, 1.0f / 256.0f);
+    tight.memory_budget_bytes = 6 << 20;
+    const rad::Solution dropped = rad::solve(s, tight);
+    MESSAGE("over the budget: " << dropped.report().specular_depth_choice);
+    CHECK(dropped.report().method == rad::SolverMethod::hierarchical);
+    CHECK(dropped.report().specular_depth == 0u);
+    CHECK(!dropped.report().emitted_through_glass);
+    const std::vector<std::string>& warnings = dropped.report().warnings;
+    CHECK(std::any_of(warnings.begin(), warnings.end(), [](const std::string& w) {
+      return w.rfind("specular depth 0 after all: the rows with mirror and glass paths could need", 0) == 0;
+    }));
+    tight.method = rad::SolverMethod::gauss_seidel;
+    CHECK_THROWS_AS(rad::solve(s, tight), rad::Error);
   }
 }
 

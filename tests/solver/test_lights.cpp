@@ -314,6 +314,7 @@ TEST_SUITE("solver") {
     MESSAGE("sky through a window pane of 0.6: worst element error " << worst << " E");
     // The classic first pass: the pane stops the sun.
     o.form_factors.specular_depth = 0;
+    o.specular_paths = rad::SpecularPaths::as_given;
     floor_irradiance(rad::solve(scene_with(window, rad::LightType::directional), o),
                      [&](const rad::PatchHierarchy&, std::uint32_t, const rad::Rgb& H) { CHECK(H.y == 0.0f); });
   }

@@ -70,6 +70,7 @@ TEST_SUITE("solver") {
     const rad::Scene specular = rad::cornell_box_specular();
     rad::SolveOptions coarse;
     coarse.mesh.max_element_area = 10000.0f;
+    coarse.specular_paths = rad::SpecularPaths::as_given;  // a classic pass 1: every caustic is the photon map's
     const rad::Solution pass1 = rad::solve(specular, coarse);
     rad::TwoPassOptions t;
     t.width = t.height = 8;

@@ -320,6 +320,56 @@ TEST_SUITE("two_pass") {
     // Everything stored is on the floor: the lamp's back and the slab are not diffuse landings.
     CHECK(stored.x == doctest::Approx(on_floor.x).epsilon(1e-6));
     MESSAGE("floor flux / lamp power = " << on_floor.x / P.x << ", expected " << expected);
+    // A pass 1 that carried the lamp's light through glass (SolveReport::emitted_through_glass,
+    // depth 1) has the landings after at most one reflection: only the photons reflected twice
+    // or more inside the slab (4 or more specular events: in, reflected, reflected, out) are
+    // still stored, the same ones (the same random streams).
+    const auto rest = rad::detail::shoot_caustic_photons(specular, po, 1, 0, 3, true);
+    std::size_t reflected_inside = 0;
+    for (const auto& p : shot.photons) reflected_inside += p.specular_bounces >= 4 ? 1 : 0;
+    rad::Rgb left(0.0f);
+    for (const auto& p : rest.photons) {
+      CHECK(p.specular_bounces >= 4);
+      left += p.power;
+    }
+    MESSAGE("stored after a pass 1 through glass: " << left.x / P.x << " of the lamp's power");
+    CHECK(rest.photons.size() == reflected_inside);
+    CHECK(left.x < 0.02f * P.x);
+    // Depth 1 without it: glass is the photon map's alone, as at depth 0.
+    CHECK(rad::detail::shoot_caustic_photons(specular, po, 1, 0, 3).photons.size() == shot.photons.size());
+  }
+
+  TEST_CASE("photons that the extended pass 1 carries through a window are not stored again, from either side") {
+    // A lamp facing up under a window pane (ior 1, transmittance 0.7) and a diffuse ceiling
+    // above it. The pane faces up or down: the photons meet its front or its back. Pass 1 at
+    // depth 1 carries a window passage either way (before session 32 a passage through the
+    // back was taken for a reflection, and stored again as a caustic).
+    for (const float facing : {1.0f, -1.0f}) {
+      CAPTURE(facing);
+      rad::Scene scene;
+      rad::Material ceiling, lamp, window;
+      ceiling.reflectance = rad::Rgb(0.5f);
+      lamp.reflectance = rad::Rgb(0.0f);
+      lamp.emission = rad::Rgb(1.0f);
+      window.reflectance = rad::Rgb(0.0f);
+      window.transmittance = rad::Rgb(0.7f);
+      window.ior = 1.0f;
+      const auto c = scene.add_material(ceiling), l = scene.add_material(lamp), w = scene.add_material(window);
+      test::add_quad(scene, {{-50, 2, -50}, {50, 2, -50}, {50, 2, 50}, {-50, 2, 50}}, {0, -1, 0}, c, "ceiling");
+      test::add_quad(scene, {{-20, 1, -20}, {20, 1, -20}, {20, 1, 20}, {-20, 1, 20}}, {0, facing, 0}, w, "pane");
+      test::add_quad(scene, {{-0.5f, 0, -0.5f}, {0.5f, 0, -0.5f}, {0.5f, 0, 0.5f}, {-0.5f, 0, 0.5f}}, {0, 1, 0}, l,
+                     "lamp");
+      const rad::PatchHierarchy hierarchy(scene, rad::MeshOptions{1e6f, 1e6f});
+      const rad::detail::SpecularScene specular(scene, hierarchy);
+      rad::PhotonOptions po;
+      po.photons = 20000;
+      const auto all = rad::detail::shoot_caustic_photons(specular, po, 0, 0, 3);
+      rad::Rgb stored(0.0f);
+      for (const auto& p : all.photons) stored += p.power;
+      // Classic pass 1: the photon map has the lamp's light through the pane, 0.7 of nearly all.
+      CHECK(stored.x > 0.6f * all.emitted_power.x);
+      CHECK(rad::detail::shoot_caustic_photons(specular, po, 1, 0, 3).photons.empty());
+    }
   }
 
   TEST_CASE("photons that the extended pass 1 carries through the mirror are not stored again") {

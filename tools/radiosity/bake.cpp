@@ -176,13 +176,11 @@ int run_bake(const BakeArgs& a) {
     }
 
     rad::SolveOptions options = to_options(a.solve, bar);
-    const rad::SolveOptions plain = options;
-    const std::string extended = extend_first_pass_alone(scene, options, a.solve);
-    const rad::Solution sol = solve_extended(scene, options, plain, extended,
-                                             [](const rad::Scene& s, const rad::SolveOptions& o) { return rad::solve(s, o); });
+    apply_specular_depth(options, a.solve);
+    const rad::Solution sol = rad::solve(scene, options);
     bar.finish();
     print_summary(sol);
-    print_estimator(sol, options, extended);
+    print_estimator(sol, options);
     print_solve_warnings(scene, sol);
 
     // `-o lit.glb`: one glTF file with the light baked in, instead of a folder.

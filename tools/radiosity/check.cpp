@@ -51,7 +51,7 @@ struct Estimate {
   /// default_bytes is over the memory budget: the default solve is hierarchical.
   bool default_hierarchical = false;
   /// The default solve's specular depth: 1 on a scene with mirror or glass materials (the
-  /// extended first pass, extend_first_pass()), 0 otherwise or when it is hierarchical.
+  /// extended first pass, rad::SpecularPaths::automatic), 0 otherwise or when it is hierarchical.
   unsigned default_specular_depth = 0;
 };
 

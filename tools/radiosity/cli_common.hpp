@@ -196,7 +196,7 @@ struct SolveArgs {
   bool two_sided = false;
   std::string reverse_winding;  ///< `--reverse-winding`: "", "all" or "outward"
   bool light_groups = false;
-  // Whether the user gave these (extend_first_pass() chooses them otherwise); set by add_solve_options().
+  // Whether the user gave these (apply_specular_depth(), prepare_pass1()); set by add_solve_options().
   const CLI::Option* method_option = nullptr;
   const CLI::Option* form_factors_option = nullptr;
   const CLI::Option* specular_depth_option = nullptr;
@@ -349,55 +349,34 @@ inline void add_solve_options(CLI::App& cmd, SolveArgs& a, bool with_path = fals
   add_reverse_winding_option(cmd, a.reverse_winding);
 }
 
-/// The extended first pass where the scene has mirror or glass materials
-/// (rad::prepare_two_pass(): Monte Carlo form factors carrying mirror reflections and window
-/// passages between diffuse surfaces), unless the user chose otherwise: a --specular-depth, a
-/// --form-factors other than monte-carlo, or --method hierarchical (whose links carry none).
-/// Without it the light that reaches a mirror or a pane stops there: a room's glass pane took a
-/// quarter of its lamp's power (`solve`, session 31). A --specular-depth above 0 without
-/// --form-factors selects the Monte Carlo estimator (the only one that carries it). Returns why
-/// `options` was extended, or "" when it was not.
-inline std::string extend_first_pass(const rad::Scene& scene, rad::SolveOptions& options, const SolveArgs& a) {
+/// --specular-depth: given, the depth is taken as it is (rad::SpecularPaths::as_given), and a
+/// depth above 0 without --form-factors selects the Monte Carlo estimator (the only one that
+/// carries it). Not given, solve() chooses (rad::SpecularPaths::automatic: the extended first
+/// pass on a scene with mirror or glass materials unless --form-factors or --method rules it
+/// out, and without it when its rows exceed the memory budget under --method auto), and
+/// SolveReport::specular_depth_choice says what it chose. For solve and bake, which no photon
+/// pass follows, the emitters' light through glass counts (FormFactorOptions::emitted_through_glass)
+/// unless `photons_follow`.
+inline void apply_specular_depth(rad::SolveOptions& options, const SolveArgs& a, bool photons_follow = false) {
   auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };
-  if (given(a.specular_depth_option)) {
-    if (a.specular_depth > 0 && !given(a.form_factors_option))
-      options.form_factors.method = rad::FormFactorMethod::monte_carlo;
-    return "";
-  }
-  if (!rad::needs_extended_first_pass(scene)) return "";
-  if (given(a.form_factors_option) && options.form_factors.method != rad::FormFactorMethod::monte_carlo) return "";
-  if (given(a.method_option) && options.method == rad::SolverMethod::hierarchical) return "";
+  if (!given(a.specular_depth_option)) return;
+  options.specular_paths = rad::SpecularPaths::as_given;
+  options.form_factors.emitted_through_glass = !photons_follow;
+  if (a.specular_depth > 0 && !given(a.form_factors_option))
+    options.form_factors.method = rad::FormFactorMethod::monte_carlo;
+}
+
+/// render's two-pass mode: pass 1 as rad::prepare_two_pass() sets it up (the emitters' light
+/// through glass left to the photon map's sharp caustics), unless --specular-depth, a
+/// --form-factors other than monte-carlo or --method hierarchical says otherwise (then as
+/// apply_specular_depth()).
+inline void prepare_pass1(const rad::Scene& scene, rad::SolveOptions& options, const SolveArgs& a) {
+  auto given = [](const CLI::Option* o) { return o != nullptr && o->count() > 0; };
+  apply_specular_depth(options, a, true);
+  if (given(a.specular_depth_option)) return;
+  if (given(a.form_factors_option) && options.form_factors.method != rad::FormFactorMethod::monte_carlo) return;
+  if (given(a.method_option) && options.method == rad::SolverMethod::hierarchical) return;
   rad::prepare_two_pass(scene, options);
-  return "the scene has mirror or glass materials";
-}
-
-/// For a solve that no photon pass follows (solve, bake): the extended first pass carries the
-/// emitters' light through glass too (FormFactorOptions::emitted_through_glass).
-inline std::string extend_first_pass_alone(const rad::Scene& scene, rad::SolveOptions& options, const SolveArgs& a) {
-  std::string why = extend_first_pass(scene, options, a);
-  if (options.form_factors.specular_depth > 0) options.form_factors.emitted_through_glass = true;
-  return why;
-}
-
-/// solve() with the extended first pass that extend_first_pass() chose, or, when its rows would
-/// exceed the memory budget and the method is automatic (which then takes hierarchical, whose
-/// links carry no mirror paths), without it, said on stdout. `run` is the solve (rad::solve, or
-/// its MPI form).
-inline rad::Solution solve_extended(const rad::Scene& scene, rad::SolveOptions& options, const rad::SolveOptions& plain,
-                                    const std::string& extended,
-                                    const std::function<rad::Solution(const rad::Scene&, const rad::SolveOptions&)>& run) {
-  if (extended.empty()) return run(scene, options);
-  try {
-    return run(scene, options);
-  } catch (const rad::Error& e) {
-    if (e.code() != rad::ErrorCode::memory_budget || plain.method != rad::SolverMethod::automatic) throw;
-    std::printf("specular depth: 0 after all: the extended first pass's rows exceed the memory budget (%s); light "
-                "reaching mirrors and glass stops there\n",
-                e.what());
-    std::fflush(stdout);
-    options = plain;
-    return run(scene, options);
-  }
 }
 
 inline rad::SolveOptions to_options(const SolveArgs& a, ProgressBar& bar) {
@@ -521,29 +500,37 @@ inline void print_summary(const rad::Solution& sol) {
     std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
 }
 
-/// Says which estimator ran, and why when the choice was automatic (`extended`: why
-/// extend_first_pass() chose the extended first pass, or "").
-inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options, const std::string& extended = "") {
+/// Says which estimator ran, and why when the choice was automatic.
+inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
   const rad::SolveReport& r = sol.report();
+  // Why the specular depth is 0 on a scene with mirrors or glass, unless a warning says it
+  // (dropped over the memory budget).
+  const bool warned = std::any_of(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
+    return w.rfind("specular depth 0 after all", 0) == 0;
+  });
+  const bool say_depth = !r.specular_depth_choice.empty() && r.specular_depth == 0 && !warned;
   if (!r.method_choice.empty())
     std::printf("method: %s (automatic: %s; --method overrides)\n",
                 r.method == rad::SolverMethod::hierarchical ? "hierarchical" : "gauss-seidel", r.method_choice.c_str());
   if (!r.estimator_ran()) {
     std::printf("form factors: links of the hierarchy (point-to-polygon and cluster transport, shadow rays)\n");
+    if (say_depth) std::printf("specular depth: %s\n", r.specular_depth_choice.c_str());
     return;
   }
-  if (!extended.empty() && r.specular_depth > 0) {
-    std::printf("form factors: %s, specular depth %u (automatic: %s, whose light it carries between diffuse "
-                "surfaces; --specular-depth 0 turns it off)\n",
-                rad::to_string(r.form_factor_method), static_cast<unsigned>(r.specular_depth), extended.c_str());
+  const bool chosen = r.specular_depth > 0 && r.specular_depth_choice.find("automatic") != std::string::npos;
+  if (chosen) {
+    std::printf("form factors: %s, specular depth %s, the mirror and glass paths carried between diffuse surfaces; "
+                "--specular-depth 0 turns it off\n",
+                rad::to_string(r.form_factor_method), r.specular_depth_choice.c_str());
     return;
   }
+  if (say_depth) std::printf("specular depth: %s\n", r.specular_depth_choice.c_str());
   if (options.form_factors.method != rad::FormFactorMethod::automatic) {
     std::printf("form factors: %s\n", rad::to_string(r.form_factor_method));
     return;
   }
   std::string why;
-  if (options.form_factors.specular_depth > 0)
+  if (r.specular_depth > 0)
     why = "mirror and window form factors need it";
   else
     why = std::to_string(r.patch_count) + " patches: " +

@@ -157,12 +157,10 @@ int main(int argc, char** argv) {
       else if (mode == rad::RenderMode::radiosity && needed == rad::RenderMode::two_pass)
         why += "; specular materials are shown as diffuse";
       rad::SolveOptions solve_options = to_options(render_args, bar);
-      const rad::SolveOptions plain_options = solve_options;
-      std::string extended;
       if (mode == rad::RenderMode::two_pass) {
         // The extended first pass (mirror and window form factors) where the scene has mirrors
         // or glass, unless the user chose otherwise.
-        extended = extend_first_pass(scene, solve_options, render_args);
+        prepare_pass1(scene, solve_options, render_args);
         why += "; pass 1 with " + form_factor_name(solve_options.form_factors.method) +
                " form factors and specular depth " + std::to_string(solve_options.form_factors.specular_depth);
       }
@@ -189,8 +187,7 @@ int main(int argc, char** argv) {
       } else if (mode == rad::RenderMode::two_pass) {
         // Pass 1: radiosity; with the Monte Carlo estimator and --specular-depth it carries mirror
         // and window form factors (the extended first pass).
-        rad::Solution sol = solve_extended(scene, solve_options, plain_options, extended,
-                                           [](const rad::Scene& s, const rad::SolveOptions& o) { return rad::solve(s, o); });
+        rad::Solution sol = rad::solve(scene, solve_options);
         bar.finish();
         print_summary(sol);
         print_estimator(sol, solve_options);
@@ -239,24 +236,20 @@ int main(int argc, char** argv) {
       rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.photometric, {solve_args.two_sided, solve_args.reverse_winding});
       print_warnings(scene.warnings());
       rad::SolveOptions options = to_options(solve_args, bar);
-      const rad::SolveOptions plain = options;
-      const std::string extended = extend_first_pass_alone(scene, options, solve_args);
-      const auto run = [](const rad::Scene& s, const rad::SolveOptions& o) {
+      apply_specular_depth(options, solve_args);
 #if RADIOSITY_HAS_MPI
-        // Jacobi split among the processes: every rank gets the whole solution; rank 0 reports it.
-        return process_count() > 1 ? rad::mpi::solve(s, o, MPI_COMM_WORLD) : rad::solve(s, o);
+      // Jacobi split among the processes: every rank gets the whole solution; rank 0 reports it.
+      rad::Solution sol = process_count() > 1 ? rad::mpi::solve(scene, options, MPI_COMM_WORLD) : rad::solve(scene, options);
 #else
-        return rad::solve(s, o);
+      rad::Solution sol = rad::solve(scene, options);
 #endif
-      };
-      rad::Solution sol = solve_extended(scene, options, plain, extended, run);
       bar.finish();
       if (process_rank() != 0) return 0;
       if (process_count() > 1)
         std::printf("mpi: Jacobi split among %d processes (form-factor rows and lights by blocks of unknowns)\n",
                     process_count());
       print_summary(sol);
-      print_estimator(sol, options, extended);
+      print_estimator(sol, options);
       print_solve_warnings(scene, sol);
       for (const std::string& g : sol.groups()) {
         rad::Rgb b = sol.group_radiosity(g);
