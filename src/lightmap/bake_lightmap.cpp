@@ -262,10 +262,7 @@ class FinalGather {
     lights_ = detail::SceneLights(scene.lights(), &weights.light);
     // The delta lights and the gather rays through windows and glass, as pass 1 took them
     // (the extended pass).
-    if (solution.report().specular_depth > 0) {
-      detail::PassThrough through(scene, true, h_);
-      if (through.any()) through_ = std::move(through);
-    }
+    if (solution.report().specular_depth > 0) through_ = detail::PassThrough::if_any(scene, true, h_);
     if (options.light_group < 0) {
       front_ = solution.vertex_radiosity();
       back_ = solution.vertex_back_radiosity();
@@ -316,7 +313,7 @@ class FinalGather {
     leaves_.intersect(rays, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                       hits.data(), found.data());
     Rgb direct(0.0f), indirect(0.0f);
-    constexpr int kMaxCrossings = 16;
+    constexpr int kMaxCrossings = detail::PassThrough::kMaxCrossings;
     for (std::uint32_t r = 0; r < rays; ++r) {
       // A ray goes on through windows and glass (through_: the extended pass), each pane's
       // own radiosity counted first, what lies beyond times what the panes passed (T).

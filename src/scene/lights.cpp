@@ -138,10 +138,21 @@ PassThrough::PassThrough(const Scene& scene, bool glass, const PatchHierarchy& h
   ior_ = std::move(ior);
 }
 
+std::optional<PassThrough> PassThrough::if_any(const Scene& scene, bool glass) {
+  PassThrough through(scene, glass);
+  if (!through.any()) return std::nullopt;
+  return through;
+}
+
+std::optional<PassThrough> PassThrough::if_any(const Scene& scene, bool glass, const PatchHierarchy& hierarchy) {
+  PassThrough through(scene, glass, hierarchy);
+  if (!through.any()) return std::nullopt;
+  return through;
+}
+
 Rgb PassThrough::transmittance(const RayScene& polygons, const glm::vec3& origin, const glm::vec3& dir, float tnear,
                                float tfar, float step) const {
   Rgb T(1.0f);
-  constexpr int kMaxCrossings = 16;
   for (int crossing = 0; crossing <= kMaxCrossings; ++crossing) {
     const std::optional<RayScene::Hit> h = polygons.intersect(origin, dir, tnear, tfar);
     if (!h) return T;

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -116,11 +117,16 @@ class PassThrough {
   /// The same for a RayScene of `hierarchy`'s leaves (RayScene::from_leaves(): ids are element
   /// ids), each element as its polygon.
   PassThrough(const Scene& scene, bool glass, const PatchHierarchy& hierarchy);
+  /// The same, or nothing when no polygon passes light (then shadow rays need not look for panes).
+  static std::optional<PassThrough> if_any(const Scene& scene, bool glass);
+  static std::optional<PassThrough> if_any(const Scene& scene, bool glass, const PatchHierarchy& hierarchy);
   /// Whether some polygon passes light (else transmittance() is never more than 0).
   bool any() const { return any_; }
+  /// The most panes a ray is followed through; one that meets more is taken as blocked.
+  static constexpr int kMaxCrossings = 16;
   /// The transmittance along origin + t dir, t in (tnear, tfar), through `polygons` (the
   /// RayScene whose ids this was built for): 1 when nothing is hit, 0 when a polygon that does
-  /// not pass light is, else the product over the crossings (at most 16). `step` (parametric,
+  /// not pass light is, else the product over the crossings (at most kMaxCrossings). `step` (parametric,
   /// > 0) moves each next search past the polygon just crossed. Thread safety: may be called
   /// concurrently.
   Rgb transmittance(const RayScene& polygons, const glm::vec3& origin, const glm::vec3& dir, float tnear, float tfar,

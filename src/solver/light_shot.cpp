@@ -143,10 +143,7 @@ LightShooter::LightShooter(const Scene& scene, const PatchHierarchy& hierarchy, 
   patch_has_back_.resize(hierarchy.patches().size());
   for (std::size_t p = 0; p < patch_has_back_.size(); ++p)
     patch_has_back_[p] = pass1_has_back(scene.material(hierarchy.patches()[p].material)) ? 1 : 0;
-  if (through_windows) {
-    PassThrough through(scene, true);
-    if (through.any()) through_ = std::move(through);
-  }
+  if (through_windows) through_ = PassThrough::if_any(scene, true);
 }
 
 Rgb LightShooter::element_irradiance(std::uint32_t e, bool back_side, std::uint64_t& rays,

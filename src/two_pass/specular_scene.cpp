@@ -34,10 +34,7 @@ SpecularScene::SpecularScene(const Scene& scene, const PatchHierarchy& hierarchy
   for (const Patch& p : hierarchy.patches())
     if (p.polygon >= polygons.size())
       throw Error(ErrorCode::invalid_argument, "render_two_pass: the solution was not made from this scene");
-  if (through_windows) {
-    PassThrough through(scene, true, hierarchy);
-    if (through.any()) through_ = std::move(through);
-  }
+  if (through_windows) through_ = PassThrough::if_any(scene, true, hierarchy);
 
   // The specular part of a material is its model without the Lambertian term: make_brdf() of the
   // same material with zero diffuse reflectance (pass 1 carries the diffuse term). A material
