@@ -167,8 +167,10 @@ Rgb PassThrough::transmittance(const RayScene& polygons, const glm::vec3& origin
 Rgb PassThrough::crossing(std::uint32_t id, const glm::vec3& dir, const glm::vec3& geometric_normal) const {
   if (id >= tau_.size() || !(max_channel(tau_[id]) > 0.0f)) return Rgb(0.0f);
   if (ior_[id] == 1.0f) return tau_[id];
+  // From outside at the ray's angle, whichever face it meets: the shadow ray is not bent
+  // (monte_carlo.cpp, the glass's Fresnel reflectance, says why).
   const float cos_in = glm::dot(glm::normalize(dir), glm::normalize(geometric_normal));
-  return tau_[id] * (1.0f - fresnel_dielectric(-cos_in, ior_[id]));
+  return tau_[id] * (1.0f - fresnel_dielectric(std::fabs(cos_in), ior_[id]));
 }
 
 Rgb light_transmittance(const RayScene& occluders, const PassThrough* through, const glm::vec3& origin,

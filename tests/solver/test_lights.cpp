@@ -248,6 +248,45 @@ TEST_SUITE("solver") {
     CHECK_THROWS_AS(rad::solve(scene, bad), rad::Error);
   }
 
+  TEST_CASE("lights: with the extended first pass the sun at 60 degrees reaches a floor through a glass slab times "
+            "(1 - F)^2 - no total internal reflection at its far face") {
+    // A closed slab of clear glass (n = 1.5, faces wound outward), 8 x 8 x 0.1, level at height
+    // 0.5 over a floor of side 4: every sun ray from the floor crosses the bottom face (its
+    // front) and the top face (from behind), both at the sun's angle, since shadow rays are
+    // not bent. The bent ray meets the top at its refracted angle, where F equals the entry's
+    // (Stokes), so H = E cos(theta) (1 - F(theta))^2. Before session 32 the top's F was taken
+    // from inside at the unbent 60 degrees: total internal reflection, H = 0.
+    const glm::vec3 sun_direction = glm::normalize(glm::vec3(std::sqrt(3.0f), -1.0f, 0.0f));  // 60 degrees
+    const float cos_theta = -sun_direction.y;
+    rad::Scene scene = plane_scene(4.0f);
+    rad::Material glass;
+    glass.reflectance = rad::Rgb(0.0f);
+    glass.transmittance = rad::Rgb(1.0f);
+    glass.ior = 1.5f;
+    const rad::MaterialId g = scene.add_material(glass);
+    rad::add_box(scene, {-4, 0.5f, -4}, {4, 0.6f, 4}, g, "slab");
+    rad::Light sun;
+    sun.type = rad::LightType::directional;
+    sun.direction = sun_direction;
+    sun.intensity = 1.0f;
+    scene.add_light(sun);
+    rad::SolveOptions o;
+    o.mesh.max_patch_area = 1.0f;
+    o.mesh.max_element_area = 0.25f;
+    const rad::Solution sol = rad::solve(scene, o);  // the extended first pass, chosen for the glass
+    REQUIRE(sol.report().specular_depth == 1u);
+    const double F = rad::fresnel_dielectric(cos_theta, 1.5f);
+    const double expected = cos_theta * (1.0 - F) * (1.0 - F);
+    const rad::PatchHierarchy& h = sol.hierarchy();
+    int count = 0;
+    for (std::uint32_t e : h.leaves()) {
+      if (h.patches()[h.element(e).patch].group != 0) continue;
+      CHECK(sol.direct_irradiance()[e].y == doctest::Approx(expected).epsilon(1e-5));
+      ++count;
+    }
+    CHECK(count == 64);
+  }
+
   TEST_CASE("lights: with the extended first pass the sun and the sky reach a floor through a window pane times its "
             "transmittance, through glass times its Fresnel transmission") {
     // A floor of side 4 under a level pane of side 8 at height 0.5: every sun ray from the floor

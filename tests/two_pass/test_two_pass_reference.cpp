@@ -52,8 +52,9 @@ TEST_SUITE("two_pass") {
     const rad::Image R = two_pass_64(rad::CornellSpecular::glass, pass1);
     const double rmse = test::relative_rmse(R, P), ratio = test::mean_ratio(R, P);
     MESSAGE("glass Cornell box: relative RMSE " << rmse << ", mean ratio " << ratio);
-    // Measured 7.8 % and 0.966: pass 1 passes light through the glass straight (no bending,
-    // no trapping by total internal reflection), the photon map blurs and speckles the caustics.
+    // Measured 6.6 % and 0.978 (7.1 % and 0.973 before session 32's Fresnel at the far face):
+    // pass 1 passes light through the glass straight (no bending, no trapping by total internal
+    // reflection), the photon map blurs and speckles the caustics.
     CHECK(rmse < 0.12);
     CHECK(std::fabs(ratio - 1.0) < 0.05);
     CHECK(!pass1.report().emitted_through_glass);
@@ -65,6 +66,7 @@ TEST_SUITE("two_pass") {
     CHECK(pass1.report().emitted_through_glass);
     const double chosen_rmse = test::relative_rmse(C, P), chosen_ratio = test::mean_ratio(C, P);
     MESSAGE("glass Cornell box, pass 1 by default: relative RMSE " << chosen_rmse << ", mean ratio " << chosen_ratio);
+    // Measured 9.9 % and 1.001: the lamp's light through the blocks unbent and blurred.
     CHECK(chosen_rmse < 0.12);
     CHECK(std::fabs(chosen_ratio - 1.0) < 0.05);
   }
