@@ -40,7 +40,7 @@ struct ImageOptions {
   /// box filter; rounded up to a square (g = ceil(sqrt(spp))). Default 4 here and in
   /// RenderOptions, 64 in PathTraceOptions, 16 in TwoPassOptions.
   int spp = 4;
-  std::optional<Camera> camera;  ///< default: the scene's camera
+  std::optional<Camera> camera;  ///< default: choose_camera(scene) (the scene's camera if it has one)
   unsigned threads = 0;          ///< 0 = all hardware threads; 1 = the calling thread only
   /// The image is a function of the inputs and the seed only: bit-identical at any thread count
   /// (each pixel draws from its own random stream keyed by (seed, pixel)).
@@ -86,6 +86,26 @@ RADIOSITY_API void validate(const RenderOptions& options);
 /// solution that was not made from this scene, or a relit one whose light groups are not the
 /// scene's materials' and lights'.
 RADIOSITY_API Image render(const Scene& scene, const Solution& solution, const RenderOptions& options = {});
+
+/// The camera the renderers take when ImageOptions::camera is not set, and why.
+struct CameraChoice {
+  Camera camera;
+  /// e.g. "the scene's camera", "the scene has none: framing its bounds from -z", or "the scene
+  /// has none, and from outside 44 % of the view is surfaces no light reaches (a closed model):
+  /// inside, at (2, 1.5, 0.2) looking +z, 60 degrees (100 % of the view lit surfaces)".
+  std::string reason;
+};
+
+/// The scene's camera when it has one (Scene::has_camera()). Otherwise Scene::camera()'s view
+/// framing the bounds from -z, unless most of the surfaces that view meets show no light: the
+/// backs of one-sided polygons, or sides that no emitter (the centroids of the 16 strongest
+/// emitting polygons) or light reaches directly, as a closed room seen from outside (whose
+/// image would be black). Then a view from inside, at mid height 5 % in from a side of the
+/// bounds looking across (+z, -z, +x or -x; y up) with a 60 degree field of view: the one whose
+/// image shows the most lit surfaces, judged by 24 x 24 rays per candidate. Builds a ray scene
+/// of the polygons (Embree) when the scene has no camera and something emits. Thread safety:
+/// may be called concurrently (reads `scene` only).
+RADIOSITY_API CameraChoice choose_camera(const Scene& scene);
 
 /// Which pipeline turns a scene into an image (`radiosity render --mode`).
 enum class RenderMode {

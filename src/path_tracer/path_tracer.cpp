@@ -135,7 +135,7 @@ class PathTracer {
  public:
   PathTracer(const Scene& scene, const PathTraceOptions& options)
       : options_(options),
-        camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
+        camera_(options.camera ? *options.camera : choose_camera(scene).camera, options.width, options.height),
         rays_(detail::RayScene::from_polygons(scene)),
         lights_(scene.lights()),
         through_(scene, false),

@@ -42,7 +42,7 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
     if (p.polygon >= scene.polygons().size())
       throw Error(ErrorCode::invalid_argument, "render: the solution was not made from this scene");
 
-  Camera camera_settings = options.camera ? *options.camera : scene.camera();
+  Camera camera_settings = options.camera ? *options.camera : choose_camera(scene).camera;
   const detail::PinholeCamera camera(camera_settings, options.width, options.height);
   const detail::RayScene rays =
       detail::RayScene::from_leaves(hierarchy, detail::RayScene::backs_inside(scene, hierarchy));

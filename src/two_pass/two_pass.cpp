@@ -77,7 +77,7 @@ class TwoPassRenderer {
  public:
   TwoPassRenderer(const Scene& scene, const Solution& pass1, const TwoPassOptions& options, TwoPassReport& report)
       : options_(options),
-        camera_(options.camera ? *options.camera : scene.camera(), options.width, options.height),
+        camera_(options.camera ? *options.camera : choose_camera(scene).camera, options.width, options.height),
         scene_(traced_scene(scene, pass1)),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
     auto start = std::chrono::steady_clock::now();

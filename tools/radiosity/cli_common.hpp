@@ -500,6 +500,27 @@ inline void print_summary(const rad::Solution& sol) {
     std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
 }
 
+/// The PNG preview's exposure from `values` (per pixel, its largest channel): 1, which shows a
+/// calibrated scene (the Cornell box) as it is meant, unless the image would be mostly clipped
+/// or dark: when the 95th percentile of the lit pixels (values > 0) is above 1 or below 0.1,
+/// the exposure that shows it at 0.8, and `why` says so (else `why` is empty). An exported room
+/// in watts comes out white at 1, a scene in photometric units black.
+inline float preview_exposure(std::vector<float> values, std::string& why) {
+  why.clear();
+  values.erase(std::remove_if(values.begin(), values.end(), [](float v) { return !(v > 0.0f) || !std::isfinite(v); }),
+               values.end());
+  if (values.empty()) return 1.0f;
+  const std::size_t k = values.size() * 95 / 100;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  const float p95 = values[k];
+  if (p95 >= 0.1f && p95 <= 1.0f) return 1.0f;
+  char s[160];
+  std::snprintf(s, sizeof s, "at 1 the 95th percentile of the lit pixels, %.3g, would be %s; it shows at 0.8",
+                static_cast<double>(p95), p95 > 1.0f ? "clipped" : "below 0.1");
+  why = s;
+  return 0.8f / p95;
+}
+
 /// Says which estimator ran, and why when the choice was automatic.
 inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
   const rad::SolveReport& r = sol.report();

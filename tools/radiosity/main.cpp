@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   int width = 512, height = 512, spp = 0;
   std::string eye, look_at, up;
   float fov = 0.0f;
-  float exposure = 1.0f;
+  float exposure = 0.0f;  // 0: automatic (preview_exposure())
   CLI::App* render = app.add_subcommand("render", "Solve and render a scene to EXR (linear) and PNG (preview)");
   render->add_option("scene", render_args.scene, kSceneHelp);
   render->add_option("-o,--output", out, "EXR output")->capture_default_str();
@@ -49,9 +49,10 @@ int main(int argc, char** argv) {
   render->add_option("--look-at", look_at, "Camera target x,y,z")->check(vec3_check());
   render->add_option("--up", up, "Camera up vector x,y,z")->check(vec3_check());
   render->add_option("--fov", fov, "Vertical field of view, degrees")->check(in_range<float>(0.0f, 180.0f));
-  render->add_option("--exposure", exposure, "PNG exposure (linear scale)")
-      ->check(any_number<float>())
-      ->capture_default_str();
+  render->add_option("--exposure", exposure,
+                     "PNG exposure (linear scale; default: 1 unless the image would be mostly clipped or dark, "
+                     "then the 95th percentile of its lit pixels shows at 0.8)")
+      ->check(any_number<float>());
   std::string mode_name = "auto";
   render
       ->add_option("--mode", mode_name,
@@ -126,9 +127,14 @@ int main(int argc, char** argv) {
     if (*render) {
       rad::Scene scene = load(render_args.scene, render_args.strict, render_args.photometric, {render_args.two_sided, render_args.reverse_winding});
       print_warnings(scene.warnings());
-      std::optional<rad::Camera> camera;
+      // A scene without a camera (an OBJ, STL or PLY has none) gets one chosen for it, said
+      // unless --eye and --look-at place it.
+      const rad::CameraChoice chosen = rad::choose_camera(scene);
+      if (!scene.has_camera() && (eye.empty() || look_at.empty()))
+        std::printf("camera: %s; --eye and --look-at override\n", chosen.reason.c_str());
+      std::optional<rad::Camera> camera = chosen.camera;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
-        rad::Camera c = scene.camera();
+        rad::Camera c = chosen.camera;
         if (!eye.empty()) c.eye = parse_vec3(eye, "--eye");
         if (!look_at.empty()) c.look_at = parse_vec3(look_at, "--look-at");
         if (!up.empty()) c.up = parse_vec3(up, "--up");
@@ -229,8 +235,18 @@ int main(int argc, char** argv) {
         if (png.empty()) png = std::filesystem::path(out).replace_extension(".png").string();
         rad::PngOptions po;
         po.exposure = exposure;
+        if (!(exposure > 0.0f)) {
+          std::vector<float> values;
+          values.reserve(image.pixels.size());
+          for (const rad::Rgb& p : image.pixels) values.push_back(std::max({p.x, p.y, p.z}));
+          std::string exposure_why;
+          po.exposure = preview_exposure(std::move(values), exposure_why);
+          if (!exposure_why.empty())
+            std::printf("preview exposure: %.4g (automatic: %s; --exposure overrides)\n", po.exposure,
+                        exposure_why.c_str());
+        }
         rad::write_png(image, png, po);
-        std::printf("wrote %s (sRGB preview, exposure %g)\n", std::filesystem::absolute(png).c_str(), exposure);
+        std::printf("wrote %s (sRGB preview, exposure %g)\n", std::filesystem::absolute(png).c_str(), po.exposure);
       }
     } else if (*solve) {
       rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.photometric, {solve_args.two_sided, solve_args.reverse_winding});

@@ -1,0 +1,194 @@
+// A camera for a scene that has none (choose_camera()): the view that frames its bounds from
+// outside, unless that view would show mostly surfaces no light reaches, as a closed room seen
+// from outside does (a black image). Then a view from inside, the one whose image shows the
+// most lit surfaces. Found by rendering an exported room (an OBJ has no camera): the
+// default view from outside was black but for a few specks, with nothing said (session 32).
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "radiosity/render.hpp"
+#include "geometry/ray_scene.hpp"
+#include "image/camera.hpp"
+
+namespace radiosity {
+inline namespace v1 {
+
+namespace {
+
+/// The scene's light as seen by a probe: the emitting polygons' centroids (the 16 strongest)
+/// and the lights, each a point to see or a direction to see free.
+class LightProbe {
+ public:
+  LightProbe(const Scene& scene, const detail::RayScene& rays) : rays_(rays) {
+    epsilon_ = 1e-4f * std::max(scene.bounds().diagonal(), 1e-6f);
+    std::vector<std::pair<float, std::size_t>> power;
+    const std::vector<Polygon>& polygons = scene.polygons();
+    for (std::size_t p = 0; p < polygons.size(); ++p) {
+      const Material& m = scene.material(polygons[p].material);
+      const float e = std::max({m.emission.x, m.emission.y, m.emission.z});
+      if (e > 0.0f) power.emplace_back(e * polygons[p].area, p);
+    }
+    const std::size_t kept = std::min<std::size_t>(power.size(), 16);
+    std::partial_sort(power.begin(), power.begin() + static_cast<std::ptrdiff_t>(kept), power.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t k = 0; k < kept; ++k) {
+      const Polygon& polygon = polygons[power[k].second];
+      glm::vec3 centroid(0.0f);
+      for (const glm::vec3& v : polygon.vertices) centroid += v;
+      centroid /= static_cast<float>(polygon.vertices.size());
+      const bool two_sided = scene.material(polygon.material).two_sided;
+      emitters_.push_back(Emitter{centroid, polygon.normal, two_sided});
+    }
+    for (const Light& light : scene.lights()) {
+      const glm::vec3 zenith = glm::length(light.direction) > 0.0f ? glm::normalize(light.direction) : glm::vec3(0, 1, 0);
+      if (light.type == LightType::point || light.type == LightType::spot)
+        points_.push_back(light.position);
+      else if (light.type == LightType::directional)
+        directions_.push_back(-zenith);
+      else
+        directions_.push_back(zenith);  // the sky: its zenith stands for it
+    }
+  }
+  bool empty() const { return emitters_.empty() && points_.empty() && directions_.empty(); }
+  /// Whether light reaches `x` on the side its unit normal `n` faces.
+  bool reaches(const glm::vec3& x, const glm::vec3& n) const {
+    const glm::vec3 o = x + epsilon_ * n;
+    for (const Emitter& e : emitters_) {
+      const glm::vec3 d = e.centroid - o;
+      if (!(glm::dot(d, n) > 0.0f) || !(e.two_sided || glm::dot(d, e.normal) < 0.0f)) continue;
+      if (!rays_.occluded(o, d, 0.0f, 1.0f - 1e-3f)) return true;
+    }
+    for (const glm::vec3& p : points_) {
+      const glm::vec3 d = p - o;
+      if (glm::dot(d, n) > 0.0f && !rays_.occluded(o, d, 0.0f, 1.0f - 1e-4f)) return true;
+    }
+    for (const glm::vec3& d : directions_)
+      if (glm::dot(d, n) > 0.0f && !rays_.occluded(o, d, 0.0f, std::numeric_limits<float>::infinity())) return true;
+    return false;
+  }
+
+ private:
+  struct Emitter {
+    glm::vec3 centroid, normal;
+    bool two_sided;
+  };
+  const detail::RayScene& rays_;
+  float epsilon_ = 0.0f;
+  std::vector<Emitter> emitters_;
+  std::vector<glm::vec3> points_, directions_;
+};
+
+/// What a camera's image shows, sampled by a kGrid x kGrid grid of rays through the pixel
+/// centres of a square image: the share of rays that meet a surface that shows light (a side a
+/// renderer shows, that some emitter or light reaches), and the share that meet a surface that
+/// shows none (the back of a one-sided polygon, black in every renderer, or a side no light
+/// reaches, as the outside of a closed room). Misses (the background) are neither.
+struct ViewContent {
+  double lit = 0.0;
+  double unlit = 0.0;
+};
+
+constexpr int kGrid = 24;
+
+ViewContent view_content(const Scene& scene, const detail::RayScene& rays, const LightProbe& light,
+                         const Camera& camera) {
+  const detail::PinholeCamera pinhole(camera, kGrid, kGrid);
+  std::vector<glm::vec3> origin(kGrid * kGrid, camera.eye), direction(kGrid * kGrid);
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x)
+      direction[static_cast<std::size_t>(y) * kGrid + x] =
+          pinhole.direction((static_cast<float>(x) + 0.5f) / kGrid, (static_cast<float>(y) + 0.5f) / kGrid);
+  std::vector<detail::RayScene::Hit> hits(origin.size());
+  std::vector<std::uint8_t> found(origin.size());
+  rays.intersect(origin.size(), origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
+                 hits.data(), found.data());
+  const auto positive = [](const Rgb& c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; };
+  ViewContent out;
+  for (std::size_t r = 0; r < origin.size(); ++r) {
+    if (!found[r]) continue;  // the background
+    const Polygon& polygon = scene.polygons()[hits[r].id];
+    const Material& m = scene.material(polygon.material);
+    const bool front = glm::dot(direction[r], hits[r].geometric_normal) < 0.0f;
+    const bool shown = front || m.two_sided || positive(m.diffuse_transmittance) || positive(m.transmittance);
+    const glm::vec3 x = camera.eye + hits[r].t * direction[r];
+    const glm::vec3 n = front ? polygon.normal : -polygon.normal;
+    // An emitter shows its own light; another side a renderer shows needs light to reach it.
+    const bool emits = (front || m.two_sided) && positive(m.emission);
+    if (shown && (emits || light.reaches(x, n)))
+      out.lit += 1.0;
+    else
+      out.unlit += 1.0;
+  }
+  out.lit /= static_cast<double>(origin.size());
+  out.unlit /= static_cast<double>(origin.size());
+  return out;
+}
+
+std::string format_vec3(const glm::vec3& v) {
+  char s[96];
+  std::snprintf(s, sizeof s, "(%.4g, %.4g, %.4g)", static_cast<double>(v.x), static_cast<double>(v.y),
+                static_cast<double>(v.z));
+  return s;
+}
+
+}  // namespace
+
+CameraChoice choose_camera(const Scene& scene) {
+  CameraChoice out;
+  out.camera = scene.camera();
+  if (scene.has_camera()) {
+    out.reason = "the scene's camera";
+    return out;
+  }
+  out.reason = "the scene has none: framing its bounds from -z";
+  if (scene.polygons().empty()) return out;
+  const detail::RayScene rays = detail::RayScene::from_polygons(scene);
+  const LightProbe light(scene, rays);
+  if (light.empty()) return out;  // nothing lights any view
+  const ViewContent outside = view_content(scene, rays, light, out.camera);
+  // A view from outside that shows mostly lit surfaces, or mostly background, is kept: an
+  // object, a city, a box open toward the camera. Only one whose surfaces are mostly unlit (a
+  // closed model seen from outside: backs, or outer sides no light reaches) is replaced.
+  if (!(outside.unlit > 0.5 * (outside.lit + outside.unlit))) return out;
+
+  // From inside: at mid height, 5 % of the way in from each side of the bounds, looking across
+  // to the opposite side (y up, as the scene formats here have it), with a wide lens.
+  const Bounds b = scene.bounds();
+  const glm::vec3 centre = 0.5f * (b.lower + b.upper), extent = b.upper - b.lower;
+  struct Candidate {
+    glm::vec3 toward;
+    const char* name;
+  };
+  const std::array<Candidate, 4> candidates = {
+      {{{0, 0, 1}, "+z"}, {{0, 0, -1}, "-z"}, {{1, 0, 0}, "+x"}, {{-1, 0, 0}, "-x"}}};
+  double best_lit = outside.lit;
+  for (const Candidate& c : candidates) {
+    Camera camera;
+    camera.eye = centre - 0.45f * glm::dot(extent, glm::abs(c.toward)) * c.toward;
+    camera.look_at = camera.eye + c.toward;
+    camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    camera.fov_deg = 60.0f;
+    const ViewContent inside = view_content(scene, rays, light, camera);
+    if (inside.lit > best_lit) {
+      best_lit = inside.lit;
+      out.camera = camera;
+      char share[160];
+      std::snprintf(share, sizeof share,
+                    "the scene has none, and from outside %.0f %% of the view is surfaces no light reaches (a "
+                    "closed model): inside, at ",
+                    100.0 * outside.unlit);
+      out.reason = share + format_vec3(camera.eye) + " looking " + c.name + ", 60 degrees (" +
+                   std::to_string(static_cast<int>(100.0 * inside.lit + 0.5)) + " % of the view lit surfaces)";
+    }
+  }
+  return out;
+}
+
+}  // namespace v1
+}  // namespace radiosity

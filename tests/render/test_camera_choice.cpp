@@ -1,0 +1,77 @@
+// choose_camera(): the camera the renderers take for a scene without one.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include <radiosity/radiosity.hpp>
+
+#include "support/scenes.hpp"
+
+namespace rad = radiosity;
+
+namespace {
+
+bool inside(const rad::Bounds& b, const glm::vec3& p) {
+  return p.x > b.lower.x && p.x < b.upper.x && p.y > b.lower.y && p.y < b.upper.y && p.z > b.lower.z &&
+         p.z < b.upper.z;
+}
+
+}  // namespace
+
+TEST_SUITE("render") {
+  TEST_CASE("choose_camera: the scene's own, the view from outside for an object, a view from inside for a closed "
+            "room - whose render is then its radiosity and not black") {
+    // A closed box whose walls face its centre, emitting E and reflecting rho: a furnace, whose
+    // every wall has B = E / (1 - rho), so every pixel seen from inside shows B / pi. From
+    // outside (Scene::camera()'s default view) a camera sees only the walls' backs: black.
+    const float E = 1.0f, rho = 0.5f;
+    rad::Material wall;
+    wall.emission = rad::Rgb(E);
+    wall.reflectance = rad::Rgb(rho);
+    const rad::Scene room = test::closed_box(wall, glm::vec3(4.0f, 3.0f, 5.0f));
+    const rad::CameraChoice chosen = rad::choose_camera(room);
+    MESSAGE(chosen.reason);
+    CHECK(inside(room.bounds(), chosen.camera.eye));
+    CHECK(chosen.reason.find("the scene has none, and from outside") == 0);
+    CHECK(chosen.reason.find("inside, at") != std::string::npos);
+    CHECK(chosen.reason.find("(100 % of the view lit surfaces)") != std::string::npos);
+
+    rad::SolveOptions so;
+    so.mesh.max_patch_area = 1.0f;
+    so.tolerance = 1e-6;
+    const rad::Solution sol = rad::solve(room, so);
+    rad::RenderOptions ro;
+    ro.width = ro.height = 16;
+    const rad::Image image = rad::render(room, sol, ro);
+    const double expected = E / (1.0 - rho) / 3.14159265358979;
+    double worst = 0.0;
+    for (const rad::Rgb& p : image.pixels) worst = std::max(worst, std::fabs(p.y - expected) / expected);
+    MESSAGE("render from the chosen camera: worst pixel " << worst << " off B / pi");
+    // A furnace is uniform: what is left is the form factors' row sums (measured 0.33 %).
+    CHECK(worst < 0.01);
+    // The view from outside, which renders used before: black.
+    ro.camera = room.camera();
+    double outside = 0.0;
+    for (const rad::Rgb& p : rad::render(room, sol, ro).pixels) outside += p.y;
+    CHECK(outside == 0.0);
+
+    // An object seen from outside (a box whose faces face out): the default view is kept.
+    rad::Scene object;
+    rad::add_box(object, {0, 0, 0}, {1, 1, 1}, object.add_material(rad::Material{}), "box");
+    const rad::CameraChoice framed = rad::choose_camera(object);
+    CHECK(framed.reason == "the scene has none: framing its bounds from -z");
+    CHECK(framed.camera.eye == object.camera().eye);
+
+    // A scene with its own camera keeps it.
+    rad::Scene with_camera = room;
+    rad::Camera own;
+    own.eye = {1, 1, 1};
+    own.look_at = {2, 1, 3};
+    with_camera.set_camera(own);
+    const rad::CameraChoice kept = rad::choose_camera(with_camera);
+    CHECK(kept.reason == "the scene's camera");
+    CHECK(kept.camera.eye == own.eye);
+    CHECK(kept.camera.look_at == own.look_at);
+  }
+}
