@@ -14,6 +14,7 @@
 
 #include "radiosity/render.hpp"
 #include "geometry/ray_scene.hpp"
+#include "core/text.hpp"
 #include "image/camera.hpp"
 
 namespace radiosity {
@@ -130,13 +131,6 @@ ViewContent view_content(const Scene& scene, const detail::RayScene& rays, const
   return out;
 }
 
-std::string format_vec3(const glm::vec3& v) {
-  char s[96];
-  std::snprintf(s, sizeof s, "(%.4g, %.4g, %.4g)", static_cast<double>(v.x), static_cast<double>(v.y),
-                static_cast<double>(v.z));
-  return s;
-}
-
 }  // namespace
 
 CameraChoice choose_camera(const Scene& scene) {
@@ -183,7 +177,7 @@ CameraChoice choose_camera(const Scene& scene) {
                     "the scene has none, and from outside %.0f %% of the view is surfaces no light reaches (a "
                     "closed model): inside, at ",
                     100.0 * outside.unlit);
-      out.reason = share + format_vec3(camera.eye) + " looking " + c.name + ", 60 degrees (" +
+      out.reason = share + detail::point_text(camera.eye) + " looking " + c.name + ", 60 degrees (" +
                    std::to_string(static_cast<int>(100.0 * inside.lit + 0.5)) + " % of the view lit surfaces)";
     }
   }

@@ -23,6 +23,7 @@
 // radiosity solutions", SIGGRAPH 1991 (surfaces split where others meet them, against light
 // and shadow leaks).
 #include "scene/overlap.hpp"
+#include "core/text.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -453,13 +454,6 @@ std::vector<PolygonOverlap> overlaps(const Scene& scene, const KeepGoing& keep_g
                           [&](const PolygonOverlap& x, const PolygonOverlap& y) { return key(x) == key(y); }),
               found.end());
   return found;
-}
-
-std::string point_text(const glm::vec3& p) {
-  char text[96];
-  std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g)", static_cast<double>(p.x), static_cast<double>(p.y),
-                static_cast<double>(p.z));
-  return text;
 }
 
 }  // namespace
