@@ -208,7 +208,9 @@ void Problem::Impl::choose_specular_depth() {
   if (o.specular_paths != SpecularPaths::automatic || !needs_extended_first_pass(scene)) return;
   automatic_specular_paths = true;
   given_form_factors = o.form_factors.method;
-  if (o.form_factors.specular_depth > 0) return;  // given: kept, but dropped over the budget under automatic
+  // A depth given is kept (with no choice to report), but under SolverMethod::automatic dropped
+  // over the budget as a chosen one is (choose_method()).
+  if (o.form_factors.specular_depth > 0) return;
   const FormFactorMethod f = o.form_factors.method;
   if (f != FormFactorMethod::automatic && f != FormFactorMethod::monte_carlo) {
     specular_depth_choice = std::string("0 (automatic: the ") + to_string(f) +
@@ -254,6 +256,7 @@ void Problem::Impl::choose_method() {
     specular_depth_choice = "0 (automatic: the rows with mirror and glass paths could need " + figure + ")";
     o.form_factors.specular_depth = 0;
     o.form_factors.emitted_through_glass = false;
+    // The estimator asked for before choose_specular_depth(), resolved at depth 0 (the report's).
     o.form_factors.method = given_form_factors;
     o.form_factors.method = choose_form_factor_method(hierarchy, o.form_factors);
   }

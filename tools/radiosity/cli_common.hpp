@@ -524,12 +524,9 @@ inline float preview_exposure(std::vector<float> values, std::string& why) {
 /// Says which estimator ran, and why when the choice was automatic.
 inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& options) {
   const rad::SolveReport& r = sol.report();
-  // Why the specular depth is 0 on a scene with mirrors or glass, unless a warning says it
-  // (dropped over the memory budget).
-  const bool warned = std::any_of(r.warnings.begin(), r.warnings.end(), [](const std::string& w) {
-    return w.rfind("specular depth 0 after all", 0) == 0;
-  });
-  const bool say_depth = !r.specular_depth_choice.empty() && r.specular_depth == 0 && !warned;
+  // Why the specular depth is 0 on a scene with mirrors or glass (dropped over the memory
+  // budget, a warning on stderr says it too).
+  const bool say_depth = !r.specular_depth_choice.empty() && r.specular_depth == 0;
   if (!r.method_choice.empty())
     std::printf("method: %s (automatic: %s; --method overrides)\n",
                 r.method == rad::SolverMethod::hierarchical ? "hierarchical" : "gauss-seidel", r.method_choice.c_str());
@@ -538,8 +535,8 @@ inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& o
     if (say_depth) std::printf("specular depth: %s\n", r.specular_depth_choice.c_str());
     return;
   }
-  const bool chosen = r.specular_depth > 0 && r.specular_depth_choice.find("automatic") != std::string::npos;
-  if (chosen) {
+  // solve() chose the extended first pass (a depth given under SpecularPaths::automatic has no choice).
+  if (r.specular_depth > 0 && !r.specular_depth_choice.empty()) {
     std::printf("form factors: %s, specular depth %s, the mirror and glass paths carried between diffuse surfaces; "
                 "--specular-depth 0 turns it off\n",
                 rad::to_string(r.form_factor_method), r.specular_depth_choice.c_str());
