@@ -493,11 +493,15 @@ inline void print_summary(const rad::Solution& sol) {
   const double emitted = double(r.emitted_power.x) + double(r.emitted_power.y) + double(r.emitted_power.z);
   const double escaped = double(r.escaped_power.x) + double(r.escaped_power.y) + double(r.escaped_power.z);
   const double lit = double(r.light_power.x) + double(r.light_power.y) + double(r.light_power.z);
+  // Escaped: emitted minus absorbed, so also what the backs of one-sided polygons took (a
+  // pane crossed from behind: what it absorbs; an outward-wound wall: all it gets).
   if (emitted > 0.0 && lit > 0.0)
-    std::printf("power: emitted %.6g W (%.6g W of it from the lights), escaped %.1f %% (left the scene)\n", emitted, lit,
-                100.0 * escaped / emitted);
+    std::printf("power: emitted %.6g W (%.6g W of it from the lights), escaped %.1f %% (left the scene or met the "
+                "back of a one-sided polygon)\n",
+                emitted, lit, 100.0 * escaped / emitted);
   else if (emitted > 0.0)
-    std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene)\n", emitted, 100.0 * escaped / emitted);
+    std::printf("power: emitted %.6g W, escaped %.1f %% (left the scene or met the back of a one-sided polygon)\n",
+                emitted, 100.0 * escaped / emitted);
 }
 
 /// The PNG preview's exposure from `values` (per pixel, its largest channel): 1, which shows a
