@@ -66,6 +66,8 @@ struct CheckResult {
   /// contact, lit correctly).
   std::size_t z_fighting = 0;
   std::vector<rad::PolygonId> facing_away;
+  /// The camera `render` would take (rad::choose_camera()).
+  rad::CameraChoice camera;
   std::optional<Estimate> estimate;
   std::string error;  ///< why `radiosity solve` would refuse the scene; empty when it would run
 };
@@ -119,6 +121,7 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   r.area = scene.total_area();
   for (const rad::Polygon& p : scene.polygons()) r.emitters += emits(scene.material(p.material)) ? 1 : 0;
   r.warnings = scene.warnings();
+  r.camera = rad::choose_camera(scene);
   if (r.polygons == 0) {
     r.error = "the scene has no polygons";
     return r;
@@ -225,6 +228,7 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
                   "materials, whose light it carries between diffuse surfaces)\n",
                   e.default_specular_depth);
   }
+  std::printf("camera: %s\n", r.camera.reason.c_str());
   if (r.error.empty())
     std::printf("result: ok, the scene can be solved\n");
   else
@@ -258,6 +262,12 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
   Json away = Json::array();
   for (rad::PolygonId p : r.facing_away) away.push_back(Json{{"polygon", p}, {"group", group_of(scene, p)}});
   j["emitters_facing_away"] = std::move(away);
+  const rad::Camera& c = r.camera.camera;
+  j["camera"] = Json{{"eye", {c.eye.x, c.eye.y, c.eye.z}},
+                     {"look_at", {c.look_at.x, c.look_at.y, c.look_at.z}},
+                     {"up", {c.up.x, c.up.y, c.up.z}},
+                     {"fov_deg", c.fov_deg},
+                     {"reason", r.camera.reason}};
   if (r.estimate) {
     const Estimate& e = *r.estimate;
     j["estimate"] = Json{{"patches", e.patches},
