@@ -102,9 +102,11 @@ struct CameraChoice {
 /// emitting polygons) or light reaches directly, as a closed room seen from outside (whose
 /// image would be black). Then a view from inside, at mid height 5 % in from a side of the
 /// bounds looking across (+z, -z, +x or -x; y up) with a 60 degree field of view: the one whose
-/// image shows the most lit surfaces, judged by 24 x 24 rays per candidate. Builds a ray scene
-/// of the polygons (Embree) when the scene has no camera and something emits. Thread safety:
-/// may be called concurrently (reads `scene` only).
+/// image shows the most lit surfaces, judged by 24 x 24 rays per candidate and a shadow ray to
+/// each emitter and light from what they meet. Builds a ray scene of the polygons (Embree) when
+/// the scene has no camera: about 1 s a million polygons, not cancellable (the renderers judge
+/// on the ray scene they build anyway). Thread safety: may be called concurrently (reads
+/// `scene` only).
 RADIOSITY_API CameraChoice choose_camera(const Scene& scene);
 
 /// Which pipeline turns a scene into an image (`radiosity render --mode`).

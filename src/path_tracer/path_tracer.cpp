@@ -39,6 +39,7 @@
 #include "image/camera.hpp"
 #include "image/image_loop.hpp"
 #include "image/image_options.hpp"
+#include "render/camera_choice.hpp"
 #include "scene/lights.hpp"
 
 namespace radiosity {
@@ -135,8 +136,10 @@ class PathTracer {
  public:
   PathTracer(const Scene& scene, const PathTraceOptions& options)
       : options_(options),
-        camera_(options.camera ? *options.camera : choose_camera(scene).camera, options.width, options.height),
         rays_(detail::RayScene::from_polygons(scene)),
+        camera_(options.camera ? *options.camera
+                               : detail::choose_camera(scene, rays_, [](std::uint32_t id) { return PolygonId{id}; }).camera,
+                options.width, options.height),
         lights_(scene.lights()),
         through_(scene, false),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
@@ -621,8 +624,8 @@ class PathTracer {
   }
 
   const PathTraceOptions& options_;
+  detail::RayScene rays_;  // before camera_: choose_camera() looks through it
   detail::PinholeCamera camera_;
-  detail::RayScene rays_;
   detail::SceneLights lights_;  ///< Scene::lights(): delta lights sampled at every vertex, the sky seen by escaping rays
   /// The delta lights' shadow rays pass windows (ior 1: straight through, times their
   /// transmittance, which is what the window's own model does to a ray), so a lamp or the sun

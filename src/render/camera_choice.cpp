@@ -12,13 +12,11 @@
 
 #include <glm/geometric.hpp>
 
-#include "radiosity/render.hpp"
-#include "geometry/ray_scene.hpp"
+#include "render/camera_choice.hpp"
 #include "core/text.hpp"
 #include "image/camera.hpp"
 
-namespace radiosity {
-inline namespace v1 {
+namespace radiosity::detail {
 
 namespace {
 
@@ -26,7 +24,7 @@ namespace {
 /// and the lights, each a point to see or a direction to see free.
 class LightProbe {
  public:
-  LightProbe(const Scene& scene, const detail::RayScene& rays) : rays_(rays) {
+  LightProbe(const Scene& scene, const RayScene& rays) : rays_(rays) {
     epsilon_ = 1e-4f * std::max(scene.bounds().diagonal(), 1e-6f);
     std::vector<std::pair<float, std::size_t>> power;
     const std::vector<Polygon>& polygons = scene.polygons();
@@ -79,7 +77,7 @@ class LightProbe {
     glm::vec3 centroid, normal;
     bool two_sided;
   };
-  const detail::RayScene& rays_;
+  const RayScene& rays_;
   float epsilon_ = 0.0f;
   std::vector<Emitter> emitters_;
   std::vector<glm::vec3> points_, directions_;
@@ -97,15 +95,16 @@ struct ViewContent {
 
 constexpr int kGrid = 24;
 
-ViewContent view_content(const Scene& scene, const detail::RayScene& rays, const LightProbe& light,
+ViewContent view_content(const Scene& scene, const RayScene& rays,
+                         const std::function<PolygonId(std::uint32_t)>& polygon_of, const LightProbe& light,
                          const Camera& camera) {
-  const detail::PinholeCamera pinhole(camera, kGrid, kGrid);
+  const PinholeCamera pinhole(camera, kGrid, kGrid);
   std::vector<glm::vec3> origin(kGrid * kGrid, camera.eye), direction(kGrid * kGrid);
   for (int y = 0; y < kGrid; ++y)
     for (int x = 0; x < kGrid; ++x)
       direction[static_cast<std::size_t>(y) * kGrid + x] =
           pinhole.direction((static_cast<float>(x) + 0.5f) / kGrid, (static_cast<float>(y) + 0.5f) / kGrid);
-  std::vector<detail::RayScene::Hit> hits(origin.size());
+  std::vector<RayScene::Hit> hits(origin.size());
   std::vector<std::uint8_t> found(origin.size());
   rays.intersect(origin.size(), origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                  hits.data(), found.data());
@@ -113,7 +112,7 @@ ViewContent view_content(const Scene& scene, const detail::RayScene& rays, const
   ViewContent out;
   for (std::size_t r = 0; r < origin.size(); ++r) {
     if (!found[r]) continue;  // the background
-    const Polygon& polygon = scene.polygons()[hits[r].id];
+    const Polygon& polygon = scene.polygons()[polygon_of(hits[r].id)];
     const Material& m = scene.material(polygon.material);
     const bool front = glm::dot(direction[r], hits[r].geometric_normal) < 0.0f;
     const bool shown = front || m.two_sided || positive(m.diffuse_transmittance) || positive(m.transmittance);
@@ -133,7 +132,8 @@ ViewContent view_content(const Scene& scene, const detail::RayScene& rays, const
 
 }  // namespace
 
-CameraChoice choose_camera(const Scene& scene) {
+CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
+                           const std::function<PolygonId(std::uint32_t)>& polygon_of) {
   CameraChoice out;
   out.camera = scene.camera();
   if (scene.has_camera()) {
@@ -142,10 +142,9 @@ CameraChoice choose_camera(const Scene& scene) {
   }
   out.reason = "the scene has none: framing its bounds from -z";
   if (scene.polygons().empty()) return out;
-  const detail::RayScene rays = detail::RayScene::from_polygons(scene);
   const LightProbe light(scene, rays);
   if (light.empty()) return out;  // nothing lights any view
-  const ViewContent outside = view_content(scene, rays, light, out.camera);
+  const ViewContent outside = view_content(scene, rays, polygon_of, light, out.camera);
   // A view from outside that shows mostly lit surfaces, or mostly background, is kept: an
   // object, a city, a box open toward the camera. Only one whose surfaces are mostly unlit (a
   // closed model seen from outside: backs, or outer sides no light reaches) is replaced.
@@ -168,7 +167,7 @@ CameraChoice choose_camera(const Scene& scene) {
     camera.look_at = camera.eye + c.toward;
     camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
     camera.fov_deg = 60.0f;
-    const ViewContent inside = view_content(scene, rays, light, camera);
+    const ViewContent inside = view_content(scene, rays, polygon_of, light, camera);
     if (inside.lit > best_lit) {
       best_lit = inside.lit;
       out.camera = camera;
@@ -177,11 +176,27 @@ CameraChoice choose_camera(const Scene& scene) {
                     "the scene has none, and from outside %.0f %% of the view is surfaces no light reaches (a "
                     "closed model): inside, at ",
                     100.0 * outside.unlit);
-      out.reason = share + detail::point_text(camera.eye) + " looking " + c.name + ", 60 degrees (" +
+      out.reason = share + point_text(camera.eye) + " looking " + c.name + ", 60 degrees (" +
                    std::to_string(static_cast<int>(100.0 * inside.lit + 0.5)) + " % of the view lit surfaces)";
     }
   }
   return out;
+}
+
+}  // namespace radiosity::detail
+
+namespace radiosity {
+inline namespace v1 {
+
+CameraChoice choose_camera(const Scene& scene) {
+  if (scene.has_camera() || scene.polygons().empty()) {
+    CameraChoice out;
+    out.camera = scene.camera();
+    out.reason = scene.has_camera() ? "the scene's camera" : "the scene has none: framing its bounds from -z";
+    return out;
+  }
+  const detail::RayScene rays = detail::RayScene::from_polygons(scene);
+  return detail::choose_camera(scene, rays, [](std::uint32_t id) { return PolygonId{id}; });
 }
 
 }  // namespace v1

@@ -19,6 +19,7 @@
 #include "image/image_loop.hpp"
 #include "image/image_options.hpp"
 #include "radiosity/render.hpp"
+#include "render/camera_choice.hpp"
 #include "scene/lights.hpp"
 #include "solver/light_groups.hpp"
 
@@ -42,10 +43,14 @@ Image render(const Scene& scene, const Solution& solution, const RenderOptions& 
     if (p.polygon >= scene.polygons().size())
       throw Error(ErrorCode::invalid_argument, "render: the solution was not made from this scene");
 
-  Camera camera_settings = options.camera ? *options.camera : choose_camera(scene).camera;
-  const detail::PinholeCamera camera(camera_settings, options.width, options.height);
   const detail::RayScene rays =
       detail::RayScene::from_leaves(hierarchy, detail::RayScene::backs_inside(scene, hierarchy));
+  const Camera camera_settings =
+      options.camera ? *options.camera
+                     : detail::choose_camera(scene, rays, [&](std::uint32_t element) {
+                         return hierarchy.patches()[hierarchy.element(element).patch].polygon;
+                       }).camera;
+  const detail::PinholeCamera camera(camera_settings, options.width, options.height);
   const std::vector<Rgb> vertex_B = solution.vertex_radiosity(options.ambient);
   const std::vector<Rgb> vertex_back = solution.vertex_back_radiosity();  // empty: every back is black
   // A ray that hits nothing sees the sky, at its light group's weight in a relit solution.

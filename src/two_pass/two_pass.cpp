@@ -36,6 +36,7 @@
 #include "image/camera.hpp"
 #include "image/image_loop.hpp"
 #include "image/image_options.hpp"
+#include "render/camera_choice.hpp"
 #include "two_pass/photon_map.hpp"
 #include "two_pass/specular_scene.hpp"
 
@@ -77,8 +78,14 @@ class TwoPassRenderer {
  public:
   TwoPassRenderer(const Scene& scene, const Solution& pass1, const TwoPassOptions& options, TwoPassReport& report)
       : options_(options),
-        camera_(options.camera ? *options.camera : choose_camera(scene).camera, options.width, options.height),
         scene_(traced_scene(scene, pass1)),
+        camera_(options.camera ? *options.camera
+                               : detail::choose_camera(scene, scene_.rays(),
+                                                       [this](std::uint32_t element) {
+                                                         return scene_.polygon_of_element(element);
+                                                       })
+                                     .camera,
+                options.width, options.height),
         g_(static_cast<int>(std::ceil(std::sqrt(static_cast<double>(options.spp)) - 1e-9))) {
     auto start = std::chrono::steady_clock::now();
     vertex_B_ = pass1.vertex_radiosity(options.ambient);
@@ -371,8 +378,8 @@ class TwoPassRenderer {
   }
 
   const TwoPassOptions& options_;
+  detail::SpecularScene scene_;  // before camera_: choose_camera() looks through its rays
   detail::PinholeCamera camera_;
-  detail::SpecularScene scene_;
   int g_;
   std::vector<Rgb> vertex_B_;
   std::vector<Rgb> vertex_back_;  ///< pass 1's radiosity of translucent backs, or empty (black backs)

@@ -50,6 +50,28 @@ TEST_SUITE("render") {
     MESSAGE("render from the chosen camera: worst pixel " << worst << " off B / pi");
     // A furnace is uniform: what is left is the form factors' row sums (measured 0.33 %).
     CHECK(worst < 0.01);
+    // The two-pass view (nothing specular: the display's image) and the path tracer look from
+    // the same chosen camera.
+    rad::TwoPassOptions to;
+    to.width = to.height = 16;
+    to.spp = 4;
+    const rad::Image two_pass = rad::render_two_pass(room, sol, to);
+    double display_sum = 0.0, two_pass_sum = 0.0;
+    for (std::size_t k = 0; k < image.pixels.size(); ++k) {
+      display_sum += image.pixels[k].y;
+      two_pass_sum += two_pass.pixels[k].y;
+    }
+    CHECK(two_pass_sum == doctest::Approx(display_sum).epsilon(1e-4));
+    rad::PathTraceOptions po;
+    po.width = po.height = 16;
+    po.spp = 64;
+    double traced = 0.0;
+    for (const rad::Rgb& p : rad::render_path_traced(room, po).pixels) traced += p.y;
+    traced /= 256.0;
+    MESSAGE("path traced from the chosen camera: mean pixel " << traced << ", B / pi = " << expected);
+    // 16 384 paths of a furnace with rho 0.5: the mean's noise is well under 2 %.
+    CHECK(traced == doctest::Approx(expected).epsilon(0.02));
+
     // The view from outside, which renders used before: black.
     ro.camera = room.camera();
     double outside = 0.0;
