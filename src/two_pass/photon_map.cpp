@@ -91,7 +91,9 @@ void trace_photon(const SpecularScene& scene, const PhotonOptions& options, int 
     const bool reflected = (sample->wi.z > 0.0f) == (wo.z > 0.0f);
     const bool glass = pass1_glass && s.pass1_glass;
     pass1_kind = pass1_kind && sample->delta && (glass || (reflected ? s.pass1_mirror : s.pass1_window));
-    mirrors += reflected ? 1 : 0;
+    // Pass 1 carries glass either way: a reflection beyond its depth goes on straight there
+    // (monte_carlo.cpp), so with `pass1_glass` only mirrors count toward the depth.
+    mirrors += reflected && !glass ? 1 : 0;
     dir = glm::normalize(frame.to_world(sample->wi));
     origin = x + scene.epsilon() * (glm::dot(dir, s.normal) > 0.0f ? s.normal : -s.normal);
     ++specular;
@@ -116,7 +118,8 @@ PhotonShoot shoot_caustic_photons(const SpecularScene& scene, const PhotonOption
   parallel_for(threads, blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       const std::size_t last = std::min(options.photons, (b + 1) * kPhotonBlock);
-      for (std::size_t k = b * kPhotonBlock; k < last; ++k) trace_photon(scene, options, pass1_depth, pass1_glass, seed, k, stored[b]);
+      for (std::size_t k = b * kPhotonBlock; k < last; ++k)
+        trace_photon(scene, options, pass1_depth, pass1_glass, seed, k, stored[b]);
       const std::size_t now = held.fetch_add(stored[b].size()) + stored[b].size();
       if (now > most)
         refuse_memory("the caustic photon map (" + std::to_string(now) + " photons stored after " +
