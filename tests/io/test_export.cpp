@@ -358,6 +358,24 @@ TEST_CASE("write_stats_json names the estimator that ran, and none for the hiera
   }
 }
 
+TEST_CASE("write_stats_json records the specular depth solve() chose for a scene with glass, and why") {
+  const radiosity::Scene scene = radiosity::cornell_box_specular(radiosity::CornellSpecular::glass);
+  radiosity::SolveOptions opt;
+  opt.mesh.max_patch_area = 40000.0f;
+  const fs::path path = kTmp / "stats_specular.json";
+  radiosity::write_stats_json(radiosity::solve(scene, opt), path, opt, "cornell-glass");
+  const nlohmann::json j = nlohmann::json::parse(read_all(path));
+  CHECK(j.at("specular_depth_used") == 1);
+  CHECK(j.at("specular_depth_choice") == "1 (automatic: the scene has mirror or glass materials)");
+  CHECK(j.at("emitted_through_glass") == true);
+  // Without glass or mirrors: depth 0, no choice.
+  radiosity::write_stats_json(radiosity::solve(radiosity::cornell_box(), opt), path, opt, "cornell");
+  const nlohmann::json plain = nlohmann::json::parse(read_all(path));
+  CHECK(plain.at("specular_depth_used") == 0);
+  CHECK(plain.at("specular_depth_choice") == "");
+  CHECK(plain.at("emitted_through_glass") == false);
+}
+
 TEST_CASE("write_stats_json with options records the scene and the solve's method") {
   const radiosity::Solution sol = small_solution();
   radiosity::SolveOptions opt;

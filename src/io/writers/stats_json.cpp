@@ -91,6 +91,9 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   j["light_rays"] = r.light_rays;
   j["method_used"] = method_name(r.method);
   j["method_choice"] = r.method_choice;
+  j["specular_depth_used"] = r.specular_depth;
+  j["specular_depth_choice"] = r.specular_depth_choice;
+  j["emitted_through_glass"] = r.emitted_through_glass;
   j["mesh"] = Json{{"max_patch_area", number(solution.hierarchy().options().max_patch_area)},
                    {"max_element_area", number(solution.hierarchy().options().max_element_area)}};
   j["emitted_power"] = rgb(r.emitted_power);
