@@ -97,7 +97,8 @@ struct CameraChoice {
 };
 
 /// The scene's camera when it has one (Scene::has_camera()). Otherwise Scene::camera()'s view
-/// framing the bounds from -z, unless most of the surfaces that view meets show no light: the
+/// framing the bounds from -z, unless most of the surfaces that view meets (and a quarter of
+/// the view at least) show no light: the
 /// backs of one-sided polygons, or sides that no emitter (the centroids of the 16 strongest
 /// emitting polygons) or light reaches directly, as a closed room seen from outside (whose
 /// image would be black). Then a view from inside, at mid height 5 % in from a side of the

@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 
 #include "render/camera_choice.hpp"
+#include "core/frame.hpp"
 #include "core/text.hpp"
 #include "image/camera.hpp"
 
@@ -21,7 +22,7 @@ namespace radiosity::detail {
 namespace {
 
 /// The scene's light as seen by a probe: the emitting polygons' centroids (the 16 strongest)
-/// and the lights, each a point to see or a direction to see free.
+/// and the lights, each a point to see or a direction to see free (a sky: five directions).
 class LightProbe {
  public:
   LightProbe(const Scene& scene, const RayScene& rays) : rays_(rays) {
@@ -50,8 +51,13 @@ class LightProbe {
         points_.push_back(light.position);
       else if (light.type == LightType::directional)
         directions_.push_back(-zenith);
-      else
-        directions_.push_back(zenith);  // the sky: its zenith stands for it
+      else {
+        // The sky: its zenith and four directions 60 degrees down from it, so that walls see it.
+        const Frame frame(zenith);
+        directions_.push_back(zenith);
+        for (const glm::vec2 a : {glm::vec2(1, 0), glm::vec2(-1, 0), glm::vec2(0, 1), glm::vec2(0, -1)})
+          directions_.push_back(frame.to_world(glm::vec3(0.8660254f * a.x, 0.8660254f * a.y, 0.5f)));
+      }
     }
   }
   bool empty() const { return emitters_.empty() && points_.empty() && directions_.empty(); }
@@ -148,7 +154,8 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
   // A view from outside that shows mostly lit surfaces, or mostly background, is kept: an
   // object, a city, a box open toward the camera. Only one whose surfaces are mostly unlit (a
   // closed model seen from outside: backs, or outer sides no light reaches) is replaced.
-  if (!(outside.unlit > 0.5 * (outside.lit + outside.unlit))) return out;
+  // (A closed room framed by its bounding sphere fills about 40 % of the view.)
+  if (!(outside.unlit > 0.5 * (outside.lit + outside.unlit) && outside.unlit > 0.25)) return out;
 
   // From inside: at mid height, 5 % of the way in from each side of the bounds, looking across
   // to the opposite side (y up, as the scene formats here have it), with a wide lens.

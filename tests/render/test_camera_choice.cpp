@@ -85,6 +85,20 @@ TEST_SUITE("render") {
     CHECK(framed.reason == "the scene has none: framing its bounds from -z");
     CHECK(framed.camera.eye == object.camera().eye);
 
+    // Blocks on a ground under a sky (no emitter): their walls see the sky too, so the view
+    // from outside is kept.
+    rad::Scene blocks;
+    const rad::MaterialId grey = blocks.add_material(rad::Material{});
+    blocks.add_polygon({{-50, 0, -50}, {-50, 0, 50}, {50, 0, 50}, {50, 0, -50}}, grey, "ground");
+    for (int i = -2; i <= 2; ++i)
+      for (int j = -2; j <= 2; ++j)
+        rad::add_box(blocks, {i * 12.0f - 4, 0, j * 12.0f - 4}, {i * 12.0f + 4, 10.0f + 3.0f * ((i + j) & 3), j * 12.0f + 4},
+                     grey, "building");
+    rad::Light sky;
+    sky.type = rad::LightType::sky;
+    blocks.add_light(sky);
+    CHECK(rad::choose_camera(blocks).reason == "the scene has none: framing its bounds from -z");
+
     // A scene with its own camera keeps it.
     rad::Scene with_camera = room;
     rad::Camera own;
