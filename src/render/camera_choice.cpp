@@ -136,18 +136,23 @@ ViewContent view_content(const Scene& scene, const RayScene& rays,
   return out;
 }
 
+/// The choice that needs no look: the scene's camera, or Scene::camera()'s view from -z.
+CameraChoice unjudged_choice(const Scene& scene) {
+  CameraChoice out;
+  out.camera = scene.camera();
+  out.reason = scene.has_camera() ? "the scene's camera" : "the scene has none: framing its bounds from -z";
+  return out;
+}
+
+/// Whether there is a view to judge: no camera of the scene's own, and something to see.
+bool judged(const Scene& scene) { return !scene.has_camera() && !scene.polygons().empty(); }
+
 }  // namespace
 
 CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
                            const std::function<PolygonId(std::uint32_t)>& polygon_of) {
-  CameraChoice out;
-  out.camera = scene.camera();
-  if (scene.has_camera()) {
-    out.reason = "the scene's camera";
-    return out;
-  }
-  out.reason = "the scene has none: framing its bounds from -z";
-  if (scene.polygons().empty()) return out;
+  CameraChoice out = unjudged_choice(scene);
+  if (!judged(scene)) return out;
   const LightProbe light(scene, rays);
   if (light.empty()) return out;  // nothing lights any view
   const ViewContent outside = view_content(scene, rays, polygon_of, light, out.camera);
@@ -196,12 +201,7 @@ namespace radiosity {
 inline namespace v1 {
 
 CameraChoice choose_camera(const Scene& scene) {
-  if (scene.has_camera() || scene.polygons().empty()) {
-    CameraChoice out;
-    out.camera = scene.camera();
-    out.reason = scene.has_camera() ? "the scene's camera" : "the scene has none: framing its bounds from -z";
-    return out;
-  }
+  if (!detail::judged(scene)) return detail::unjudged_choice(scene);  // no ray scene needed
   const detail::RayScene rays = detail::RayScene::from_polygons(scene);
   return detail::choose_camera(scene, rays, [](std::uint32_t id) { return PolygonId{id}; });
 }
