@@ -292,6 +292,19 @@ TEST_CASE("a missing OBJ file or an unsupported extension is an error naming the
   CHECK(contains(ext.what(), "'.abc'"));
 }
 
+TEST_CASE("an mtllib line naming one file with spaces (as Blender writes it) reads that file; two files still split") {
+  write_tmp("room mm.mtl", "newmtl plaster\nKd 0.7 0.7 0.7\n");
+  const radiosity::Scene s = radiosity::load_scene(
+      write_tmp("spaced_library.obj", "mtllib room mm.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl plaster\nf 1 2 3\n"));
+  CHECK(s.warnings().empty());
+  CHECK(near(s.material(s.polygons()[0].material).reflectance, Rgb(0.7f)));
+  // Where the whole line is no file, its words are files, as before: "room" and "nosuch.mtl".
+  const radiosity::Scene split = radiosity::load_scene(
+      write_tmp("split_library.obj", "mtllib room nosuch.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
+  REQUIRE(!split.warnings().empty());
+  CHECK(contains(split.warnings()[0], "material library 'room' not found"));
+}
+
 TEST_CASE("a missing MTL file gives the default grey with a warning - an error naming the mtllib line under strict") {
   radiosity::Scene s = radiosity::load_scene(kData / "missing_mtl.obj");
   REQUIRE(!s.polygons().empty());

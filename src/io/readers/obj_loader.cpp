@@ -508,7 +508,16 @@ ObjFile read_obj(const fs::path& file, std::string_view text, ReaderWarnings& wa
       obj.materials.push_back(UseMaterial{words.next(), line_no, after_mtllib});
     } else if (key == "mtllib") {
       after_mtllib = true;
-      const std::vector<std::string> names = mtllib_names(trim(words.rest()));
+      const std::string_view rest = trim(words.rest());
+      std::vector<std::string> names = mtllib_names(rest);
+      if (names.size() > 1) {
+        // Blender and several CAD exporters write a file name with spaces as it is ("mtllib
+        // room mm.mtl"), as Assimp reads it: the whole line names one file when that file exists.
+        fs::path whole{std::string(rest)};
+        if (whole.is_relative()) whole = file.parent_path() / whole;
+        std::error_code ec;
+        if (fs::is_regular_file(whole, ec)) names.assign(1, std::string(rest));
+      }
       if (names.empty())
         warnings.forgive("empty mtllib", ErrorCode::parse_error, loc(file, line_no), "mtllib without a file name",
                          "ignored");
