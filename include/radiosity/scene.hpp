@@ -438,6 +438,10 @@ struct OutwardFacing {
   std::vector<PolygonId> polygons;  ///< in polygon order
   double area = 0.0;                ///< theirs, scene units^2
   double one_sided_area = 0.0;      ///< of every polygon tested (the one-sided ones)
+  /// Whether they are more than half of the one-sided area: a closed model wound outward (a
+  /// roof under an open sky is found too, but it is not most of a scene). `radiosity check`
+  /// warns then, and so does solve() when most of the emitted light escaped.
+  bool looks_wound_outward() const { return one_sided_area > 0.0 && area > 0.5 * one_sided_area; }
 };
 
 /// One-sided polygons (material neither two-sided nor translucent, nor glass) that look wound
@@ -447,8 +451,8 @@ struct OutwardFacing {
 /// 4 x 4 grid, directions shuffled against the points); a polygon is reported when at most 1
 /// of its front's rays and at least 15 of its back's meet a polygon. An exterior seen alone (a
 /// box with nothing around it) is reported too, and so is a roof under an open sky (its back
-/// sees the building's inside), so the caller judges the share of the one-sided area:
-/// `radiosity check` warns above half of it. Rays cannot judge a polygon coincident with another
+/// sees the building's inside), so the caller judges the share of the one-sided area
+/// (OutwardFacing::looks_wound_outward()). Rays cannot judge a polygon coincident with another
 /// (find_overlaps(): a box's bottom on a floor), so such pairs are reported so that turning the
 /// polygons found leaves them facing opposite ways (in contact), not the same way: of a pair
 /// facing the same way one (the larger, when rays found both: the floor, not the box's bottom),

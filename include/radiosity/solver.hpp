@@ -460,12 +460,14 @@ class RADIOSITY_API Problem {
 /// consistent estimate with status cancelled (cancelled while meshing, which reports
 /// Phase::meshing: a Solution without elements or meshes).
 /// Light that leaves the scene is diagnosed in SolveReport::warnings: emitters that face away
-/// from every surface (find_emitters_facing_away()), and, for a converged solve, a scene that
-/// looks closed (over 95 % of the emitters' light meets a polygon directly, by rays) but loses
-/// more than half its emitted power (SolveReport::escaped_power): light that arrives at the
-/// back of a one-sided polygon is lost, so its polygons probably face outwards (not judged when
-/// the scene's lights reach surfaces: their reflected light leaves open scenes as a matter of
-/// course).
+/// from every surface (find_emitters_facing_away()), apart from those that lie against a
+/// polygon facing them (in contact: a fixture's top against a ceiling), and, for a converged
+/// solve, a scene that looks closed (over 95 % of the emitters' light meets a polygon directly,
+/// by rays) but loses more than half its emitted power (SolveReport::escaped_power): light that
+/// arrives at the back of a one-sided polygon is lost, so its polygons probably face outwards
+/// (not judged when the scene's lights reach surfaces: their reflected light leaves open scenes
+/// as a matter of course); when the emitters' own light leaves too, the same is said when
+/// find_polygons_facing_outward() finds most of the one-sided area wound outward.
 /// The same as Problem(scene, options).solve(), without keeping the Problem.
 /// Thread safety: concurrent calls are safe.
 RADIOSITY_API Solution solve(const Scene& scene, const SolveOptions& options = {});

@@ -12,7 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <iterator>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -118,31 +120,67 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
   const std::vector<EmitterReach> reach = emitter_reach(scene, threads, emission);
   if (reach.empty()) return warnings;
 
-  // Emitters that see nothing, by group in order of first appearance.
-  std::vector<std::pair<GroupId, std::vector<PolygonId>>> away;
-  std::size_t away_polygons = 0;
-  for (const EmitterReach& r : reach) {
-    if (r.hit_fraction > 0.0) continue;
-    const GroupId g = scene.polygons()[r.polygon].group;
-    auto it = std::find_if(away.begin(), away.end(), [g](const auto& entry) { return entry.first == g; });
-    if (it == away.end()) it = away.insert(away.end(), {g, {}});
-    it->second.push_back(r.polygon);
-    ++away_polygons;
-  }
-  if (!away.empty()) {
-    constexpr std::size_t kGroupsShown = 4;
-    std::string who;
-    for (std::size_t k = 0; k < away.size() && k < kGroupsShown; ++k) {
-      if (k > 0) who += k + 1 == away.size() ? " and " : ", ";
-      who += "'" + scene.groups()[away[k].first] + "' (polygon" + (away[k].second.size() > 1 ? "s " : " ") +
-             id_list(away[k].second) + ")";
+  // find_overlaps() (0.5 s at 246k polygons) only when something needs it, and once.
+  std::optional<std::vector<PolygonOverlap>> overlaps;
+  auto overlaps_found = [&]() -> const std::vector<PolygonOverlap>& {
+    if (!overlaps) overlaps = find_overlaps(scene);
+    return *overlaps;
+  };
+
+  // Emitters that see nothing, by group in order of first appearance; apart, those that lie
+  // against another polygon facing them (a light fixture's top against the ceiling): turning
+  // them would not help, their light has nowhere to go.
+  std::vector<PolygonId> seeing_nothing;
+  for (const EmitterReach& r : reach)
+    if (!(r.hit_fraction > 0.0)) seeing_nothing.push_back(r.polygon);
+  std::vector<PolygonId> against;
+  if (!seeing_nothing.empty())
+    for (const PolygonOverlap& o : overlaps_found()) {
+      if (o.kind != OverlapKind::coincident ||
+          glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) >= 0.0f)
+        continue;
+      for (const PolygonId p : {o.first, o.second})
+        if (std::binary_search(seeing_nothing.begin(), seeing_nothing.end(), p)) against.push_back(p);
     }
-    if (away.size() > kGroupsShown) who += " and " + std::to_string(away.size() - kGroupsShown) + " more groups";
-    const bool many = away_polygons > 1;
-    warnings.push_back(std::string(many ? "emitters " : "emitter ") + who +
+  std::sort(against.begin(), against.end());
+  against.erase(std::unique(against.begin(), against.end()), against.end());
+
+  constexpr std::size_t kGroupsShown = 4;
+  // "'lamp' (polygon 3), 'desk' (polygons 5, 6) and 2 more groups" for polygons in order.
+  auto by_group = [&](const std::vector<PolygonId>& polygons) {
+    std::vector<std::pair<GroupId, std::vector<PolygonId>>> groups;
+    for (const PolygonId p : polygons) {
+      const GroupId g = scene.polygons()[p].group;
+      auto it = std::find_if(groups.begin(), groups.end(), [g](const auto& entry) { return entry.first == g; });
+      if (it == groups.end()) it = groups.insert(groups.end(), {g, {}});
+      it->second.push_back(p);
+    }
+    std::string who;
+    for (std::size_t k = 0; k < groups.size() && k < kGroupsShown; ++k) {
+      if (k > 0) who += k + 1 == groups.size() ? " and " : ", ";
+      who += "'" + scene.groups()[groups[k].first] + "' (polygon" + (groups[k].second.size() > 1 ? "s " : " ") +
+             id_list(groups[k].second) + ")";
+    }
+    if (groups.size() > kGroupsShown) who += " and " + std::to_string(groups.size() - kGroupsShown) + " more groups";
+    return who;
+  };
+  std::vector<PolygonId> away;
+  std::set_difference(seeing_nothing.begin(), seeing_nothing.end(), against.begin(), against.end(),
+                      std::back_inserter(away));
+  if (!away.empty()) {
+    const bool many = away.size() > 1;
+    warnings.push_back(std::string(many ? "emitters " : "emitter ") + by_group(away) +
                        (many ? " face away from every surface: their light leaves the scene; check the polygons' "
                              : " faces away from every surface: its light leaves the scene; check the polygon's ") +
                        "winding (vertex order) or use two-sided materials (--two-sided)");
+  }
+  if (!against.empty()) {
+    const bool many = against.size() > 1;
+    warnings.push_back(std::string(many ? "emitters " : "emitter ") + by_group(against) +
+                       (many ? " lie against polygons facing them (in contact): their light is lost there; give "
+                               "them no emission or remove them"
+                             : " lies against a polygon facing it (in contact): its light is lost there; give it no "
+                               "emission or remove it"));
   }
 
   // A closed-looking scene that loses most of its light.
@@ -154,12 +192,28 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
       power += r.power;
       reached += r.power * r.hit_fraction;
     }
+    char share[32];
+    std::snprintf(share, sizeof share, "%.0f", 100.0 * lost / total);
     if (power > 0.0 && reached > 0.95 * power) {
-      char share[32];
-      std::snprintf(share, sizeof share, "%.0f", 100.0 * lost / total);
       warnings.push_back(std::string("the scene looks closed but ") + share +
                          " % of the emitted light left it: polygons probably face outwards (wound the wrong way); "
                          "reverse their winding (--reverse-winding outward) or use two-sided materials (--two-sided)");
+    } else {
+      // The emitters' own rays may leave (a light fixture modelled as a box wound outward, its
+      // top against the ceiling) while the room around them is wound outward too: ask the
+      // polygons themselves, as `radiosity check` does. Only here, where most light escaped,
+      // since it costs rays from every one-sided polygon and find_overlaps().
+      const OutwardFacing outward = find_polygons_facing_outward(scene, overlaps_found());
+      if (outward.looks_wound_outward()) {
+        char area_share[32];
+        std::snprintf(area_share, sizeof area_share, "%.0f", 100.0 * outward.area / outward.one_sided_area);
+        warnings.push_back(std::string(share) + " % of the emitted light left the scene, and " +
+                           std::to_string(outward.polygons.size()) + " of " + std::to_string(scene.polygons().size()) +
+                           " polygons (" + area_share +
+                           " % of the one-sided area) see nothing in front of them and surfaces behind: a closed "
+                           "model wound outward? Reverse their winding (--reverse-winding outward) or use "
+                           "two-sided materials (--two-sided)");
+      }
     }
   }
   return warnings;

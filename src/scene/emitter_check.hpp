@@ -38,11 +38,16 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads = 0
                                         const std::vector<Rgb>* emission = nullptr);
 
 /// The warnings of solve() about escaped light, given the power balance of a solve:
-/// - emitters whose front sees no polygon at all (named with their polygons and groups);
+/// - emitters whose front sees no polygon at all (named with their polygons and groups), those
+///   that lie against a polygon facing them (find_overlaps(): coincident, opposite normals) in
+///   a warning of their own (turning them would not help);
 /// - when `balanced` (the solve converged, so emitted - absorbed is light that left rather than
 ///   light not yet propagated), more than 95 % of the emitters' light meets a surface directly
 ///   (the scene looks closed) and yet more than half of the emitted power escaped: light that
-///   arrives at the backs of one-sided polygons is lost, so they probably face outwards.
+///   arrives at the backs of one-sided polygons is lost, so they probably face outwards;
+/// - when `balanced` and more than half escaped but the emitters' own rays leave too (a light
+///   fixture wound outward inside a room wound outward), the same when
+///   find_polygons_facing_outward() finds most of the one-sided area wound outward.
 /// `emitted` and `escaped` are W per channel; nothing is cast when nothing emits. `emission` as
 /// for emitter_reach().
 std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& emitted, const Rgb& escaped,

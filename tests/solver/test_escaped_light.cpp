@@ -104,6 +104,38 @@ TEST_SUITE("solver") {
     CHECK(rad::find_emitters_facing_away(scene).empty());
   }
 
+  TEST_CASE("escaped power: a room and its light fixture both wound outward are said to be, though the fixture's light leaves") {
+    // As a CAD exporter writes a room with a box-shaped ceiling light: every solid's facets point
+    // out of it, and the fixture's top lies against the ceiling. Half of the fixture's light
+    // (its top) leaves the scene at once, so "looks closed" (the emitters' rays meet surfaces)
+    // cannot judge it; the polygons' own rays can.
+    rad::Scene scene;
+    const rad::MaterialId white = scene.add_material(rad::Material{});
+    const rad::MaterialId light = scene.add_material(lamp());
+    rad::add_box(scene, {0, 0, 0}, {4, 2.7f, 3}, white, "room");
+    rad::add_box(scene, {1.8f, 2.69f, 1.2f}, {2.4f, 2.7f, 1.6f}, light, "fixture");
+    const rad::Solution sol = rad::solve(scene, coarse());
+    const rad::SolveReport& r = sol.report();
+    REQUIRE(sol.status() == rad::SolveStatus::converged);
+    CHECK(share(r.escaped_power, r.emitted_power) > 0.9);
+    CHECK(!has_warning(r, "looks closed"));
+    CHECK(has_warning(r, "% of the emitted light left the scene, and 6 of 12 polygons"));
+    CHECK(has_warning(r, "a closed model wound outward? Reverse their winding (--reverse-winding outward)"));
+
+    // What the warning asks for: the room turned, the light stays in but for the fixture's top
+    // (48 % of its area), which lies against the ceiling and sends into its back.
+    const rad::OutwardFacing outward = rad::find_polygons_facing_outward(scene);
+    CHECK(outward.looks_wound_outward());
+    scene.reverse_winding(outward.polygons);
+    const rad::Solution fixed = rad::solve(scene, coarse());
+    CHECK(share(fixed.report().escaped_power, fixed.report().emitted_power) == doctest::Approx(0.48).epsilon(0.02));
+    CHECK(!has_warning(fixed.report(), "wound outward"));
+    // The fixture's top: no use turning it, and no "faces away" that would ask for that.
+    CHECK(has_warning(fixed.report(), "emitter 'fixture' (polygon 9) lies against a polygon facing it (in contact): "
+                                      "its light is lost there; give it no emission or remove it"));
+    CHECK(!has_warning(fixed.report(), "faces away"));
+  }
+
   TEST_CASE("escaped power: the same room made two-sided keeps its light, and is said to be lit on its back") {
     // What a user does on the warning above (--two-sided): the light stays, but the room's lit
     // side is the back of its polygons, which lightmaps and per-vertex values do not hold.
@@ -141,6 +173,7 @@ TEST_SUITE("solver") {
     CHECK(has_warning(r, "emitter 'light' (polygon 1) faces away from every surface: its light leaves the scene; "
                          "check the polygon's winding (vertex order) or use two-sided materials"));
     CHECK(!has_warning(r, "looks closed"));
+    CHECK(!has_warning(r, "wound outward"));
   }
 
   TEST_CASE("escaped power: a light facing down onto an open floor is not flagged though most light escapes") {

@@ -140,7 +140,7 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     // A closed model wound outward: most of the one-sided area sees nothing in front and
     // surfaces behind (a roof under an open sky does too, but it is not most of a scene).
     const rad::OutwardFacing outward = rad::find_polygons_facing_outward(scene, r.overlaps);
-    if (outward.one_sided_area > 0.0 && outward.area > 0.5 * outward.one_sided_area) {
+    if (outward.looks_wound_outward()) {
       char share[32];
       std::snprintf(share, sizeof share, "%.0f", 100.0 * outward.area / outward.one_sided_area);
       r.warnings.push_back(std::to_string(outward.polygons.size()) + " of " + std::to_string(scene.polygons().size()) +
