@@ -90,19 +90,24 @@ RADIOSITY_API Image render(const Scene& scene, const Solution& solution, const R
 /// The camera the renderers take when ImageOptions::camera is not set, and why.
 struct CameraChoice {
   Camera camera;
-  /// e.g. "the scene's camera", "the scene has none: framing its bounds from -z", or "the scene
-  /// has none, and from outside 44 % of the view is surfaces no light reaches (a closed model):
-  /// inside, at (2, 1.5, 0.2) looking +z, 60 degrees (100 % of the view lit surfaces)".
+  /// e.g. "the scene's camera", "the scene has none: framing its bounds from -y (z up: the
+  /// sky's zenith)", or "the scene has none, and from outside 44 % of the view is surfaces no
+  /// light reaches (a closed model): inside, at (2, 1.5, 0.2) looking +z, 60 degrees (100 % of
+  /// the view lit surfaces; y up: the emitters face down -y)".
   std::string reason;
 };
 
-/// The scene's camera when it has one (Scene::has_camera()). Otherwise Scene::camera()'s view
-/// framing the bounds from -z, unless most of the surfaces that view meets (and a quarter of
-/// the view at least) show no light: the
+/// The scene's camera when it has one (Scene::has_camera()). Otherwise a view framing the
+/// bounds from the side with the scene's up: Scene::camera()'s view from -z when y is up, from
+/// -y when z is up. The up is a sky's zenith, else the directional lights' (they shine down),
+/// else the axis (y or z) along which polygons at the bounds' lowest end cover the bounds (the
+/// ground), else the one the emitting polygons face down along (ceiling lamps), else y (OBJ's
+/// and glTF's custom); CameraChoice::reason says which. That view is kept unless most of the
+/// surfaces it meets (and a quarter of the view at least) show no light: the
 /// backs of one-sided polygons, or sides that no emitter (the centroids of the 16 strongest
 /// emitting polygons) or light reaches directly, as a closed room seen from outside (whose
 /// image would be black). Then a view from inside, at mid height 5 % in from a side of the
-/// bounds looking across (+z, -z, +x or -x; y up) with a 60 degree field of view: the one whose
+/// bounds looking across (along the two axes across the up) with a 60 degree field of view: the one whose
 /// image shows the most lit surfaces, judged by 24 x 24 rays per candidate and a shadow ray to
 /// each emitter and light from what they meet. Builds a ray scene of the polygons (Embree) when
 /// the scene has no camera: about 1 s a million polygons, not cancellable (the renderers judge

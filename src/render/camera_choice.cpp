@@ -4,7 +4,7 @@
 // most lit surfaces. Found by rendering an exported room (an OBJ has no camera): the
 // default view from outside was black but for a few specks, with nothing said (session 32).
 #include <algorithm>
-#include <array>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -136,11 +136,130 @@ ViewContent view_content(const Scene& scene, const RayScene& rays,
   return out;
 }
 
-/// The choice that needs no look: the scene's camera, or Scene::camera()'s view from -z.
+/// A scene's up: a signed coordinate axis, and why it was taken. The scene formats read here
+/// have y up (OBJ by custom, glTF by its specification), but CAD and thermal models (STL, PLY,
+/// View3D) often have z up, and a camera with the wrong up shows them on their side.
+struct Up {
+  int axis = 1;       ///< 0, 1 or 2
+  float sign = 1.0f;  ///< +1 or -1
+  const char* why = "";
+  glm::vec3 vector() const {
+    glm::vec3 v(0.0f);
+    v[axis] = sign;
+    return v;
+  }
+};
+
+/// The signed axis nearest to `v` (non-zero).
+Up nearest_axis(const glm::vec3& v, const char* why) {
+  const glm::vec3 a = glm::abs(v);
+  Up up;
+  up.axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+  up.sign = v[up.axis] < 0.0f ? -1.0f : 1.0f;
+  up.why = why;
+  return up;
+}
+
+/// The scene's up, from the first of these that decides:
+/// - a sky's zenith; else the directional lights (the sun shines down), weighted by intensity;
+/// - the ground: where the polygons facing along y (or z) at the bounds' lowest y (or z) (within
+///   2 % of the bounds' extent along it) cover
+///   more than half of the bounds' section across that axis and at least twice the share that
+///   those at the lowest z (or y) cover (a city's ground, a floor under an open front); a closed
+///   room's floor and its wall are alike, and leave it to
+/// - the emitting polygons' normals (weighted by power): ceiling lamps face down, -y or -z,
+///   when one of the two is at least twice the other and half of the power (a lamp on a wall
+///   decides nothing);
+/// - y, the formats' custom.
+Up scene_up(const Scene& scene) {
+  glm::vec3 sun(0.0f);
+  for (const Light& light : scene.lights()) {
+    if (light.type == LightType::sky)  // a zenith of 0 is up (0, 1, 0), as Light has it
+      return nearest_axis(glm::length(light.direction) > 0.0f ? light.direction : glm::vec3(0, 1, 0),
+                          "the sky's zenith");
+    if (light.type == LightType::directional && glm::length(light.direction) > 0.0f)
+      sun -= light.intensity * glm::normalize(light.direction);
+  }
+  if (glm::length(sun) > 0.0f) return nearest_axis(sun, "the sun shines down");
+
+  const Bounds b = scene.bounds();
+  const glm::vec3 extent = b.upper - b.lower;
+  // "Lowest" within 2 % of the height: a table's legs poking 5 mm through a floor 2.7 m below
+  // the ceiling leave the floor the ground.
+  const float tolerance = 1e-4f * std::max(b.diagonal(), 1e-6f);
+  const glm::vec3 low = b.lower + glm::max(0.02f * extent, glm::vec3(tolerance));
+  double ground[3] = {0.0, 0.0, 0.0};
+  glm::dvec3 lamps(0.0);
+  double power = 0.0;
+  for (const Polygon& polygon : scene.polygons()) {
+    for (int a = 1; a <= 2; ++a) {
+      if (std::fabs(polygon.normal[a]) < 0.999f) continue;
+      bool lowest = true;
+      for (const glm::vec3& v : polygon.vertices) lowest = lowest && v[a] <= low[a];
+      if (lowest) ground[a] += polygon.area;
+    }
+    const Material& m = scene.material(polygon.material);
+    const double e = std::max({m.emission.x, m.emission.y, m.emission.z});
+    if (e > 0.0 && !m.two_sided) {
+      lamps += e * polygon.area * glm::dvec3(polygon.normal);
+      power += e * polygon.area;
+    }
+  }
+  const double section_y = double(extent.x) * double(extent.z), section_z = double(extent.x) * double(extent.y);
+  const double cover_y = section_y > 0.0 ? ground[1] / section_y : 0.0;
+  const double cover_z = section_z > 0.0 ? ground[2] / section_z : 0.0;
+  Up up;
+  if (cover_z > 0.5 && cover_z >= 2.0 * cover_y) {
+    up.axis = 2;
+    up.why = "the ground lies at the lowest z";
+    return up;
+  }
+  if (cover_y > 0.5 && cover_y >= 2.0 * cover_z) {
+    up.why = "the ground lies at the lowest y";
+    return up;
+  }
+  const double down_y = -lamps.y, down_z = -lamps.z;
+  if (down_z > 0.5 * power && down_z >= 2.0 * std::fabs(lamps.y)) {
+    up.axis = 2;
+    up.why = "the emitters face down -z";
+    return up;
+  }
+  if (down_y > 0.5 * power && down_y >= 2.0 * std::fabs(lamps.z)) {
+    up.why = "the emitters face down -y";
+    return up;
+  }
+  up.why = "as OBJ and glTF have it";
+  return up;
+}
+
+/// Axis names for the reasons: "+x", "-z", ...
+std::string axis_name(int axis, float sign) { return std::string(sign < 0.0f ? "-" : "+") + "xyz"[axis]; }
+
+/// "z up: the ground lies at the lowest z", "-y up: the sky's zenith".
+std::string up_text(const Up& up) {
+  return (up.sign < 0.0f ? "-" : "") + std::string(1, "xyz"[up.axis]) + " up: " + up.why;
+}
+
+/// The choice that needs no look: the scene's camera, or the view that frames its bounds from
+/// the side, its up the scene's (Scene::camera()'s view from -z when y is up; from -y when z is).
 CameraChoice unjudged_choice(const Scene& scene) {
   CameraChoice out;
   out.camera = scene.camera();
-  out.reason = scene.has_camera() ? "the scene's camera" : "the scene has none: framing its bounds from -z";
+  if (scene.has_camera()) {
+    out.reason = "the scene's camera";
+    return out;
+  }
+  const Up up = scene_up(scene);
+  // Look along z unless z is up (then along y), from the negative side, as Scene::camera().
+  const int front = up.axis == 2 ? 1 : 2;
+  if (front != 2 || up.axis != 1 || up.sign < 0.0f) {
+    const float distance = glm::length(out.camera.eye - out.camera.look_at);
+    glm::vec3 toward(0.0f);
+    toward[front] = 1.0f;
+    out.camera.eye = out.camera.look_at - distance * toward;
+    out.camera.up = up.vector();
+  }
+  out.reason = "the scene has none: framing its bounds from " + axis_name(front, -1.0f) + " (" + up_text(up) + ")";
   return out;
 }
 
@@ -163,21 +282,29 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
   if (!(outside.unlit > 0.5 * (outside.lit + outside.unlit) && outside.unlit > 0.25)) return out;
 
   // From inside: at mid height, 5 % of the way in from each side of the bounds, looking across
-  // to the opposite side (y up, as the scene formats here have it), with a wide lens.
+  // to the opposite side (along the two axes across the scene's up), with a wide lens.
+  const Up up = scene_up(scene);
   const Bounds b = scene.bounds();
   const glm::vec3 centre = 0.5f * (b.lower + b.upper), extent = b.upper - b.lower;
   struct Candidate {
     glm::vec3 toward;
-    const char* name;
+    std::string name;
   };
-  const std::array<Candidate, 4> candidates = {
-      {{{0, 0, 1}, "+z"}, {{0, 0, -1}, "-z"}, {{1, 0, 0}, "+x"}, {{-1, 0, 0}, "-x"}}};
+  std::vector<Candidate> candidates;
+  for (const int axis : {2, 0, 1}) {  // z, x, then y: y-up scenes as before
+    if (axis == up.axis) continue;
+    for (const float sign : {1.0f, -1.0f}) {
+      glm::vec3 toward(0.0f);
+      toward[axis] = sign;
+      candidates.push_back(Candidate{toward, axis_name(axis, sign)});
+    }
+  }
   double best_lit = outside.lit;
   for (const Candidate& c : candidates) {
     Camera camera;
     camera.eye = centre - 0.45f * glm::dot(extent, glm::abs(c.toward)) * c.toward;
     camera.look_at = camera.eye + c.toward;
-    camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    camera.up = up.vector();
     camera.fov_deg = 60.0f;
     const ViewContent inside = view_content(scene, rays, polygon_of, light, camera);
     if (inside.lit > best_lit) {
@@ -189,7 +316,8 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
                     "closed model): inside, at ",
                     100.0 * outside.unlit);
       out.reason = share + point_text(camera.eye) + " looking " + c.name + ", 60 degrees (" +
-                   std::to_string(static_cast<int>(100.0 * inside.lit + 0.5)) + " % of the view lit surfaces)";
+                   std::to_string(static_cast<int>(100.0 * inside.lit + 0.5)) + " % of the view lit surfaces; " +
+                   up_text(up) + ")";
     }
   }
   return out;

@@ -35,7 +35,8 @@ TEST_SUITE("render") {
     CHECK(inside(room.bounds(), chosen.camera.eye));
     CHECK(chosen.reason.find("the scene has none, and from outside") == 0);
     CHECK(chosen.reason.find("inside, at") != std::string::npos);
-    CHECK(chosen.reason.find("(100 % of the view lit surfaces)") != std::string::npos);
+    CHECK(chosen.reason.find("(100 % of the view lit surfaces; y up: as OBJ and glTF have it)") != std::string::npos);
+    CHECK(chosen.camera.up == glm::vec3(0, 1, 0));
 
     rad::SolveOptions so;
     so.mesh.max_patch_area = 1.0f;
@@ -82,7 +83,7 @@ TEST_SUITE("render") {
     rad::Scene object;
     rad::add_box(object, {0, 0, 0}, {1, 1, 1}, object.add_material(rad::Material{}), "box");
     const rad::CameraChoice framed = rad::choose_camera(object);
-    CHECK(framed.reason == "the scene has none: framing its bounds from -z");
+    CHECK(framed.reason == "the scene has none: framing its bounds from -z (y up: as OBJ and glTF have it)");
     CHECK(framed.camera.eye == object.camera().eye);
 
     // Blocks on a ground under a sky (no emitter): their walls see the sky too, so the view
@@ -97,7 +98,7 @@ TEST_SUITE("render") {
     rad::Light sky;
     sky.type = rad::LightType::sky;
     blocks.add_light(sky);
-    CHECK(rad::choose_camera(blocks).reason == "the scene has none: framing its bounds from -z");
+    CHECK(rad::choose_camera(blocks).reason == "the scene has none: framing its bounds from -z (y up: the sky's zenith)");
 
     // A scene with its own camera keeps it.
     rad::Scene with_camera = room;
@@ -109,5 +110,67 @@ TEST_SUITE("render") {
     CHECK(kept.reason == "the scene's camera");
     CHECK(kept.camera.eye == own.eye);
     CHECK(kept.camera.look_at == own.look_at);
+  }
+
+  TEST_CASE("choose_camera: a scene with z up (CAD, thermal models) is seen upright, from the side") {
+    // A building on a ground at z = 0 under a sky whose zenith is +z.
+    rad::Scene city;
+    const rad::MaterialId grey = city.add_material(rad::Material{});
+    rad::add_quad(city, {-10, -10, 0}, {20, 0, 0}, {0, 20, 0}, grey, "ground");
+    rad::add_box(city, {-2, -3, 0}, {2, 3, 6}, grey, "building");
+    rad::Light sky;
+    sky.type = rad::LightType::sky;
+    sky.intensity = 100.0f;
+    sky.direction = {0, 0, 1};
+    city.add_light(sky);
+    rad::CameraChoice c = rad::choose_camera(city);
+    CHECK(c.reason == "the scene has none: framing its bounds from -y (z up: the sky's zenith)");
+    CHECK(c.camera.up == glm::vec3(0, 0, 1));
+    CHECK(c.camera.look_at == city.camera().look_at);
+    CHECK(c.camera.eye.y < city.bounds().lower.y);  // in front, at the bounds' middle height
+    CHECK(c.camera.eye.x == doctest::Approx(c.camera.look_at.x));
+    CHECK(c.camera.eye.z == doctest::Approx(c.camera.look_at.z));
+    // What the sky would have said, the ground says without it (lit by a lamp over the roof,
+    // facing up: the emitters' normals decide nothing).
+    rad::Scene lamp_lit;
+    rad::add_quad(lamp_lit, {-10, -10, 0}, {20, 0, 0}, {0, 20, 0}, lamp_lit.add_material(rad::Material{}), "ground");
+    rad::add_box(lamp_lit, {-2, -3, 0}, {2, 3, 6}, 0, "building");
+    rad::Material lamp;
+    lamp.emission = rad::Rgb(10.0f);
+    rad::add_quad(lamp_lit, {-0.5f, -0.5f, 7}, {1, 0, 0}, {0, 1, 0}, lamp_lit.add_material(lamp), "lamp");  // faces +z
+    c = rad::choose_camera(lamp_lit);
+    CHECK(c.reason == "the scene has none: framing its bounds from -y (z up: the ground lies at the lowest z)");
+    CHECK(c.camera.up == glm::vec3(0, 0, 1));
+
+    // A closed room with z up, lit by a ceiling lamp facing down (-z): floor and walls look
+    // alike, the lamp decides; the view from inside is upright and looks across (x or y).
+    rad::Material white;
+    white.reflectance = rad::Rgb(0.6f);
+    rad::Scene room = test::closed_box(white, glm::vec3(4.0f, 5.0f, 3.0f));  // 3 high along z
+    rad::add_quad(room, {1.5f, 2.0f, 2.99f}, {0, 1, 0}, {1, 0, 0}, room.add_material(lamp), "lamp");
+    REQUIRE(room.polygons().back().normal.z < -0.99f);
+    c = rad::choose_camera(room);
+    MESSAGE(c.reason);
+    CHECK(c.camera.up == glm::vec3(0, 0, 1));
+    CHECK(c.reason.find("; z up: the emitters face down -z)") != std::string::npos);
+    CHECK(inside(room.bounds(), c.camera.eye));
+    CHECK(c.camera.eye.z == doctest::Approx(1.5f));  // mid height
+    CHECK(std::fabs(c.camera.look_at.z - c.camera.eye.z) < 1e-6f);  // looking across
+    // The same room with y up (its lamp facing -y) keeps y.
+    rad::Scene y_room = test::closed_box(white, glm::vec3(4.0f, 3.0f, 5.0f));
+    rad::add_quad(y_room, {1.5f, 2.99f, 2.0f}, {1, 0, 0}, {0, 0, 1}, y_room.add_material(lamp), "lamp");
+    REQUIRE(y_room.polygons().back().normal.y < -0.99f);
+    c = rad::choose_camera(y_room);
+    CHECK(c.camera.up == glm::vec3(0, 1, 0));
+    CHECK(c.reason.find("; y up: the emitters face down -y)") != std::string::npos);
+    // A room as exported (y up), lit by a box-shaped fixture whose faces all emit (their normals
+    // cancel), with a table leg poking 5 cm through the floor: the floor stays the ground's
+    // candidate (within 2 % of the height), ties with the back wall, and y stays up.
+    rad::Scene exported = test::closed_box(white, glm::vec3(4.0f, 2.7f, 3.0f));
+    rad::add_box(exported, {1.8f, 2.5f, 1.2f}, {2.4f, 2.6f, 1.6f}, exported.add_material(lamp), "fixture");
+    rad::add_box(exported, {1.0f, -0.05f, 1.0f}, {1.05f, 0.75f, 1.05f}, 0, "leg");
+    c = rad::choose_camera(exported);
+    CHECK(c.camera.up == glm::vec3(0, 1, 0));
+    CHECK(c.reason.find("; y up: as OBJ and glTF have it)") != std::string::npos);
   }
 }
