@@ -383,6 +383,30 @@ class RADIOSITY_API Solution {
 /// Checks options; throws Error{invalid_argument} naming the first bad field.
 RADIOSITY_API void validate(const SolveOptions& options);
 
+/// What the first solve() of a Problem will do, decided without solving (Problem::plan()):
+/// the choices SolveReport states afterwards, and the memory figure behind them.
+struct SolvePlan {
+  /// The solver that will run (never automatic) and, when SolveOptions::method was automatic,
+  /// why (SolveReport::method_choice).
+  SolverMethod method = SolverMethod::gauss_seidel;
+  std::string method_choice;
+  /// The estimator (never automatic): of the rows costed below, and the one that will run
+  /// unless `method` is hierarchical (SolveReport::form_factor_method).
+  FormFactorMethod form_factor_method = FormFactorMethod::automatic;
+  std::uint32_t specular_depth = 0;   ///< SolveReport::specular_depth
+  std::string specular_depth_choice;  ///< SolveReport::specular_depth_choice
+  /// Bytes that the Gauss-Seidel and Jacobi rows could need (one row per leaf, and per back of
+  /// a translucent or two-sided leaf) with `row_form_factor_method`: the figure that
+  /// SolverMethod::automatic compares with SolveOptions::memory_budget_bytes and a matrix method
+  /// named is refused by. 0 when the method was named and holds no rows (hierarchical,
+  /// progressive).
+  std::size_t row_bytes = 0;
+  bool sparse_rows = false;  ///< those rows are sparse (an index and a float per entry), else dense
+  /// The estimator of those rows: form_factor_method, unless SolverMethod::automatic dropped
+  /// the specular paths over the budget (then the one with them, which was costed).
+  FormFactorMethod row_form_factor_method = FormFactorMethod::automatic;
+};
+
 /// A scene set up for solving, kept across solves: its patch hierarchy (refined in place by
 /// adaptive subdivision), its form-factor estimator (with whatever it builds and caches: BVHs,
 /// visibility) and the form factors the matrix methods have computed (or the hierarchical
@@ -428,6 +452,12 @@ class RADIOSITY_API Problem {
   /// Bytes of form factors kept between solves (the matrix methods' rows, progressive
   /// refinement's columns, the hierarchical solver's links and cluster tree).
   std::size_t form_factor_bytes() const;
+  /// What the first solve() will do (SolvePlan), decided now: the automatic method and
+  /// specular depth chosen as solve() chooses them (solve() then keeps these choices). Costs
+  /// making the estimator (a BVH of the scene for the ray estimators) unless the method is
+  /// hierarchical; computes no form factors. Throws what solve() throws when making the
+  /// estimator.
+  SolvePlan plan();
 
   /// Solves with the emission of the scene's materials. The result is that of
   /// solve(scene, options) for a fresh Problem, and what solve(scene, options) documents holds

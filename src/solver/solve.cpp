@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <tuple>
 
 #include "form_factors/estimators.hpp"
 #include "scene/emission.hpp"
@@ -195,6 +196,13 @@ struct Problem::Impl {
   /// budget, else hierarchical (dropping specular paths under SpecularPaths::automatic; given
   /// ones need the rows). Makes the estimator.
   void choose_method();
+  /// The Gauss-Seidel rows' bytes at most with the estimator (made here if there is none yet),
+  /// and whether they are sparse.
+  std::pair<std::size_t, bool> row_cost();
+  /// What choose_method() costed: the rows' bytes, sparse or not, and their estimator.
+  std::size_t costed_bytes = 0;
+  bool costed_sparse = false;
+  FormFactorMethod costed_method = FormFactorMethod::automatic;
   /// The lights' first shot for `elements` that lack it; false when cancelled.
   bool shoot_lights(const std::vector<std::uint32_t>& elements, detail::ProgressGate& gate);
   /// light_shooter->shoot(elements, shot, gate, only), or, split, each process's share of the
@@ -230,9 +238,8 @@ void Problem::Impl::choose_specular_depth() {
   specular_depth_choice = "1 (automatic: the scene has mirror or glass materials)";
 }
 
-void Problem::Impl::choose_method() {
-  if (!automatic_method || !method_choice.empty()) return;
-  SolveOptions& o = options;
+std::pair<std::size_t, bool> Problem::Impl::row_cost() {
+  const SolveOptions& o = options;
   if (!estimator) estimator = make_form_factor_estimator(scene, hierarchy, o.form_factors);
   // The rows solve_matrix() would hold: one per leaf, and one per back of a translucent or
   // two-sided leaf (rows over every target, sparse).
@@ -244,8 +251,16 @@ void Problem::Impl::choose_method() {
     for (std::uint32_t e : hierarchy.leaves()) rows += has_back[hierarchy.element(e).patch] ? 1 : 0;
     sparse = true;
   }
-  const std::size_t bytes =
-      detail::row_memory_bytes(rows, estimator->target_count(), sparse, estimator->max_row_entries());
+  return {detail::row_memory_bytes(rows, estimator->target_count(), sparse, estimator->max_row_entries()), sparse};
+}
+
+void Problem::Impl::choose_method() {
+  if (!automatic_method || !method_choice.empty()) return;
+  SolveOptions& o = options;
+  const auto [bytes, sparse] = row_cost();
+  costed_bytes = bytes;
+  costed_sparse = sparse;
+  costed_method = o.form_factors.method;
   auto mib = [](std::size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
   const std::string figure = mib(bytes) + (bytes > o.memory_budget_bytes ? ", over" : ", within") +
                              " the memory budget of " + mib(o.memory_budget_bytes);
@@ -948,6 +963,29 @@ const SolveOptions& Problem::options() const { return impl_->options; }
 const PatchHierarchy& Problem::hierarchy() const { return impl_->hierarchy; }
 std::size_t Problem::form_factor_bytes() const {
   return impl_->store.bytes() + impl_->columns.bytes + (impl_->links ? impl_->links->bytes() : 0);
+}
+
+SolvePlan Problem::plan() {
+  Impl& m = *impl_;
+  const SolveOptions& o = m.options;
+  SolvePlan plan;
+  if (!m.meshing_cancelled) {
+    if (m.automatic_method) {
+      m.choose_method();
+      plan.row_bytes = m.costed_bytes;
+      plan.sparse_rows = m.costed_sparse;
+      plan.row_form_factor_method = m.costed_method;
+    } else if (o.method == SolverMethod::gauss_seidel || o.method == SolverMethod::jacobi) {
+      std::tie(plan.row_bytes, plan.sparse_rows) = m.row_cost();
+      plan.row_form_factor_method = o.form_factors.method;
+    }
+  }
+  plan.method = o.method;
+  plan.method_choice = m.method_choice;
+  plan.form_factor_method = o.form_factors.method;
+  plan.specular_depth = o.form_factors.specular_depth;
+  plan.specular_depth_choice = m.specular_depth_choice;
+  return plan;
 }
 
 Solution Problem::solve() { return impl_->solve(nullptr, false); }

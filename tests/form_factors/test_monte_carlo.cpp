@@ -615,7 +615,15 @@ TEST_SUITE("form_factors") {
     rad::SolveOptions tight = o;
     tight.mesh = mesh(1.0f / 256.0f, 1.0f / 256.0f);
     tight.memory_budget_bytes = 6 << 20;
+    rad::Problem planned(s, tight);
+    const rad::SolvePlan plan = planned.plan();  // what check reports before a solve
+    CHECK(plan.method == rad::SolverMethod::hierarchical);
+    CHECK(plan.specular_depth == 0u);
+    CHECK(plan.row_form_factor_method == rad::FormFactorMethod::monte_carlo);  // the rows with the paths, costed
+    CHECK(plan.sparse_rows);
+    CHECK(plan.row_bytes > tight.memory_budget_bytes);
     const rad::Solution dropped = rad::solve(s, tight);
+    CHECK(dropped.report().specular_depth_choice == plan.specular_depth_choice);
     MESSAGE("over the budget: " << dropped.report().specular_depth_choice);
     CHECK(dropped.report().method == rad::SolverMethod::hierarchical);
     CHECK(dropped.report().specular_depth == 0u);

@@ -214,6 +214,51 @@ TEST_SUITE("solver") {
     CHECK(rad::solve(scene, o).report().method_choice.empty());
   }
 
+  TEST_CASE("Problem::plan() says before solving what the first solve does - within and beyond the budget, "
+            "named methods") {
+    const rad::Scene scene = rad::cornell_box();
+    rad::SolveOptions o;  // SolverMethod::automatic
+    o.tolerance = 1e-4;
+    // The default budget (4 GiB) and 4 MiB, which the rows (6.4 MiB) exceed.
+    for (const std::size_t budget : {std::size_t{0}, std::size_t{4} << 20}) {
+      o.memory_budget_bytes = budget;
+      rad::Problem problem(scene, o);
+      const rad::SolvePlan plan = problem.plan();
+      CHECK(plan.method == (budget == 0 ? rad::SolverMethod::gauss_seidel : rad::SolverMethod::hierarchical));
+      CHECK(!plan.method_choice.empty());
+      // The rows costed: the Cornell box's default estimator (Monte Carlo, sparse rows of an
+      // index and a float per entry, at most one entry per patch), the figure the choice gives.
+      const std::size_t leaves = problem.hierarchy().leaves().size(), patches = problem.hierarchy().patches().size();
+      CHECK(plan.row_form_factor_method == problem.options().form_factors.method);
+      CHECK(plan.row_form_factor_method == rad::FormFactorMethod::monte_carlo);
+      CHECK(plan.sparse_rows);
+      CHECK(plan.row_bytes > (std::size_t{4} << 20));
+      CHECK(plan.row_bytes <= leaves * patches * 2 * sizeof(float));
+      CHECK(plan.method_choice.find(std::to_string((plan.row_bytes + (1u << 20) - 1) >> 20) + " MiB") !=
+            std::string::npos);
+      const rad::SolveReport r = problem.solve().report();
+      CHECK(r.method == plan.method);
+      CHECK(r.method_choice == plan.method_choice);
+      CHECK(r.form_factor_method == plan.form_factor_method);
+      CHECK(r.specular_depth == plan.specular_depth);
+      CHECK(r.specular_depth_choice == plan.specular_depth_choice);
+      // And a fresh solve() agrees with it.
+      CHECK(rad::solve(scene, o).report().method_choice == plan.method_choice);
+    }
+    // Named: no choice; a matrix method's rows are costed (the figure it would be refused by),
+    // the hierarchical solver's are not.
+    o = {};
+    o.method = rad::SolverMethod::jacobi;
+    rad::Problem jacobi(scene, o);
+    const rad::SolvePlan named = jacobi.plan();
+    CHECK(named.method == rad::SolverMethod::jacobi);
+    CHECK(named.method_choice.empty());
+    CHECK(named.row_bytes > 0);
+    o.method = rad::SolverMethod::hierarchical;
+    rad::Problem links(scene, o);
+    CHECK(links.plan().row_bytes == 0);
+  }
+
   TEST_CASE("group_radiosity of an unknown group names it") {
     const rad::Scene scene = test::closed_box(furnace_material());
     rad::Solution sol = rad::solve(scene, coarse(rad::SolverMethod::gauss_seidel));

@@ -29,8 +29,6 @@ struct CheckArgs {
 /// The overlaps (text and JSON) and emitters facing away (text) listed one by one; the rest are counted.
 constexpr std::size_t kOverlapsShown = 5;
 constexpr std::size_t kEmittersShown = 10;
-/// solve()'s memory budget when SolveOptions::memory_budget_bytes is 0 (solver.hpp).
-constexpr std::size_t kDefaultMemoryBudget = std::size_t{4} << 30;
 
 /// What `radiosity solve` would build and hold for the scene with these mesh options.
 struct Estimate {
@@ -42,17 +40,16 @@ struct Estimate {
   /// hemisphere_rays plus the emitting patches, at most the targets; an index and a float per
   /// entry): the bound the solvers check against the memory budget; rows hold only non-zeros.
   std::size_t sparse_rows_bytes = 0;
-  /// What the default solve (Gauss-Seidel, automatic estimator) holds: the dense matrix with
-  /// ray_cast and no back sides, else sparse rows (monte_carlo's bounded rows, or rows over
-  /// every target when translucent or two-sided surfaces add back sides).
+  /// What the default solve's Gauss-Seidel rows could need (rad::SolvePlan: the estimator, dense
+  /// or sparse, bytes), and what it does: hierarchical when they exceed the memory budget
+  /// (SolverMethod::automatic), and its specular depth (1 on a scene with mirror or glass
+  /// materials, rad::SpecularPaths::automatic; 0 otherwise or when it is hierarchical).
   rad::FormFactorMethod default_method = rad::FormFactorMethod::ray_cast;
   bool default_dense = true;
   std::size_t default_bytes = 0;
-  /// default_bytes is over the memory budget: the default solve is hierarchical.
   bool default_hierarchical = false;
-  /// The default solve's specular depth: 1 on a scene with mirror or glass materials (the
-  /// extended first pass, rad::SpecularPaths::automatic), 0 otherwise or when it is hierarchical.
   unsigned default_specular_depth = 0;
+  std::size_t memory_budget = 0;  ///< SolveOptions::memory_budget_bytes as solve() applies it
 };
 
 struct CheckResult {
@@ -75,7 +72,12 @@ struct CheckResult {
 bool emits(const rad::Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
 
 Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions& mesh) {
-  const rad::PatchHierarchy hierarchy(scene, mesh);
+  // The default solve's choices are the library's own (Problem::plan()), so that what check
+  // says is what solve does; the two what-if figures (dense matrix, sparse rows) are ours.
+  rad::SolveOptions options;
+  options.mesh = mesh;
+  rad::Problem problem(scene, options);
+  const rad::PatchHierarchy& hierarchy = problem.hierarchy();
   Estimate e;
   e.patches = hierarchy.patches().size();
   e.elements = hierarchy.leaves().size();
@@ -100,15 +102,13 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
   const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
   e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
-  rad::FormFactorOptions default_options;
-  if (rad::needs_extended_first_pass(scene)) default_options.specular_depth = 1;  // as solve takes it
-  e.default_specular_depth = default_options.specular_depth;
-  e.default_method = rad::choose_form_factor_method(hierarchy, default_options);
-  const bool monte_carlo = e.default_method == rad::FormFactorMethod::monte_carlo;
-  e.default_dense = !monte_carlo && back_patches == 0;
-  e.default_bytes = e.default_dense ? e.dense_matrix_bytes
-                    : monte_carlo   ? e.sparse_rows_bytes
-                                    : rows * targets * entry;
+  const rad::SolvePlan plan = problem.plan();
+  e.default_method = plan.row_form_factor_method;
+  e.default_dense = !plan.sparse_rows;
+  e.default_bytes = plan.row_bytes;
+  e.default_hierarchical = plan.method == rad::SolverMethod::hierarchical;
+  e.default_specular_depth = plan.specular_depth;
+  e.memory_budget = problem.options().memory_budget_bytes;
   return e;
 }
 
@@ -165,10 +165,6 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     r.warnings.push_back(std::to_string(r.z_fighting) +
                          " pair(s) of coincident polygons face the same way (z-fighting): which is in front is "
                          "decided by rounding, remove one of each pair (listed under overlaps)");
-  // Over the budget the default solve (--method auto) takes the hierarchical solver, which keeps
-  // no rows (SolverMethod::automatic).
-  r.estimate->default_hierarchical = r.estimate->default_bytes > kDefaultMemoryBudget;
-  if (r.estimate->default_hierarchical) r.estimate->default_specular_depth = 0;  // its links carry no mirror paths
   return r;
 }
 
@@ -216,9 +212,9 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
                 mib(e.dense_matrix_bytes).c_str(), e.sparse_rows_bytes, mib(e.sparse_rows_bytes).c_str());
     if (e.default_hierarchical)
       std::printf("default solve: hierarchical (automatic: gauss-seidel with %s form factors would need %s: %zu "
-                  "bytes (%s), over the memory budget of 4096 MiB)\n",
+                  "bytes (%s), over the memory budget of %zu MiB)\n",
                   rad::to_string(e.default_method), e.default_dense ? "a dense matrix" : "sparse rows up to",
-                  e.default_bytes, mib(e.default_bytes).c_str());
+                  e.default_bytes, mib(e.default_bytes).c_str(), e.memory_budget >> 20);
     else
       std::printf("default solve: gauss-seidel, %s form factors (automatic), %s: %zu bytes (%s)\n",
                   rad::to_string(e.default_method), e.default_dense ? "dense matrix" : "sparse rows up to",
