@@ -90,16 +90,19 @@ RADIOSITY_API Image render(const Scene& scene, const Solution& solution, const R
 /// The camera the renderers take when ImageOptions::camera is not set, and why.
 struct CameraChoice {
   Camera camera;
-  /// e.g. "the scene's camera", "the scene has none: framing its bounds from -y (z up: the
-  /// sky's zenith)", or "the scene has none, and from outside 44 % of the view is surfaces no
+  /// e.g. "the scene's camera", "the scene has none: framing its bounds from -z (y up: as OBJ
+  /// and glTF have it)", "the scene has none: framing what stands on its ground from -y, 30
+  /// degrees above (z up: the sky's zenith)", or "the scene has none, and from outside 44 % of the view is surfaces no
   /// light reaches (a closed model): inside, at (2, 1.5, 0.2) looking +z, 60 degrees (100 % of
   /// the view lit surfaces; y up: the emitters face down -y)".
   std::string reason;
 };
 
-/// The scene's camera when it has one (Scene::has_camera()). Otherwise a view framing the
-/// bounds from the side with the scene's up: Scene::camera()'s view from -z when y is up, from
-/// -y when z is up. The up is a sky's zenith, else the directional lights' (they shine down),
+/// The scene's camera when it has one (Scene::has_camera()). Otherwise, on a ground open to the
+/// sky (level polygons at the lowest end along the up cover most of the bounds' section, and
+/// roofs or a ceiling above cover less than half of them: a site, a city), a view from 30
+/// degrees above framing what stands on the ground; else a view framing the bounds from the
+/// side: Scene::camera()'s view from -z when y is up, from -y when z is up. The up is a sky's zenith, else the directional lights' (they shine down),
 /// else the axis (y or z) along which polygons at the bounds' lowest end cover the bounds (the
 /// ground), else the one the emitting polygons face down along (ceiling lamps), else y (OBJ's
 /// and glTF's custom); CameraChoice::reason says which. That view is kept unless most of the

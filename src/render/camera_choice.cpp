@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "render/camera_choice.hpp"
 #include "core/frame.hpp"
@@ -160,11 +161,47 @@ Up nearest_axis(const glm::vec3& v, const char* why) {
   return up;
 }
 
+/// The level polygons along a signed axis: those facing along it (either way) at the bounds'
+/// lowest end along it, within 2 % of the height (a table's legs poking 5 mm through a floor
+/// 2.7 m below the ceiling leave the floor the ground), and the rest.
+struct Levels {
+  double ground = 0.0;   ///< area of the level polygons at the lowest end
+  double cover = 0.0;    ///< ground over the bounds' section across the axis
+  double covered = 0.0;  ///< area of the level polygons above them (roofs, a ceiling)
+  Bounds rest;           ///< of every polygon that is not ground
+  bool any_rest = false;
+};
+
+Levels levels(const Scene& scene, int axis, float sign) {
+  const Bounds b = scene.bounds();
+  const glm::vec3 extent = b.upper - b.lower;
+  const float tolerance = std::max(0.02f * extent[axis], 1e-4f * std::max(b.diagonal(), 1e-6f));
+  auto height = [&](const glm::vec3& v) { return sign > 0.0f ? v[axis] - b.lower[axis] : b.upper[axis] - v[axis]; };
+  Levels out;
+  for (const Polygon& polygon : scene.polygons()) {
+    const bool level = std::fabs(polygon.normal[axis]) >= 0.999f;
+    bool lowest = level;
+    for (const glm::vec3& v : polygon.vertices) lowest = lowest && height(v) <= tolerance;
+    if (lowest) {
+      out.ground += polygon.area;
+      continue;
+    }
+    if (level) out.covered += polygon.area;
+    for (const glm::vec3& v : polygon.vertices) {
+      out.rest.lower = out.any_rest ? glm::min(out.rest.lower, v) : v;
+      out.rest.upper = out.any_rest ? glm::max(out.rest.upper, v) : v;
+      out.any_rest = true;
+    }
+  }
+  const double section = double(extent[(axis + 1) % 3]) * double(extent[(axis + 2) % 3]);
+  out.cover = section > 0.0 ? out.ground / section : 0.0;
+  return out;
+}
+
 /// The scene's up, from the first of these that decides:
 /// - a sky's zenith; else the directional lights (the sun shines down), weighted by intensity;
-/// - the ground: where the polygons facing along y (or z) at the bounds' lowest y (or z) (within
-///   2 % of the bounds' extent along it) cover
-///   more than half of the bounds' section across that axis and at least twice the share that
+/// - the ground: where the polygons facing along y (or z) at the bounds' lowest y (or z) (levels())
+///   cover more than half of the bounds' section across that axis and at least twice the share that
 ///   those at the lowest z (or y) cover (a city's ground, a floor under an open front); a closed
 ///   room's floor and its wall are alike, and leave it to
 /// - the emitting polygons' normals (weighted by power): ceiling lamps face down, -y or -z,
@@ -182,22 +219,9 @@ Up scene_up(const Scene& scene) {
   }
   if (glm::length(sun) > 0.0f) return nearest_axis(sun, "the sun shines down");
 
-  const Bounds b = scene.bounds();
-  const glm::vec3 extent = b.upper - b.lower;
-  // "Lowest" within 2 % of the height: a table's legs poking 5 mm through a floor 2.7 m below
-  // the ceiling leave the floor the ground.
-  const float tolerance = 1e-4f * std::max(b.diagonal(), 1e-6f);
-  const glm::vec3 low = b.lower + glm::max(0.02f * extent, glm::vec3(tolerance));
-  double ground[3] = {0.0, 0.0, 0.0};
   glm::dvec3 lamps(0.0);
   double power = 0.0;
   for (const Polygon& polygon : scene.polygons()) {
-    for (int a = 1; a <= 2; ++a) {
-      if (std::fabs(polygon.normal[a]) < 0.999f) continue;
-      bool lowest = true;
-      for (const glm::vec3& v : polygon.vertices) lowest = lowest && v[a] <= low[a];
-      if (lowest) ground[a] += polygon.area;
-    }
     const Material& m = scene.material(polygon.material);
     const double e = std::max({m.emission.x, m.emission.y, m.emission.z});
     if (e > 0.0 && !m.two_sided) {
@@ -205,9 +229,7 @@ Up scene_up(const Scene& scene) {
       power += e * polygon.area;
     }
   }
-  const double section_y = double(extent.x) * double(extent.z), section_z = double(extent.x) * double(extent.y);
-  const double cover_y = section_y > 0.0 ? ground[1] / section_y : 0.0;
-  const double cover_z = section_z > 0.0 ? ground[2] / section_z : 0.0;
+  const double cover_y = levels(scene, 1, 1.0f).cover, cover_z = levels(scene, 2, 1.0f).cover;
   Up up;
   if (cover_z > 0.5 && cover_z >= 2.0 * cover_y) {
     up.axis = 2;
@@ -240,8 +262,19 @@ std::string up_text(const Up& up) {
   return (up.sign < 0.0f ? "-" : "") + std::string(1, "xyz"[up.axis]) + " up: " + up.why;
 }
 
-/// The choice that needs no look: the scene's camera, or the view that frames its bounds from
-/// the side, its up the scene's (Scene::camera()'s view from -z when y is up; from -y when z is).
+/// A ground open to the sky (levels() along the scene's up): it covers more than half of the
+/// bounds' section, and the level polygons above it (roofs, a ceiling) cover less than half of
+/// it (a closed room's ceiling covers its floor); and something stands on it.
+bool open_ground(const Levels& l) { return l.any_rest && l.cover > 0.5 && l.covered < 0.5 * l.ground; }
+
+/// How far above the horizontal the view of a ground open to the sky looks down.
+constexpr float kAerialElevationDeg = 30.0f;
+
+/// The choice that needs no look: the scene's camera; else, on a ground open to the sky (a
+/// site, a city), the view 30 degrees from above that frames what stands on it (the ground's
+/// edge seen from the side shows nothing: a house on a 1 km plot was a speck on a horizon);
+/// else the view that frames the bounds from the side, its up the scene's (Scene::camera()'s
+/// view from -z when y is up; from -y when z is).
 CameraChoice unjudged_choice(const Scene& scene) {
   CameraChoice out;
   out.camera = scene.camera();
@@ -252,10 +285,26 @@ CameraChoice unjudged_choice(const Scene& scene) {
   const Up up = scene_up(scene);
   // Look along z unless z is up (then along y), from the negative side, as Scene::camera().
   const int front = up.axis == 2 ? 1 : 2;
+  glm::vec3 toward(0.0f);
+  toward[front] = 1.0f;
+  const Levels ground = levels(scene, up.axis, up.sign);
+  if (open_ground(ground)) {
+    const glm::vec3 centre = 0.5f * (ground.rest.lower + ground.rest.upper);
+    const float radius = std::max(0.5f * ground.rest.diagonal(), 1e-3f);
+    out.camera.fov_deg = 45.0f;
+    const float distance = radius / std::sin(glm::radians(0.5f * out.camera.fov_deg));
+    const float elevation = glm::radians(kAerialElevationDeg);
+    out.camera.look_at = centre;
+    out.camera.eye = centre + distance * (std::sin(elevation) * up.vector() - std::cos(elevation) * toward);
+    out.camera.up = up.vector();
+    char degrees[16];
+    std::snprintf(degrees, sizeof degrees, "%.0f", kAerialElevationDeg);
+    out.reason = "the scene has none: framing what stands on its ground from " + axis_name(front, -1.0f) + ", " +
+                 degrees + " degrees above (" + up_text(up) + ")";
+    return out;
+  }
   if (front != 2 || up.axis != 1 || up.sign < 0.0f) {
     const float distance = glm::length(out.camera.eye - out.camera.look_at);
-    glm::vec3 toward(0.0f);
-    toward[front] = 1.0f;
     out.camera.eye = out.camera.look_at - distance * toward;
     out.camera.up = up.vector();
   }

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <string>
 
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
 #include <radiosity/radiosity.hpp>
 
 #include "support/scenes.hpp"
@@ -98,7 +101,9 @@ TEST_SUITE("render") {
     rad::Light sky;
     sky.type = rad::LightType::sky;
     blocks.add_light(sky);
-    CHECK(rad::choose_camera(blocks).reason == "the scene has none: framing its bounds from -z (y up: the sky's zenith)");
+    // A ground open to the sky: seen from 30 degrees above, framing the blocks.
+    CHECK(rad::choose_camera(blocks).reason ==
+          "the scene has none: framing what stands on its ground from -z, 30 degrees above (y up: the sky's zenith)");
 
     // A scene with its own camera keeps it.
     rad::Scene with_camera = room;
@@ -124,12 +129,20 @@ TEST_SUITE("render") {
     sky.direction = {0, 0, 1};
     city.add_light(sky);
     rad::CameraChoice c = rad::choose_camera(city);
-    CHECK(c.reason == "the scene has none: framing its bounds from -y (z up: the sky's zenith)");
+    CHECK(c.reason ==
+          "the scene has none: framing what stands on its ground from -y, 30 degrees above (z up: the sky's zenith)");
     CHECK(c.camera.up == glm::vec3(0, 0, 1));
-    CHECK(c.camera.look_at == city.camera().look_at);
-    CHECK(c.camera.eye.y < city.bounds().lower.y);  // in front, at the bounds' middle height
-    CHECK(c.camera.eye.x == doctest::Approx(c.camera.look_at.x));
-    CHECK(c.camera.eye.z == doctest::Approx(c.camera.look_at.z));
+    // At the building's middle (what stands on the ground), from -y and 30 degrees above.
+    CHECK(c.camera.look_at.x == doctest::Approx(0.0f));
+    CHECK(c.camera.look_at.y == doctest::Approx(0.0f));
+    CHECK(c.camera.look_at.z == doctest::Approx(3.0f));
+    const glm::vec3 back = glm::normalize(c.camera.eye - c.camera.look_at);
+    CHECK(back.z == doctest::Approx(0.5f));  // sin 30 degrees
+    CHECK(back.y == doctest::Approx(-0.8660254f));
+    CHECK(back.x == doctest::Approx(0.0f));
+    // Framed: the building's bounding sphere (radius sqrt(4^2 + 6^2 + 6^2) / 2) fills the 45 degrees.
+    CHECK(glm::length(c.camera.eye - c.camera.look_at) ==
+          doctest::Approx(std::sqrt(88.0f) / 2.0f / std::sin(glm::radians(22.5f))).epsilon(1e-4));
     // What the sky would have said, the ground says without it (lit by a lamp over the roof,
     // facing up: the emitters' normals decide nothing).
     rad::Scene lamp_lit;
@@ -139,7 +152,8 @@ TEST_SUITE("render") {
     lamp.emission = rad::Rgb(10.0f);
     rad::add_quad(lamp_lit, {-0.5f, -0.5f, 7}, {1, 0, 0}, {0, 1, 0}, lamp_lit.add_material(lamp), "lamp");  // faces +z
     c = rad::choose_camera(lamp_lit);
-    CHECK(c.reason == "the scene has none: framing its bounds from -y (z up: the ground lies at the lowest z)");
+    CHECK(c.reason == "the scene has none: framing what stands on its ground from -y, 30 degrees above (z up: the "
+                      "ground lies at the lowest z)");
     CHECK(c.camera.up == glm::vec3(0, 0, 1));
 
     // A closed room with z up, lit by a ceiling lamp facing down (-z): floor and walls look
