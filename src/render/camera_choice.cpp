@@ -271,7 +271,8 @@ bool open_ground(const Levels& l) { return l.any_rest && l.cover > 0.5 && l.cove
 constexpr float kAerialElevationDeg = 30.0f;
 
 /// The choice that needs no look: the scene's camera; else, on a ground open to the sky (a
-/// site, a city), the view 30 degrees from above that frames what stands on it (the ground's
+/// site, a city), the view 30 degrees from above that frames what stands on it and as much
+/// ground again around it (the ground's
 /// edge seen from the side shows nothing: a house on a 1 km plot was a speck on a horizon);
 /// else the view that frames the bounds from the side, its up the scene's (Scene::camera()'s
 /// view from -z when y is up; from -y when z is).
@@ -289,8 +290,18 @@ CameraChoice unjudged_choice(const Scene& scene) {
   toward[front] = 1.0f;
   const Levels ground = levels(scene, up.axis, up.sign);
   if (open_ground(ground)) {
-    const glm::vec3 centre = 0.5f * (ground.rest.lower + ground.rest.upper);
-    const float radius = std::max(0.5f * ground.rest.diagonal(), 1e-3f);
+    // What stands on the ground, with as much ground again around it across the up (within the
+    // scene's bounds): a house shows its plot; a lamp over a small floor shows the floor.
+    const Bounds scene_box = scene.bounds();
+    Bounds shown = ground.rest;
+    for (int k = 0; k < 3; ++k) {
+      if (k == up.axis) continue;
+      const float margin = 0.5f * (shown.upper[k] - shown.lower[k]);
+      shown.lower[k] = std::max(shown.lower[k] - margin, scene_box.lower[k]);
+      shown.upper[k] = std::min(shown.upper[k] + margin, scene_box.upper[k]);
+    }
+    const glm::vec3 centre = 0.5f * (shown.lower + shown.upper);
+    const float radius = std::max(0.5f * shown.diagonal(), 1e-3f);
     out.camera.fov_deg = 45.0f;
     const float distance = radius / std::sin(glm::radians(0.5f * out.camera.fov_deg));
     const float elevation = glm::radians(kAerialElevationDeg);

@@ -132,7 +132,8 @@ TEST_SUITE("render") {
     CHECK(c.reason ==
           "the scene has none: framing what stands on its ground from -y, 30 degrees above (z up: the sky's zenith)");
     CHECK(c.camera.up == glm::vec3(0, 0, 1));
-    // At the building's middle (what stands on the ground), from -y and 30 degrees above.
+    // At the middle of the building (what stands on the ground) with as much ground again
+    // around it, from -y and 30 degrees above.
     CHECK(c.camera.look_at.x == doctest::Approx(0.0f));
     CHECK(c.camera.look_at.y == doctest::Approx(0.0f));
     CHECK(c.camera.look_at.z == doctest::Approx(3.0f));
@@ -140,9 +141,10 @@ TEST_SUITE("render") {
     CHECK(back.z == doctest::Approx(0.5f));  // sin 30 degrees
     CHECK(back.y == doctest::Approx(-0.8660254f));
     CHECK(back.x == doctest::Approx(0.0f));
-    // Framed: the building's bounding sphere (radius sqrt(4^2 + 6^2 + 6^2) / 2) fills the 45 degrees.
+    // Framed: the building (4 x 6 x 6) grown by half its width and depth on each side (8 x 12 x
+    // 6, within the 20 x 20 ground); its bounding sphere fills the 45 degrees.
     CHECK(glm::length(c.camera.eye - c.camera.look_at) ==
-          doctest::Approx(std::sqrt(88.0f) / 2.0f / std::sin(glm::radians(22.5f))).epsilon(1e-4));
+          doctest::Approx(std::sqrt(244.0f) / 2.0f / std::sin(glm::radians(22.5f))).epsilon(1e-4));
     // What the sky would have said, the ground says without it (lit by a lamp over the roof,
     // facing up: the emitters' normals decide nothing).
     rad::Scene lamp_lit;
