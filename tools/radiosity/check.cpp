@@ -2,6 +2,9 @@
 // warnings, overlapping polygons, emitters facing away, and the size of the default solve.
 #include "check.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -50,6 +53,8 @@ struct Estimate {
   bool default_hierarchical = false;
   unsigned default_specular_depth = 0;
   std::size_t memory_budget = 0;  ///< SolveOptions::memory_budget_bytes as solve() applies it
+  /// Per polygon: the area of its largest element (scene units^2).
+  std::vector<float> largest_element;
 };
 
 struct CheckResult {
@@ -102,6 +107,12 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
   const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
   e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
+  e.largest_element.assign(scene.polygons().size(), 0.0f);
+  for (std::uint32_t leaf : hierarchy.leaves()) {
+    const rad::Element& element = hierarchy.element(leaf);
+    float& largest = e.largest_element[hierarchy.patches()[element.patch].polygon];
+    largest = std::max(largest, element.area);
+  }
   const rad::SolvePlan plan = problem.plan();
   e.default_method = plan.row_form_factor_method;
   e.default_dense = !plan.sparse_rows;
@@ -110,6 +121,59 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   e.default_specular_depth = plan.specular_depth;
   e.memory_budget = problem.options().memory_budget_bytes;
   return e;
+}
+
+/// Groups that stand on or pass through a polygon whose elements are larger than the whole
+/// group (a house on a 1 km ground of 45 m elements): its shadow and contact cannot show on
+/// that polygon. One warning per pair of groups, the first kShownPairs of them.
+void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::PolygonOverlap>& overlaps,
+                             const std::vector<float>& largest_element, std::vector<std::string>& warnings) {
+  constexpr std::size_t kShownPairs = 3;
+  const std::vector<rad::Polygon>& polygons = scene.polygons();
+  // Each group's largest extent along an axis.
+  std::vector<glm::vec3> lower(scene.groups().size(), glm::vec3(std::numeric_limits<float>::max()));
+  std::vector<glm::vec3> upper(scene.groups().size(), glm::vec3(std::numeric_limits<float>::lowest()));
+  for (const rad::Polygon& p : polygons)
+    for (const glm::vec3& v : p.vertices) {
+      lower[p.group] = glm::min(lower[p.group], v);
+      upper[p.group] = glm::max(upper[p.group], v);
+    }
+  auto size_of = [&](rad::GroupId g) {
+    const glm::vec3 d = upper[g] - lower[g];
+    return std::max({d.x, d.y, d.z});
+  };
+  struct Pair {
+    rad::GroupId under, object;
+    float element, object_size;
+  };
+  std::vector<Pair> pairs;
+  for (const rad::PolygonOverlap& o : overlaps) {
+    const rad::Polygon &first = polygons[o.first], &second = polygons[o.second];
+    // Contact: coincident and facing apart, or one passing through the other.
+    if (o.kind == rad::OverlapKind::coincident && glm::dot(first.normal, second.normal) > 0.0f) continue;
+    for (const auto& [under, object] : {std::make_pair(o.first, o.second), std::make_pair(o.second, o.first)}) {
+      const rad::GroupId g = polygons[under].group, h = polygons[object].group;
+      const float element = std::sqrt(largest_element[under]), size = size_of(h);
+      if (g == h || !(element > size)) continue;
+      if (std::none_of(pairs.begin(), pairs.end(), [&](const Pair& q) { return q.under == g && q.object == h; }))
+        pairs.push_back(Pair{g, h, element, size});
+    }
+  }
+  for (std::size_t k = 0; k < pairs.size() && k < kShownPairs; ++k) {
+    const Pair& q = pairs[k];
+    const float suggested = 0.0625f * q.object_size * q.object_size;  // elements a quarter of its size
+    char figures[160];
+    std::snprintf(figures, sizeof figures, "elements up to %.3g across, larger than group '%s' (%.3g) that stands on "
+                  "or passes through it", q.element, scene.groups()[q.object].c_str(), q.object_size);
+    char hint[96];
+    std::snprintf(hint, sizeof hint, "lower --max-element-area (%.3g gives elements a quarter of its size)", suggested);
+    warnings.push_back("group '" + scene.groups()[q.under] + "' has " + figures +
+                       ": its shadow and contact cannot show there; cut '" + scene.groups()[q.under] +
+                       "' finer around it in the model, or " + hint);
+  }
+  if (pairs.size() > kShownPairs)
+    warnings.push_back(std::to_string(pairs.size() - kShownPairs) +
+                       " more pairs of groups where one stands on elements larger than itself");
 }
 
 CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
@@ -161,6 +225,7 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     r.error = e.what();  // e.g. max_element_area > max_patch_area, or far too many elements
     return r;
   }
+  coarse_contact_warnings(scene, r.overlaps, r.estimate->largest_element, r.warnings);
   if (r.z_fighting > 0)
     r.warnings.push_back(std::to_string(r.z_fighting) +
                          " pair(s) of coincident polygons face the same way (z-fighting): which is in front is "
