@@ -11,8 +11,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <iterator>
+#include <limits>
 #include <numeric>
 #include <optional>
 #include <utility>
