@@ -124,7 +124,7 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
 }
 
 /// Groups that stand on or pass through a polygon whose elements are larger than the whole
-/// group (a house on a 1 km ground of 45 m elements): its shadow and contact cannot show on
+/// group (a house on a 1 km ground of 21.7 m elements): its shadow and contact cannot show on
 /// that polygon. One warning per pair of groups, the first kShownPairs of them.
 void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::PolygonOverlap>& overlaps,
                              const std::vector<float>& largest_element, std::vector<std::string>& warnings) {
