@@ -275,15 +275,15 @@ constexpr float kAerialElevationDeg = 30.0f;
 /// ground again around it (the ground's
 /// edge seen from the side shows nothing: a house on a 1 km plot was a speck on a horizon);
 /// else the view that frames the bounds from the side, its up the scene's (Scene::camera()'s
-/// view from -z when y is up; from -y when z is).
-CameraChoice unjudged_choice(const Scene& scene) {
+/// view from -z when y is up; from -y when z is). `up`: scene_up(scene), unused (and not worth
+/// computing) when the scene has a camera.
+CameraChoice unjudged_choice(const Scene& scene, const Up& up) {
   CameraChoice out;
   out.camera = scene.camera();
   if (scene.has_camera()) {
     out.reason = "the scene's camera";
     return out;
   }
-  const Up up = scene_up(scene);
   // Look along z unless z is up (then along y), from the negative side, as Scene::camera().
   const int front = up.axis == 2 ? 1 : 2;
   glm::vec3 toward(0.0f);
@@ -326,12 +326,18 @@ CameraChoice unjudged_choice(const Scene& scene) {
 /// Whether there is a view to judge: no camera of the scene's own, and something to see.
 bool judged(const Scene& scene) { return !scene.has_camera() && !scene.polygons().empty(); }
 
+/// unjudged_choice() with the scene's up found only when it is used.
+CameraChoice unjudged_choice(const Scene& scene) {
+  return unjudged_choice(scene, scene.has_camera() ? Up{} : scene_up(scene));
+}
+
 }  // namespace
 
 CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
                            const std::function<PolygonId(std::uint32_t)>& polygon_of) {
-  CameraChoice out = unjudged_choice(scene);
-  if (!judged(scene)) return out;
+  if (!judged(scene)) return unjudged_choice(scene);
+  const Up up = scene_up(scene);  // once: the view from outside and those from inside
+  CameraChoice out = unjudged_choice(scene, up);
   const LightProbe light(scene, rays);
   if (light.empty()) return out;  // nothing lights any view
   const ViewContent outside = view_content(scene, rays, polygon_of, light, out.camera);
@@ -343,7 +349,6 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
 
   // From inside: at mid height, 5 % of the way in from each side of the bounds, looking across
   // to the opposite side (along the two axes across the scene's up), with a wide lens.
-  const Up up = scene_up(scene);
   const Bounds b = scene.bounds();
   const glm::vec3 centre = 0.5f * (b.lower + b.upper), extent = b.upper - b.lower;
   struct Candidate {
