@@ -67,6 +67,7 @@ struct Search {
   std::mutex mutex;
   std::vector<PolygonOverlap> found;
   std::vector<ContactLine> lines;
+  std::vector<ContactSegment> segments;
 };
 
 using Points2 = std::vector<glm::dvec2>;
@@ -203,8 +204,11 @@ bool test_pair(const Search& s, PolygonId ia, PolygonId ib, PolygonOverlap& out)
 // Where `b` divides `a` along a line: b stands on a (an edge of b lies in a's plane, the rest
 // of b on one side) or passes through it, along a segment that runs inside a (more than the
 // tolerance from its border: not a wall meeting a floor at the floor's edge, a T-junction)
-// from border to border. Coplanar pairs have no such line.
-bool contact_of(const Search& s, PolygonId ia, PolygonId ib, ContactLine& out) {
+// from border to border. Coplanar pairs have no such line. A contact that ends inside a (a
+// block's side on a floor) is a segment instead (`segment` true, `part` set): cutting along
+// its whole chord would spread slivers over the floor, so the mesh is graded toward it.
+bool contact_of(const Search& s, PolygonId ia, PolygonId ib, ContactLine& out, bool& segment, ContactSegment& part) {
+  segment = false;
   const Polygon& a = (*s.polygons)[ia];
   const Polygon& b = (*s.polygons)[ib];
   const Plane& pa = s.planes[ia];
@@ -260,7 +264,17 @@ bool contact_of(const Search& s, PolygonId ia, PolygonId ib, ContactLine& out) {
   // b must cover the whole chord: it divides a in two. A block standing on a floor covers part
   // of a chord only; rays already find what it hides (docs/ARCHITECTURE.md, "Contact"), and
   // cutting along whole chords there would spread slivers over the floor.
-  if (lo > chord_lo + 2.0 * s.tolerance || hi < chord_hi - 2.0 * s.tolerance) return false;
+  if (lo > chord_lo + 2.0 * s.tolerance || hi < chord_hi - 2.0 * s.tolerance) {
+    lo = std::max(lo, chord_lo);
+    hi = std::min(hi, chord_hi);
+    if (!(hi - lo > s.tolerance)) return false;  // it meets a's plane outside a
+    segment = true;
+    part.polygon = ia;
+    part.other = ib;
+    part.from = origin + lo * axis;
+    part.to = origin + hi * axis;
+    return false;
+  }
   lo = chord_lo;
   hi = chord_hi;
   out.polygon = ia;
@@ -304,9 +318,13 @@ void on_collisions(void* user, RTCCollision* collisions, unsigned count) {
     if (s->contacts) {
       for (const auto& [on, other] : {std::make_pair(a, b), std::make_pair(b, a)}) {
         ContactLine line;
-        if (!contact_of(*s, on, other, line)) continue;
+        ContactSegment part;
+        bool segment = false;
+        const bool divides = contact_of(*s, on, other, line, segment, part);
+        if (!divides && !segment) continue;
         const std::lock_guard<std::mutex> lock(s->mutex);
-        s->lines.push_back(line);
+        if (divides) s->lines.push_back(line);
+        else s->segments.push_back(part);
       }
       continue;
     }
@@ -481,10 +499,14 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing
 }
 
 std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep_going) {
+  return find_contacts(scene, keep_going).lines;
+}
+
+Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going) {
   if (scene.polygons().size() < 2) return {};
   Search s;
   s.contacts = true;
-  search_pairs(scene, s, "contact_lines", keep_going);
+  search_pairs(scene, s, "find_contacts", keep_going);
   // Sorted by polygon, then by line, and one line per polygon where several polygons meet it
   // along the same line (a wall modelled as two coincident faces, collinear walls): the order
   // of Embree's callbacks must not show.
@@ -507,7 +529,19 @@ std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep
     }
     if (!same) out.push_back(l);
   }
-  return out;
+  // The query may report a pair twice and in any order.
+  std::vector<ContactSegment> segments = std::move(s.segments);
+  auto segment_key = [](const ContactSegment& c) {
+    return std::make_tuple(c.polygon, c.other, c.from.x, c.from.y, c.from.z, c.to.x, c.to.y, c.to.z);
+  };
+  std::sort(segments.begin(), segments.end(),
+            [&](const ContactSegment& x, const ContactSegment& y) { return segment_key(x) < segment_key(y); });
+  segments.erase(std::unique(segments.begin(), segments.end(),
+                             [&](const ContactSegment& x, const ContactSegment& y) {
+                               return segment_key(x) == segment_key(y);
+                             }),
+                 segments.end());
+  return Contacts{std::move(out), std::move(segments)};
 }
 
 double touching_tolerance(const glm::vec3& lower, const glm::vec3& upper) {

@@ -61,4 +61,24 @@ struct ContactLine {
 /// al. 1991). Cost: as find_overlaps(). Thread safety: concurrent calls are safe.
 std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep_going = {});
 
+/// A segment in a polygon's plane, inside it, along which another polygon stands on it or
+/// passes through it without dividing it: a wall's foot on a ground, a block's sides on a
+/// floor, a leg through a floor.
+struct ContactSegment {
+  std::uint32_t polygon = 0;  ///< the polygon touched (a PolygonId)
+  std::uint32_t other = 0;    ///< the polygon standing on it or passing through it
+  glm::dvec3 from{0.0}, to{0.0};
+};
+
+/// What one search finds: the lines that divide polygons (as contact_lines()) and the segments
+/// that end inside them (sorted by polygon, then by other polygon).
+struct Contacts {
+  std::vector<ContactLine> lines;
+  std::vector<ContactSegment> segments;
+};
+/// Both kinds at the cost of one search (as find_overlaps()). PatchHierarchy cuts polygons
+/// along the lines and grades their elements toward the segments (MeshOptions::grade_at_contacts):
+/// the shadow and the darkening at a contact are as small as what stands there.
+Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going = {});
+
 }  // namespace radiosity::detail

@@ -1,5 +1,6 @@
 // Tests for PatchHierarchy: area bookkeeping, option handling, shared vertices, crack-free vertex
 // values, aggregation, area-uniform sampling and progress and cancel while meshing.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -380,6 +381,69 @@ TEST_CASE("the default Cornell box meshes into a few hundred patches and a few t
   double area = 0.0;
   for (const std::uint32_t id : h.leaves()) area += h.element(id).area;
   CHECK(area == doctest::Approx(scene.total_area()).epsilon(1e-5));
+}
+
+TEST_CASE("a ground's elements are graded toward a house standing on it when they are larger than the house") {
+  // A 10 m house (a box) on a 1 km plot: the default elements are 21.7 m across, larger than
+  // the house, so its shadow and contact could not show. Graded (MeshOptions::
+  // grade_at_contacts), the ground's elements touching the house are at most a quarter of its
+  // size, grow to at most half their distance from it, and far away are as before.
+  Scene scene;
+  const MaterialId m = scene.add_material(Material{});
+  scene.add_polygon({{-500, 0, 500}, {500, 0, 500}, {500, 0, -500}, {-500, 0, -500}}, m, "ground");
+  add_box(scene, {-5, 0, -5}, {5, 3, 5}, m, "house");
+  const PatchHierarchy graded(scene, MeshOptions{});
+  MeshOptions off;
+  off.grade_at_contacts = false;
+  const PatchHierarchy plain(scene, off);
+  const GroupId ground = *scene.find_group("ground");
+  double area = 0.0, largest = 0.0, largest_plain = 0.0, at_house = 0.0, worst_grading = 0.0;
+  std::size_t ground_leaves = 0;
+  for (const std::uint32_t id : graded.leaves()) {
+    const Element& e = graded.element(id);
+    area += e.area;
+    if (scene.polygons()[graded.patches()[e.patch].polygon].group != ground) continue;
+    ++ground_leaves;
+    const double edge = std::sqrt(static_cast<double>(e.area));
+    largest = std::max(largest, edge);
+    // The gap between the element and the house's footprint, |x|, |z| <= 5 (0 inside it).
+    float gap = 0.0f;
+    for (int k = 0; k < 3; k += 2) {
+      float lo = 1e9f, hi = -1e9f;
+      for (int c = 0; c < e.corner_count(); ++c) {
+        lo = std::min(lo, graded.vertices()[e.corners[static_cast<std::size_t>(c)]][k]);
+        hi = std::max(hi, graded.vertices()[e.corners[static_cast<std::size_t>(c)]][k]);
+      }
+      gap = std::max({gap, lo - 5.0f, -5.0f - hi});
+    }
+    if (gap <= 0.0f) at_house = std::max(at_house, edge);
+    // Within the reach of the distance rule (two elements' size), no element larger than
+    // about its distance: the rule splits while edge > max(2.5, gap / 2) measured from the
+    // element's centre less its radius, so edge <= 2 gap + a level's slack.
+    if (gap > 0.0f && edge > 2.5) worst_grading = std::max(worst_grading, edge / static_cast<double>(gap));
+  }
+  for (const std::uint32_t id : plain.leaves()) {
+    const Element& e = plain.element(id);
+    if (scene.polygons()[plain.patches()[e.patch].polygon].group == ground)
+      largest_plain = std::max(largest_plain, std::sqrt(static_cast<double>(e.area)));
+  }
+  MESSAGE("ground leaves " << ground_leaves << " (without grading " << plain.leaves().size() - 6
+                           << "), at the house " << at_house << " m, largest " << largest << " m, worst edge / gap "
+                           << worst_grading);
+  CHECK(area == doctest::Approx(scene.total_area()).epsilon(1e-5));
+  CHECK(at_house <= 2.5);
+  CHECK(largest == doctest::Approx(largest_plain));
+  CHECK(largest_plain > 20.0);
+  CHECK(worst_grading <= 4.0);
+  // A few hundred elements more, not thousands: the grading follows the house, not the plot.
+  CHECK(graded.leaves().size() > plain.leaves().size() + 100);
+  CHECK(graded.leaves().size() < plain.leaves().size() + 1000);
+  // Where the elements are smaller than what stands on them, nothing changes (the Cornell
+  // box's blocks, 165 mm, on its 31 mm floor elements).
+  const Scene cornell = cornell_box();
+  MeshOptions cornell_off;
+  cornell_off.grade_at_contacts = false;
+  CHECK(PatchHierarchy(cornell, MeshOptions{}).leaves() == PatchHierarchy(cornell, cornell_off).leaves());
 }
 
 }  // TEST_SUITE("mesh")

@@ -8,6 +8,8 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -53,8 +55,10 @@ struct Estimate {
   bool default_hierarchical = false;
   unsigned default_specular_depth = 0;
   std::size_t memory_budget = 0;  ///< SolveOptions::memory_budget_bytes as solve() applies it
-  /// Per polygon: the area of its largest element (scene units^2).
-  std::vector<float> largest_element;
+  /// Per overlap of CheckResult::overlaps, the area of the element of its first and of its
+  /// second polygon nearest the place they meet (scene units^2): what the default mesh, graded
+  /// toward contacts (rad::MeshOptions::grade_at_contacts), has there.
+  std::vector<std::pair<float, float>> contact_element;
 };
 
 struct CheckResult {
@@ -76,7 +80,8 @@ struct CheckResult {
 
 bool emits(const rad::Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
 
-Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions& mesh) {
+Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions& mesh,
+                                const std::vector<rad::PolygonOverlap>& overlaps) {
   // The default solve's choices are the library's own (Problem::plan()), so that what check
   // says is what solve does; the two what-if figures (dense matrix, sparse rows) are ours.
   rad::SolveOptions options;
@@ -107,11 +112,26 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
   const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
   e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
-  e.largest_element.assign(scene.polygons().size(), 0.0f);
-  for (std::uint32_t leaf : hierarchy.leaves()) {
-    const rad::Element& element = hierarchy.element(leaf);
-    float& largest = e.largest_element[hierarchy.patches()[element.patch].polygon];
-    largest = std::max(largest, element.area);
+  {
+    // The leaves of the polygons that meet another, then each meeting's nearest leaf.
+    std::vector<std::vector<std::uint32_t>> leaves_of(scene.polygons().size());
+    std::vector<bool> wanted(scene.polygons().size(), false);
+    for (const rad::PolygonOverlap& o : overlaps) wanted[o.first] = wanted[o.second] = true;
+    for (std::uint32_t leaf : hierarchy.leaves()) {
+      const rad::PolygonId polygon = hierarchy.patches()[hierarchy.element(leaf).patch].polygon;
+      if (wanted[polygon]) leaves_of[polygon].push_back(leaf);
+    }
+    auto nearest = [&](rad::PolygonId polygon, const glm::vec3& point) {
+      float best = std::numeric_limits<float>::max(), area = 0.0f;
+      for (std::uint32_t leaf : leaves_of[polygon]) {
+        const rad::Element& element = hierarchy.element(leaf);
+        const float d = glm::distance(element.centroid, point);
+        if (d < best) best = d, area = element.area;
+      }
+      return area;
+    };
+    for (const rad::PolygonOverlap& o : overlaps)
+      e.contact_element.emplace_back(nearest(o.first, o.point), nearest(o.second, o.point));
   }
   const rad::SolvePlan plan = problem.plan();
   e.default_method = plan.row_form_factor_method;
@@ -123,11 +143,18 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   return e;
 }
 
-/// Groups that stand on or pass through a polygon whose elements are larger than the whole
-/// group (a house on a 1 km ground of 21.7 m elements): its shadow and contact cannot show on
-/// that polygon. One warning per pair of groups, the first kShownPairs of them.
+/// Groups that stand on or pass through a polygon whose elements where they meet are larger
+/// than the whole group: its shadow and contact cannot show on that polygon. The default mesh
+/// is graded toward such contacts (rad::MeshOptions::grade_at_contacts), so this is what the
+/// grading's limits left (8 levels below the polygon's elements: a 2 cm pebble on a 1 km
+/// plot; as many new elements as the mesh had: thousands of objects on one coarse ground).
+/// One warning per pair of groups, the first kShownPairs of them.
+/// A --max-element-area is suggested only when the scene would have at most this many elements.
+constexpr double kMaxSuggestedElements = 4e6;
+
 void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::PolygonOverlap>& overlaps,
-                             const std::vector<float>& largest_element, std::vector<std::string>& warnings) {
+                             const std::vector<std::pair<float, float>>& contact_element,
+                             std::vector<std::string>& warnings) {
   constexpr std::size_t kShownPairs = 3;
   const std::vector<rad::Polygon>& polygons = scene.polygons();
   // Each group's largest extent along an axis.
@@ -147,29 +174,36 @@ void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::Pol
     float element, object_size;
   };
   std::vector<Pair> pairs;
-  for (const rad::PolygonOverlap& o : overlaps) {
+  for (std::size_t k = 0; k < overlaps.size(); ++k) {
+    const rad::PolygonOverlap& o = overlaps[k];
     const rad::Polygon &first = polygons[o.first], &second = polygons[o.second];
     // Contact: coincident and facing apart, or one passing through the other.
     if (o.kind == rad::OverlapKind::coincident && glm::dot(first.normal, second.normal) > 0.0f) continue;
-    for (const auto& [under, object] : {std::make_pair(o.first, o.second), std::make_pair(o.second, o.first)}) {
+    for (const auto& [under, object, area] : {std::make_tuple(o.first, o.second, contact_element[k].first),
+                                              std::make_tuple(o.second, o.first, contact_element[k].second)}) {
       const rad::GroupId g = polygons[under].group, h = polygons[object].group;
-      const float element = std::sqrt(largest_element[under]), size = size_of(h);
+      const float element = std::sqrt(area), size = size_of(h);
       if (g == h || !(element > size)) continue;
-      if (std::none_of(pairs.begin(), pairs.end(), [&](const Pair& q) { return q.under == g && q.object == h; }))
-        pairs.push_back(Pair{g, h, element, size});
+      const auto same = std::find_if(pairs.begin(), pairs.end(), [&](const Pair& q) { return q.under == g && q.object == h; });
+      if (same == pairs.end()) pairs.push_back(Pair{g, h, element, size});
+      else same->element = std::max(same->element, element);
     }
   }
   for (std::size_t k = 0; k < pairs.size() && k < kShownPairs; ++k) {
     const Pair& q = pairs[k];
     const float suggested = 0.0625f * q.object_size * q.object_size;  // elements a quarter of its size
     char figures[160];
-    std::snprintf(figures, sizeof figures, "elements up to %.3g across, larger than group '%s' (%.3g) that stands on "
-                  "or passes through it", q.element, scene.groups()[q.object].c_str(), q.object_size);
-    char hint[96];
-    std::snprintf(hint, sizeof hint, "lower --max-element-area (%.3g gives elements a quarter of its size)", suggested);
+    std::snprintf(figures, sizeof figures, "elements of %.3g across where group '%s' (%.3g) stands on or passes "
+                  "through it, larger than that group", q.element, scene.groups()[q.object].c_str(), q.object_size);
+    // The option only where the whole scene at that size stays a mesh one can solve.
+    char hint[96] = "";
+    if (scene.total_area() / static_cast<double>(suggested) <= kMaxSuggestedElements)
+      std::snprintf(hint, sizeof hint, ", or lower --max-element-area (%.3g gives elements a quarter of its size)",
+                    suggested);
     warnings.push_back("group '" + scene.groups()[q.under] + "' has " + figures +
-                       ": its shadow and contact cannot show there; cut '" + scene.groups()[q.under] +
-                       "' finer around it in the model, or " + hint);
+                       ": its shadow and contact cannot show there (the mesh is graded toward contacts by at most 8 "
+                       "levels and as many new elements as it had, at least 65536); cut '" +
+                       scene.groups()[q.under] + "' finer around it in the model" + hint);
   }
   if (pairs.size() > kShownPairs)
     warnings.push_back(std::to_string(pairs.size() - kShownPairs) +
@@ -220,12 +254,12 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   mesh.max_patch_area = a.max_patch_area;
   mesh.max_element_area = a.max_element_area;
   try {
-    r.estimate = estimate_default_solve(scene, mesh);
+    r.estimate = estimate_default_solve(scene, mesh, r.overlaps);
   } catch (const rad::Error& e) {
     r.error = e.what();  // e.g. max_element_area > max_patch_area, or far too many elements
     return r;
   }
-  coarse_contact_warnings(scene, r.overlaps, r.estimate->largest_element, r.warnings);
+  coarse_contact_warnings(scene, r.overlaps, r.estimate->contact_element, r.warnings);
   if (r.z_fighting > 0)
     r.warnings.push_back(std::to_string(r.z_fighting) +
                          " pair(s) of coincident polygons face the same way (z-fighting): which is in front is "
