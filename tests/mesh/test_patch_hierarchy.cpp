@@ -384,10 +384,11 @@ TEST_CASE("the default Cornell box meshes into a few hundred patches and a few t
 }
 
 TEST_CASE("a ground's elements are graded toward a house standing on it when they are larger than the house") {
-  // A 10 m house (a box) on a 1 km plot: the default elements are 21.7 m across, larger than
-  // the house, so its shadow and contact could not show. Graded (MeshOptions::
-  // grade_at_contacts), the ground's elements touching the house are at most a quarter of its
-  // size, grow to at most half their distance from it, and far away are as before.
+  // A 10 m wide, 3 m high house (a box) on a 1 km plot: the default elements are 21.7 m
+  // across, larger than the house, so its shadow and contact could not show. Graded
+  // (MeshOptions::grade_at_contacts), the ground's elements across the house's walls are at
+  // most a quarter of its size (its height, 3 m, the smaller), grow to at most about twice
+  // their distance from it, and far away are as before.
   Scene scene;
   const MaterialId m = scene.add_material(Material{});
   scene.add_polygon({{-500, 0, 500}, {500, 0, 500}, {500, 0, -500}, {-500, 0, -500}}, m, "ground");
@@ -406,8 +407,10 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
     ++ground_leaves;
     const double edge = std::sqrt(static_cast<double>(e.area));
     largest = std::max(largest, edge);
-    // The gap between the element and the house's footprint, |x|, |z| <= 5 (0 inside it).
+    // The gap between the element and the house's footprint, |x|, |z| <= 5 (0 where they
+    // meet), and whether it lies wholly inside the footprint.
     float gap = 0.0f;
+    bool inside = true;
     for (int k = 0; k < 3; k += 2) {
       float lo = 1e9f, hi = -1e9f;
       for (int c = 0; c < e.corner_count(); ++c) {
@@ -415,12 +418,13 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
         hi = std::max(hi, graded.vertices()[e.corners[static_cast<std::size_t>(c)]][k]);
       }
       gap = std::max({gap, lo - 5.0f, -5.0f - hi});
+      inside = inside && lo > -5.0f && hi < 5.0f;
     }
-    if (gap <= 0.0f) at_house = std::max(at_house, edge);
-    // Within the reach of the distance rule (two elements' size), no element larger than
-    // about its distance: the rule splits while edge > max(2.5, gap / 2) measured from the
-    // element's centre less its radius, so edge <= 2 gap + a level's slack.
-    if (gap > 0.0f && edge > 2.5) worst_grading = std::max(worst_grading, edge / static_cast<double>(gap));
+    if (gap <= 0.0f && !inside) at_house = std::max(at_house, edge);
+    // Beyond the contact, no element larger than about twice its distance: the rule splits
+    // while edge > max(0.75, gap / 2), gap measured from the element's centre less its
+    // radius, so edge <= 2 gap and a level's slack.
+    if (gap > 0.0f && edge > 0.75) worst_grading = std::max(worst_grading, edge / static_cast<double>(gap));
   }
   for (const std::uint32_t id : plain.leaves()) {
     const Element& e = plain.element(id);
@@ -431,13 +435,14 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
                            << "), at the house " << at_house << " m, largest " << largest << " m, worst edge / gap "
                            << worst_grading);
   CHECK(area == doctest::Approx(scene.total_area()).epsilon(1e-5));
-  CHECK(at_house <= 2.5);
+  CHECK(at_house <= 0.75);
   CHECK(largest == doctest::Approx(largest_plain));
   CHECK(largest_plain > 20.0);
   CHECK(worst_grading <= 4.0);
-  // A few hundred elements more, not thousands: the grading follows the house, not the plot.
+  // About a thousand elements more (1 008), not the plot at the house's scale (millions):
+  // the grading follows the house.
   CHECK(graded.leaves().size() > plain.leaves().size() + 100);
-  CHECK(graded.leaves().size() < plain.leaves().size() + 1000);
+  CHECK(graded.leaves().size() < plain.leaves().size() + 2000);
   // Where the elements are smaller than what stands on them, nothing changes (the Cornell
   // box's blocks, 165 mm, on its 31 mm floor elements).
   const Scene cornell = cornell_box();
