@@ -405,6 +405,13 @@ struct PolygonOverlap {
   PolygonId second = 0;
   OverlapKind kind = OverlapKind::coincident;
   glm::vec3 point{0.0f};  ///< a point where they meet: the middle of the shared region or crossing
+  bool same_facing = false;  ///< their normals point the same way (a positive dot product)
+
+  /// Coincident and facing the same way: which of them is in front is decided by rounding.
+  bool z_fighting() const { return kind == OverlapKind::coincident && same_facing; }
+  /// Coincident and facing apart: one lies against the other (a box's bottom on a floor, a wall
+  /// modelled once per room), in contact, lit correctly.
+  bool lying_against() const { return kind == OverlapKind::coincident && !same_facing; }
 };
 
 /// Pairs of polygons that are coincident or interpenetrate, sorted by (first, second). Distances

@@ -136,9 +136,7 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
   std::vector<PolygonId> against;
   if (!seeing_nothing.empty())
     for (const PolygonOverlap& o : overlaps_found()) {
-      if (o.kind != OverlapKind::coincident ||
-          glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) >= 0.0f)
-        continue;
+      if (!o.lying_against()) continue;
       for (const PolygonId p : {o.first, o.second})
         if (std::binary_search(seeing_nothing.begin(), seeing_nothing.end(), p)) against.push_back(p);
     }

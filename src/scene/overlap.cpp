@@ -181,6 +181,7 @@ bool test_pair(const Search& s, PolygonId ia, PolygonId ib, PolygonOverlap& out)
   const double ta = s.tolerance + pb.flatness, tb = s.tolerance + pa.flatness;
   out.first = ia;
   out.second = ib;
+  out.same_facing = glm::dot(a.normal, b.normal) > 0.0f;
 
   const bool a_in_b = sa.lo >= -ta && sa.hi <= ta, b_in_a = sb.lo >= -tb && sb.hi <= tb;
   if (a_in_b || b_in_a) {
@@ -481,9 +482,7 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing
   std::vector<const PolygonOverlap*> same_facing;
   const std::vector<PolygonOverlap> found = overlaps(scene, keep_going);
   for (const PolygonOverlap& o : found)
-    if (o.kind == OverlapKind::coincident &&
-        glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) > 0.0f)
-      same_facing.push_back(&o);
+    if (o.z_fighting()) same_facing.push_back(&o);
   if (same_facing.empty()) return out;
   const PolygonOverlap& o = *same_facing.front();
   auto name = [&](PolygonId p) {

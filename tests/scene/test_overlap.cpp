@@ -109,6 +109,10 @@ TEST_SUITE("scene") {
         const std::vector<rad::PolygonOverlap> o = rad::find_overlaps(b.scene);
         REQUIRE(o.size() == 1);
         CHECK(o[0].kind == rad::OverlapKind::coincident);
+        // Facing the same way they z-fight; facing apart one lies against the other.
+        CHECK(o[0].same_facing == !flip);
+        CHECK(o[0].z_fighting() == !flip);
+        CHECK(o[0].lying_against() == flip);
         // The overlap is [0.5, 1] x [0, 1]; its middle.
         CHECK(glm::length(o[0].point - m({0.75f, 0.5f, 0.0f})) < 1e-3f);
         CHECK(contains(error_of(b.scene), "polygon 0 (group 'a') and polygon 1 (group 'b') are coincident"));
@@ -152,6 +156,8 @@ TEST_SUITE("scene") {
       const std::vector<rad::PolygonOverlap> o = rad::find_overlaps(b.scene);
       REQUIRE(o.size() == 1);
       CHECK(o[0].kind == rad::OverlapKind::interpenetrating);
+      CHECK(!o[0].z_fighting());
+      CHECK(!o[0].lying_against());
       // They cross along x = 0.5, z = 0, y in [0, 1]: the middle of that segment.
       CHECK(glm::length(o[0].point - m({0.5f, 0.5f, 0.0f})) < 1e-3f);
       CHECK(contains(error_of(b.scene), "polygon 0 (group 'sheet') and polygon 1 (group 'blade') interpenetrate"));

@@ -176,9 +176,8 @@ void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::Pol
   std::vector<Pair> pairs;
   for (std::size_t k = 0; k < overlaps.size(); ++k) {
     const rad::PolygonOverlap& o = overlaps[k];
-    const rad::Polygon &first = polygons[o.first], &second = polygons[o.second];
     // Contact: coincident and facing apart, or one passing through the other.
-    if (o.kind == rad::OverlapKind::coincident && glm::dot(first.normal, second.normal) > 0.0f) continue;
+    if (o.z_fighting()) continue;
     for (const auto& [under, object, area] : {std::make_tuple(o.first, o.second, contact_element[k].first),
                                               std::make_tuple(o.second, o.first, contact_element[k].second)}) {
       const rad::GroupId g = polygons[under].group, h = polygons[object].group;
@@ -229,9 +228,7 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   r.overlaps = rad::find_overlaps(scene);
   for (const rad::PolygonOverlap& o : r.overlaps) {
     (o.kind == rad::OverlapKind::coincident ? r.coincident : r.interpenetrating) += 1;
-    if (o.kind == rad::OverlapKind::coincident &&
-        glm::dot(scene.polygons()[o.first].normal, scene.polygons()[o.second].normal) > 0.0f)
-      ++r.z_fighting;
+    if (o.z_fighting()) ++r.z_fighting;
   }
   r.facing_away = rad::find_emitters_facing_away(scene);
   {

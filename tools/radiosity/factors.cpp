@@ -306,9 +306,7 @@ int run_factors(const FactorsArgs& a) {
       if (level == "polygon") {
         touching.assign(scene.polygons().size(), false);
         for (const rad::PolygonOverlap& p : rad::find_overlaps(scene))
-          if (p.kind == rad::OverlapKind::coincident &&
-              glm::dot(scene.polygons()[p.first].normal, scene.polygons()[p.second].normal) < 0.0f)
-            touching[p.first] = touching[p.second] = true;
+          if (p.lying_against()) touching[p.first] = touching[p.second] = true;
       }
       for (std::size_t i = 0; i < m.rows(); ++i) {
         if (m.row_offsets[i + 1] != m.row_offsets[i]) continue;
