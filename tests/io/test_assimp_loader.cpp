@@ -534,6 +534,19 @@ TEST_CASE("Assimp broken PLY: an ASCII body that Assimp would read past its line
   CHECK(contains(second.what(), "second_face_element.ply:5: a second PLY element of faces ('face' or 'tristrips') "
                                 "(the first is on line 3); the PLY reader (Assimp 5.2) would write its instances into "
                                 "the first one's storage, past its end when it has more"));
+  // A second format line: Assimp reads the first (line 2: ascii), the walk took the last
+  // ("binaryformat" for binary) and let an ASCII list count of 444444444 through, which Assimp
+  // reserved (3.5 GB; radiosity_fuzz_ply, session 34). And format words that are none of
+  // PLY's three, which Assimp reads as one of them by a prefix.
+  CHECK(contains(load_error(fs::path(RADIOSITY_TEST_DATA) / "fuzz" / "ply" / "second_format_line.ply").what(),
+                 "second_format_line.ply:7: a second PLY format line (the first is on line 2); the PLY reader "
+                 "(Assimp 5.2) reads the first"));
+  CHECK(contains(load_error(write("two_formats.ply", ply_with("comment a unit square", "format binary_big_endian 1.0")))
+                     .what(),
+                 "two_formats.ply:3: a second PLY format line (the first is on line 2)"));
+  CHECK(contains(load_error(write("format_word.ply", ply_with("format ascii", "format binary_bigendian"))).what(),
+                 "format_word.ply:2: PLY format 'binary_bigendian', which is none of ascii, binary_little_endian and "
+                 "binary_big_endian"));
   std::string two_elements = kPly;
   two_elements.replace(two_elements.find("end_header"), 10,
                        "element face 2\nproperty list uchar int vertex_indices\nend_header");

@@ -273,6 +273,7 @@ PlyHeader read_ply_header(const fs::path& path) {
   };
   bool in_element = false;  // the lines since the last element line were its properties (or comments)
   bool ended = false;
+  std::size_t format_line = 0;
   while (in.offset() < (std::size_t{1} << 20) && lines.next(line, number)) {
     if (const std::size_t at = control_byte(line); at != std::string::npos) {
       char code[8];
@@ -289,9 +290,22 @@ PlyHeader read_ply_header(const fs::path& path) {
     }
     if (number == 1 || word == "comment" || word == "obj_info") continue;  // line 1 is "ply" (Assimp checks it)
     if (word == "format") {
+      // Assimp 5.2 takes the format from the line after "ply" and passes over any later one
+      // (its header parser ignores the lines it does not know): a second format line made
+      // this walk read an ASCII body as binary, and Assimp reserved a list of 444444444 items
+      // (3.5 GB) from a 1.4 kB file (radiosity_fuzz_ply, session 34).
+      if (format_line != 0)
+        refuse("a second PLY format line (the first is on line " + std::to_string(format_line) +
+               "); the PLY reader (Assimp 5.2) reads the first");
+      format_line = number;
       std::string format;
       words >> format;
-      header.binary = format.rfind("binary", 0) == 0;
+      // Assimp tells the formats by "ascii" and the prefix "binary_" (big-endian when a 'b'
+      // follows), so it reads other words as one of them: only PLY's own three.
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+        refuse("PLY format '" + format.substr(0, 40) + "', which is none of ascii, binary_little_endian and "
+               "binary_big_endian");
+      header.binary = format != "ascii";
       header.big_endian = format == "binary_big_endian";
       in_element = false;
     } else if (word == "element") {
