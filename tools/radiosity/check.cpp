@@ -224,7 +224,9 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     return r;
   }
   r.lights = scene.lights().size();
-  if (r.emitters == 0 && r.lights == 0) r.warnings.push_back("the scene emits no light; every radiosity is 0");
+  if (r.emitters == 0 && r.lights == 0)
+    r.warnings.push_back("the scene emits no light; every radiosity is 0 (render lights it by a uniform sky unless "
+                         "--no-default-light)");
   r.overlaps = rad::find_overlaps(scene);
   for (const rad::PolygonOverlap& o : r.overlaps) {
     (o.kind == rad::OverlapKind::coincident ? r.coincident : r.interpenetrating) += 1;

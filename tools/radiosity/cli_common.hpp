@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <glm/common.hpp>
 
 #include "radiosity/radiosity.hpp"
 
@@ -461,6 +462,23 @@ inline rad::Scene load(const std::string& path, bool strict, bool photometric, c
   reverse_winding(scene, edits.reverse_winding);
   if (edits.two_sided) scene.make_two_sided();
   return scene;
+}
+
+/// Whether anything in `scene` gives light: a light, or a polygon of an emitting material.
+inline bool has_light(const rad::Scene& scene) {
+  if (!scene.lights().empty()) return true;
+  for (const rad::Polygon& p : scene.polygons()) {
+    const rad::Rgb e = scene.material(p.material).emission;
+    if (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f) return true;
+  }
+  return false;
+}
+
+/// "+y", "-z", ...: the axis a unit axis vector points along.
+inline std::string axis_name(const glm::vec3& v) {
+  const glm::vec3 a = glm::abs(v);
+  const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+  return std::string(v[axis] < 0.0f ? "-" : "+") + "xyz"[axis];
 }
 
 inline void print_warnings(const std::vector<std::string>& warnings) {

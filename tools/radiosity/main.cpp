@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   // render
   SolveArgs render_args;
   std::string out = "radiosity.exr", png;
-  bool no_png = false;
+  bool no_png = false, no_default_light = false;
   int width = 512, height = 512, spp = 0;
   std::string eye, look_at, up;
   float fov = 0.0f;
@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
   render->add_option("-o,--output", out, "EXR output")->capture_default_str();
   render->add_option("--png", png, "PNG preview (default: the EXR path with .png)");
   render->add_flag("--no-png", no_png, "Do not write a PNG preview");
+  render->add_flag("--no-default-light", no_default_light,
+                   "Render a scene without lights or emitting materials black (by default a uniform sky of 1 W/m^2 "
+                   "lights it, so that it shows)");
   render->add_option("--width", width, "Image width")->check(positive<int>())->capture_default_str();
   render->add_option("--height", height, "Image height")->check(positive<int>())->capture_default_str();
   render
@@ -127,6 +130,21 @@ int main(int argc, char** argv) {
     if (*render) {
       rad::Scene scene = load(render_args.scene, render_args.strict, render_args.photometric, {render_args.two_sided, render_args.reverse_winding});
       print_warnings(scene.warnings());
+      // A scene without any light (an STL, a PLY, an OBJ without an emitting material) would
+      // render black: as a modeller's viewport does, a preview lights it, by a uniform sky
+      // around the scene's up (the camera choice's), and says so. solve, bake and the library
+      // keep such a scene dark (it is the physical answer; they warn).
+      if (!no_default_light && !has_light(scene)) {
+        const glm::vec3 zenith = rad::choose_camera(scene).camera.up;
+        rad::Light sky;
+        sky.type = rad::LightType::sky;
+        sky.intensity = 1.0f;
+        sky.direction = zenith;
+        scene.add_light(sky);
+        std::printf("light: the scene has none: lit by a uniform sky of 1 W/m^2 around %s (the scene's up) so that "
+                    "it shows; give it lights or emitting materials, or --no-default-light to render it black\n",
+                    axis_name(zenith).c_str());
+      }
       // A scene without a camera (an OBJ, STL or PLY has none) gets one chosen for it, said
       // unless --eye and --look-at place it.
       const rad::CameraChoice chosen = rad::choose_camera(scene);
