@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -49,10 +50,17 @@ struct MeshOptions {
   /// shadow and darkening show and the mesh coarsens smoothly away from it. The object's size
   /// is its group's extent (the polygon's own when both are in one group), at most its height
   /// off the polygon's plane (a 3 m high house's shadow is about 3 m across). At most 8 levels
-  /// below a polygon's elements, and at most as many new elements as the mesh had (at least
-  /// 65536); what stays coarser then is what `radiosity check` warns about. false: elements as
+  /// below a polygon's elements, and at most twice as many new elements as the mesh had (at
+  /// least 32768); what stays coarser then is what `radiosity check` warns about. false: elements as
   /// max_element_area alone gives them.
   bool grade_at_contacts = true;
+};
+
+/// What MeshOptions::grade_at_contacts did (PatchHierarchy::contact_grading()).
+struct ContactGrading {
+  std::size_t polygons = 0;      ///< polygons whose elements were graded toward a contact
+  std::size_t added_leaves = 0;  ///< leaf elements the grading added
+  bool budget_reached = false;   ///< it stopped at its element budget: some contacts stayed coarser
 };
 
 /// A node of a patch's quadtree. Leaves carry the radiosity unknowns; an inner node's value is
@@ -119,6 +127,8 @@ class RADIOSITY_API PatchHierarchy {
   const std::vector<glm::vec3>& vertices() const { return vertices_; }
   /// The effective options (derived values filled in).
   const MeshOptions& options() const { return options_; }
+  /// What the grading toward contacts did (all zero when it was off or found nothing to do).
+  const ContactGrading& contact_grading() const { return grading_; }
   const glm::vec3& normal(std::uint32_t element) const { return patches_[elements_[element].patch].normal; }
 
   /// Splits a leaf into four children and returns the id of the first. The children reuse
@@ -162,6 +172,7 @@ class RADIOSITY_API PatchHierarchy {
                      std::vector<std::uint32_t>& ids);
 
   MeshOptions options_;
+  ContactGrading grading_;
   std::vector<Patch> patches_;
   std::vector<Element> elements_;
   std::vector<std::uint32_t> leaves_;

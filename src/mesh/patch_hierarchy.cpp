@@ -64,9 +64,10 @@ constexpr double kMaxEstimatedElements = 1u << 28;
 constexpr double kGradeTargetShare = 0.25;
 constexpr int kMaxGradeLevels = 8;
 constexpr double kGradeDistanceShare = 0.5;
-// The new elements may be as many as the mesh had, and at least this many (a small scene with
-// one object on a large ground).
-constexpr std::size_t kMinGradeBudget = 65536;
+// The new elements may be twice as many as the mesh had, and at least this many (a small scene
+// with objects on a large ground): the cost of a solve stays within a few times the ungraded one.
+constexpr std::size_t kGradeBudgetShare = 2;
+constexpr std::size_t kMinGradeBudget = 32768;
 
 double distance_to_segment(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
   const glm::dvec3 ab = b - a;
@@ -249,7 +250,7 @@ void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b)
 // `keep_going` said no (polled per element visited).
 template <typename KeepGoingFn>
 bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vector<detail::ContactSegment>& segments,
-                           const KeepGoingFn& keep_going) {
+                           const KeepGoingFn& keep_going, ContactGrading& report) {
   const std::vector<Polygon>& polygons = scene.polygons();
   // The size of what stands on a polygon: its group's largest extent, or the polygon's own when
   // both are in one group (a single-group file: its whole extent says nothing).
@@ -321,8 +322,9 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
   // Level by level over every graded polygon, so that when the budget runs out every contact
   // has been graded as far as the others (a village on a plot: each house's ground a level or
   // two finer, not the first houses' four levels and the rest none).
-  const std::size_t budget = std::max(h.leaves().size(), kMinGradeBudget);
+  const std::size_t budget = std::max(kGradeBudgetShare * h.leaves().size(), kMinGradeBudget);
   std::size_t added = 0;
+  report.polygons = graded.size();
   std::vector<std::uint32_t> stack, split;
   for (;;) {
     split.clear();
@@ -353,9 +355,13 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
       }
     if (split.empty()) return true;
     for (const std::uint32_t e : split) {
-      if (added + 3 > budget) return true;  // what stays coarse is for `radiosity check` to say
+      if (added + 3 > budget) {
+        report.budget_reached = true;  // what stays coarse is for `radiosity check` to say
+        return true;
+      }
       h.subdivide(e);
       added += 3;
+      report.added_leaves = added;
     }
   }
 }
@@ -604,6 +610,7 @@ PatchHierarchy& PatchHierarchy::operator=(PatchHierarchy&&) noexcept = default;
 
 PatchHierarchy::PatchHierarchy(const PatchHierarchy& other)
     : options_(other.options_),
+      grading_(other.grading_),
       patches_(other.patches_),
       elements_(other.elements_),
       leaves_(other.leaves_),
@@ -770,9 +777,11 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
       for (std::uint32_t k = 4; k-- > 0;) stack.push_back(first + k);
     }
   }
-  if (!segments.empty() && !grade_toward_contacts(*this, scene, segments, [&] {
-        return ++splits % kCheckEvery != 0 || !gate.due(Phase::meshing) || report(0.99);
-      }))
+  grading_ = ContactGrading{};
+  if (!segments.empty() && !grade_toward_contacts(
+                               *this, scene, segments,
+                               [&] { return ++splits % kCheckEvery != 0 || !gate.due(Phase::meshing) || report(0.99); },
+                               grading_))
     return false;
   return report(1.0, true);
 }

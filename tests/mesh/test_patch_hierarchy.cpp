@@ -443,6 +443,12 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
   // the grading follows the house.
   CHECK(graded.leaves().size() > plain.leaves().size() + 100);
   CHECK(graded.leaves().size() < plain.leaves().size() + 2000);
+  // And it says what it did.
+  CHECK(graded.contact_grading().polygons == 1);
+  CHECK(graded.contact_grading().added_leaves == graded.leaves().size() - plain.leaves().size());
+  CHECK(!graded.contact_grading().budget_reached);
+  CHECK(plain.contact_grading().polygons == 0);
+  CHECK(plain.contact_grading().added_leaves == 0);
   // Where the elements are smaller than what stands on them, nothing changes (the Cornell
   // box's blocks, 165 mm, on its 31 mm floor elements).
   const Scene cornell = cornell_box();

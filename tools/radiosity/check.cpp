@@ -147,7 +147,7 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
 /// than the whole group: its shadow and contact cannot show on that polygon. The default mesh
 /// is graded toward such contacts (rad::MeshOptions::grade_at_contacts), so this is what the
 /// grading's limits left (8 levels below the polygon's elements: a 2 cm pebble on a 1 km
-/// plot; as many new elements as the mesh had: thousands of objects on one coarse ground).
+/// plot; twice as many new elements as the mesh had: thousands of objects on one coarse ground).
 /// One warning per pair of groups, the first kShownPairs of them.
 /// A --max-element-area is suggested only when the scene would have at most this many elements.
 constexpr double kMaxSuggestedElements = 4e6;
@@ -201,7 +201,7 @@ void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::Pol
                     suggested);
     warnings.push_back("group '" + scene.groups()[q.under] + "' has " + figures +
                        ": its shadow and contact cannot show there (the mesh is graded toward contacts by at most 8 "
-                       "levels and as many new elements as it had, at least 65536); cut '" +
+                       "levels and twice as many new elements as it had, at least 32768); cut '" +
                        scene.groups()[q.under] + "' finer around it in the model" + hint);
   }
   if (pairs.size() > kShownPairs)

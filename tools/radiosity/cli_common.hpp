@@ -499,6 +499,13 @@ inline void print_summary(const rad::Solution& sol) {
                                                                          : "cancelled";
   std::printf("solved: %zu patches, %zu elements, %d iterations, residual %.3g (%s)\n", r.patch_count,
               r.element_count, r.iterations, r.residual, status);
+  // The mesh's grading toward what stands on coarse polygons (rad::MeshOptions::grade_at_contacts).
+  const rad::ContactGrading& graded = sol.hierarchy().contact_grading();
+  if (graded.polygons > 0)
+    std::printf("mesh: graded toward what stands on %zu polygon%s with elements larger than it: %zu more elements%s\n",
+                graded.polygons, graded.polygons == 1 ? "" : "s", graded.added_leaves,
+                graded.budget_reached ? " (its budget reached: some contacts stay coarser; radiosity check names them)"
+                                      : "");
   if (r.link_count > 0)
     std::printf("hierarchical: %zu links (%.1f MiB with the cluster tree), %d refinement passes, %zu elements split\n",
                 r.link_count, static_cast<double>(r.form_factor_bytes) / (1024.0 * 1024.0), r.refinement_passes,
