@@ -28,6 +28,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
@@ -299,10 +300,48 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
     glm::dvec3 from, to;
     double size;  // elements touching it are split while larger
   };
+  // A polygon's targets in a uniform grid of cells of twice its largest element (a forest on
+  // a plot has thousands of them, and a leaf is split only for those within twice its size).
   struct Graded {
-    PolygonId polygon;
-    double smallest_area;  // kMaxGradeLevels below its largest element (less rounding)
+    PolygonId polygon = 0;
+    double smallest_area = 0.0;  // kMaxGradeLevels below its largest element (less rounding)
     std::vector<Target> targets;
+    double cell = 0.0;
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;  // cell -> targets
+
+    static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
+      // 21 bits a coordinate: cells repeat every 2^21 (aliases only cost a few extra tests).
+      constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
+      return (static_cast<std::uint64_t>(x) & mask) | ((static_cast<std::uint64_t>(y) & mask) << 21) |
+             ((static_cast<std::uint64_t>(z) & mask) << 42);
+    }
+    std::int64_t at(double v) const { return static_cast<std::int64_t>(std::floor(v / cell)); }
+    void index(double element) {
+      cell = 2.0 * element;
+      for (std::uint32_t t = 0; t < targets.size(); ++t) {
+        const glm::dvec3 lo = glm::min(targets[t].from, targets[t].to), hi = glm::max(targets[t].from, targets[t].to);
+        for (std::int64_t x = at(lo.x); x <= at(hi.x); ++x)
+          for (std::int64_t y = at(lo.y); y <= at(hi.y); ++y)
+            for (std::int64_t z = at(lo.z); z <= at(hi.z); ++z) grid[key(x, y, z)].push_back(t);
+      }
+    }
+    /// Whether a leaf (centre, bounding radius, edge) is to be split for a target near it.
+    bool wants_split(const glm::dvec3& centre, double radius, double edge) const {
+      const double reach = radius + edge / kGradeDistanceShare;  // beyond it no target splits the leaf
+      const glm::dvec3 lo = centre - reach, hi = centre + reach;
+      for (std::int64_t x = at(lo.x); x <= at(hi.x); ++x)
+        for (std::int64_t y = at(lo.y); y <= at(hi.y); ++y)
+          for (std::int64_t z = at(lo.z); z <= at(hi.z); ++z) {
+            const auto cell_targets = grid.find(key(x, y, z));
+            if (cell_targets == grid.end()) continue;
+            for (const std::uint32_t k : cell_targets->second) {
+              const Target& t = targets[k];
+              const double gap = std::max(0.0, distance_to_segment(centre, t.from, t.to) - radius);
+              if (edge > t.size && edge > kGradeDistanceShare * gap) return true;
+            }
+          }
+      return false;
+    }
   };
   std::vector<Graded> graded;
   for (std::size_t k = 0; k < segments.size();) {
@@ -312,12 +351,16 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
     // the scene (and a model cut into facets of one size, walls standing on ground facets,
     // stays as it is).
     const double element = std::sqrt(static_cast<double>(largest[id]));
-    Graded g{id, static_cast<double>(largest[id]) / std::pow(4.0, kMaxGradeLevels) * (1.0 - 1e-3), {}};
+    Graded g;
+    g.polygon = id;
+    g.smallest_area = static_cast<double>(largest[id]) / std::pow(4.0, kMaxGradeLevels) * (1.0 - 1e-3);
     for (; k < segments.size() && segments[k].polygon == id; ++k) {
       const double size = object_size(id, segments[k].other);
       if (element > size) g.targets.push_back(Target{segments[k].from, segments[k].to, kGradeTargetShare * size});
     }
-    if (!g.targets.empty()) graded.push_back(std::move(g));
+    if (g.targets.empty()) continue;
+    g.index(element);
+    graded.push_back(std::move(g));
   }
   // Level by level over every graded polygon, so that when the budget runs out every contact
   // has been graded as far as the others (a village on a plot: each house's ground a level or
@@ -345,12 +388,7 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
           double radius = 0.0;
           for (int c = 0; c < element.corner_count(); ++c)
             radius = std::max(radius, glm::length(glm::dvec3(h.vertices()[element.corners[c]]) - centre));
-          const double edge = std::sqrt(static_cast<double>(element.area));
-          if (std::any_of(g.targets.begin(), g.targets.end(), [&](const Target& t) {
-                const double gap = std::max(0.0, distance_to_segment(centre, t.from, t.to) - radius);
-                return edge > t.size && edge > kGradeDistanceShare * gap;
-              }))
-            split.push_back(e);
+          if (g.wants_split(centre, radius, std::sqrt(static_cast<double>(element.area)))) split.push_back(e);
         }
       }
     if (split.empty()) return true;
