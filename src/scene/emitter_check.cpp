@@ -170,7 +170,7 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
     warnings.push_back(std::string(many ? "emitters " : "emitter ") + by_group(away) +
                        (many ? " face away from every surface: their light leaves the scene; check the polygons' "
                              : " faces away from every surface: its light leaves the scene; check the polygon's ") +
-                       "winding (vertex order) or use two-sided materials (--two-sided)");
+                       "winding (vertex order) or use two-sided materials (--two-sided; Material::two_sided in code)");
   }
   if (!against.empty()) {
     const bool many = against.size() > 1;
@@ -195,7 +195,7 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
     if (power > 0.0 && reached > 0.95 * power) {
       warnings.push_back(std::string("the scene looks closed but ") + share +
                          " % of the emitted light left it: polygons probably face outwards (wound the wrong way); "
-                         "reverse their winding (--reverse-winding outward) or use two-sided materials (--two-sided)");
+                         "reverse their winding (--reverse-winding outward; in code, Scene::reverse_winding() of find_polygons_facing_outward()) or use two-sided materials (--two-sided; Material::two_sided in code)");
     } else {
       // The emitters' own rays may leave (a light fixture modelled as a box wound outward, its
       // top against the ceiling) while the room around them is wound outward too: ask the
@@ -209,8 +209,8 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
                            std::to_string(outward.polygons.size()) + " of " + std::to_string(scene.polygons().size()) +
                            " polygons (" + area_share +
                            " % of the one-sided area) see nothing in front of them and surfaces behind: a closed "
-                           "model wound outward? Reverse their winding (--reverse-winding outward) or use "
-                           "two-sided materials (--two-sided)");
+                           "model wound outward? Reverse their winding (--reverse-winding outward; in code, Scene::reverse_winding() of find_polygons_facing_outward()) or use "
+                           "two-sided materials (--two-sided; Material::two_sided in code)");
       }
     }
   }

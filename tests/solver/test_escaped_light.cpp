@@ -99,7 +99,9 @@ TEST_SUITE("solver") {
     REQUIRE(sol.status() == rad::SolveStatus::converged);
     CHECK(share(r.escaped_power, r.emitted_power) > 0.5);
     CHECK(has_warning(r, "the scene looks closed but 100 % of the emitted light left it: polygons probably face "
-                         "outwards (wound the wrong way); reverse their winding (--reverse-winding outward) or use two-sided materials"));
+                         "outwards (wound the wrong way); reverse their winding (--reverse-winding outward; in code, "
+                         "Scene::reverse_winding() of find_polygons_facing_outward()) or use two-sided materials "
+                         "(--two-sided; Material::two_sided in code)"));
     CHECK(!has_warning(r, "faces away"));
     CHECK(rad::find_emitters_facing_away(scene).empty());
   }
@@ -120,7 +122,8 @@ TEST_SUITE("solver") {
     CHECK(share(r.escaped_power, r.emitted_power) > 0.9);
     CHECK(!has_warning(r, "looks closed"));
     CHECK(has_warning(r, "% of the emitted light left the scene, and 6 of 12 polygons"));
-    CHECK(has_warning(r, "a closed model wound outward? Reverse their winding (--reverse-winding outward)"));
+    CHECK(has_warning(r, "a closed model wound outward? Reverse their winding (--reverse-winding outward; in code, "
+                         "Scene::reverse_winding() of find_polygons_facing_outward())"));
 
     // What the warning asks for: the room turned, the light stays in but for the fixture's top
     // (48 % of its area), which lies against the ceiling and sends into its back.
