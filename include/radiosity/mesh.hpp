@@ -48,8 +48,10 @@ struct MeshOptions {
   /// elements within reach of the contact are split until they are a quarter of the object's
   /// size, and beyond it until they are at most half their distance from it, so the contact's
   /// shadow and darkening show and the mesh coarsens smoothly away from it. The object's size
-  /// is its group's extent (the polygon's own when both are in one group), at most its height
-  /// off the polygon's plane (a 3 m high house's shadow is about 3 m across). At most 8 levels
+  /// is its group's extent (the polygon's own when both are in one group); the elements are
+  /// sized by its height off the polygon's plane within [extent / 4, extent] (a 3 m high
+  /// house's shadow is about 3 m across; a coaster is not worth elements of its thickness),
+  /// and something larger than the elements (a rug, a picture frame) changes nothing. At most 8 levels
   /// below a polygon's elements, and at most twice as many new elements as the mesh had (at
   /// least 32768); what stays coarser then is what `radiosity check` warns about. false: elements as
   /// max_element_area alone gives them.

@@ -266,8 +266,13 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
     const glm::vec3 d = hi - lo;
     return static_cast<double>(std::max({d.x, d.y, d.z}));
   };
-  // And no more than its height off the polygon's plane (its bounds' farthest corner): the
-  // shadow and the darkening at the foot of a 3 m high, 10 m wide house are about 3 m across.
+  // Its extent decides whether to grade; the elements are then sized by its height off the
+  // polygon's plane (its bounds' farthest corner), within [extent / 4, extent]: the shadow and
+  // the darkening at the foot of a 3 m high, 10 m wide house are about 3 m across, while a flat
+  // thing (a coaster, a rug smaller than an element) is not worth elements of its thickness.
+  struct Object {
+    double extent, size;
+  };
   auto object_size = [&](PolygonId under, PolygonId object) {
     const Polygon& o = polygons[object];
     glm::vec3 lo = lower[o.group], hi = upper[o.group];
@@ -284,7 +289,8 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
       const glm::dvec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
       height = std::max(height, std::fabs(glm::dot(normal, corner - origin)));
     }
-    return std::min(extent(lo, hi), height);
+    const double across = extent(lo, hi);
+    return Object{across, std::clamp(height, 0.25 * across, across)};
   };
   // Each polygon's largest element and its patches (patches are made in polygon order).
   std::vector<float> largest(polygons.size(), 0.0f);
@@ -355,8 +361,8 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
     g.polygon = id;
     g.smallest_area = static_cast<double>(largest[id]) / std::pow(4.0, kMaxGradeLevels) * (1.0 - 1e-3);
     for (; k < segments.size() && segments[k].polygon == id; ++k) {
-      const double size = object_size(id, segments[k].other);
-      if (element > size) g.targets.push_back(Target{segments[k].from, segments[k].to, kGradeTargetShare * size});
+      const Object o = object_size(id, segments[k].other);
+      if (element > o.extent) g.targets.push_back(Target{segments[k].from, segments[k].to, kGradeTargetShare * o.size});
     }
     if (g.targets.empty()) continue;
     g.index(element);

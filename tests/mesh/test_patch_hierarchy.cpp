@@ -455,6 +455,13 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
   MeshOptions cornell_off;
   cornell_off.grade_at_contacts = false;
   CHECK(PatchHierarchy(cornell, MeshOptions{}).leaves() == PatchHierarchy(cornell, cornell_off).leaves());
+  // Nor for a rug 1 cm thick, larger than the floor's elements: its thickness is no reason to
+  // mesh its border at centimetres.
+  Scene room;
+  const MaterialId w = room.add_material(Material{});
+  add_box(room, {0, 0, 0}, {4, 2.5f, 4}, w, "room");
+  add_box(room, {1, 0, 1}, {3, 0.01f, 3}, w, "rug");
+  CHECK(PatchHierarchy(room, MeshOptions{}).contact_grading().polygons == 0);
 }
 
 }  // TEST_SUITE("mesh")
