@@ -674,6 +674,7 @@ PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options) :
 PatchHierarchy::PatchHierarchy(const Scene& scene, const MeshOptions& options, const ProgressFn& on_progress)
     : PatchHierarchy() {
   if (build(scene, options, on_progress ? &on_progress : nullptr)) return;
+  grading_ = {};
   patches_ = {};
   elements_ = {};
   leaves_ = {};
