@@ -63,6 +63,16 @@ struct ContactGrading {
   std::size_t polygons = 0;      ///< polygons whose elements were graded toward a contact
   std::size_t added_leaves = 0;  ///< leaf elements the grading added
   bool budget_reached = false;   ///< it stopped at its element budget: some contacts stayed coarser
+  /// A contact whose elements the grading's limits (8 levels, the budget) left larger than
+  /// the object: its shadow and contact cannot show there.
+  struct Coarse {
+    PolygonId polygon = 0;  ///< the polygon stood on or passed through
+    PolygonId other = 0;    ///< a polygon of what stands there (the first found of its group)
+    float element = 0.0f;   ///< the largest leaf touching the contact, across (the root of its area)
+    float object = 0.0f;    ///< the object's extent (its group's; the polygon's own in one group)
+  };
+  /// One per polygon and group standing on it, by polygon, then group.
+  std::vector<Coarse> coarse;
 };
 
 /// A node of a patch's quadtree. Leaves carry the radiosity unknowns; an inner node's value is

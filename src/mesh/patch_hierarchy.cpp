@@ -25,6 +25,7 @@
 #include <limits>
 #include <numeric>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -244,6 +245,64 @@ void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b)
   else if (b < a) parent[a] = b;
 }
 
+// A contact segment a polygon is graded toward (grade_toward_contacts()).
+struct GradeTarget {
+  glm::dvec3 from, to;
+  double size;    // elements touching it are split while larger
+  double extent;  // the object's
+  PolygonId other;
+};
+// A polygon's targets in a uniform grid of cells of twice its largest element (a forest on
+// a plot has thousands of them, and a leaf is split only for those within twice its size).
+struct GradedPolygon {
+  PolygonId polygon = 0;
+  double smallest_area = 0.0;  // kMaxGradeLevels below its largest element (less rounding)
+  std::vector<GradeTarget> targets;
+  double cell = 0.0;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;  // cell -> targets
+
+  static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
+    // 21 bits a coordinate: cells repeat every 2^21 (aliases only cost a few extra tests).
+    constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
+    return (static_cast<std::uint64_t>(x) & mask) | ((static_cast<std::uint64_t>(y) & mask) << 21) |
+           ((static_cast<std::uint64_t>(z) & mask) << 42);
+  }
+  std::int64_t at(double v) const { return static_cast<std::int64_t>(std::floor(v / cell)); }
+  void index(double element) {
+    cell = 2.0 * element;
+    for (std::uint32_t t = 0; t < targets.size(); ++t) {
+      const glm::dvec3 lo = glm::min(targets[t].from, targets[t].to), hi = glm::max(targets[t].from, targets[t].to);
+      for (std::int64_t x = at(lo.x); x <= at(hi.x); ++x)
+        for (std::int64_t y = at(lo.y); y <= at(hi.y); ++y)
+          for (std::int64_t z = at(lo.z); z <= at(hi.z); ++z) grid[key(x, y, z)].push_back(t);
+    }
+  }
+  /// Calls visit(target, gap) for the targets within `reach` of a leaf (centre, bounding
+  /// radius) until it returns true; whether one did. A target may be visited twice.
+  template <typename Visit>
+  bool any_near(const glm::dvec3& centre, double radius, double reach, const Visit& visit) const {
+    const glm::dvec3 lo = centre - (radius + reach), hi = centre + (radius + reach);
+    for (std::int64_t x = at(lo.x); x <= at(hi.x); ++x)
+      for (std::int64_t y = at(lo.y); y <= at(hi.y); ++y)
+        for (std::int64_t z = at(lo.z); z <= at(hi.z); ++z) {
+          const auto cell_targets = grid.find(key(x, y, z));
+          if (cell_targets == grid.end()) continue;
+          for (const std::uint32_t k : cell_targets->second) {
+            const GradeTarget& t = targets[k];
+            if (visit(t, std::max(0.0, distance_to_segment(centre, t.from, t.to) - radius))) return true;
+          }
+        }
+    return false;
+  }
+  /// Whether a leaf (centre, bounding radius, edge) is to be split for a target near it
+  /// (beyond edge / kGradeDistanceShare none splits it).
+  bool wants_split(const glm::dvec3& centre, double radius, double edge) const {
+    return any_near(centre, radius, edge / kGradeDistanceShare, [&](const GradeTarget& t, double gap) {
+      return edge > t.size && edge > kGradeDistanceShare * gap;
+    });
+  }
+};
+
 // MeshOptions::grade_at_contacts, once every element fits max_element_area: the leaves of each
 // polygon that has contact segments are split while they are larger than a quarter of the
 // object standing there and than half their distance from it. Through the public interface
@@ -302,54 +361,7 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
   for (const Patch& p : h.patches()) ++first_patch[p.polygon + 1];
   std::partial_sum(first_patch.begin(), first_patch.end(), first_patch.begin());
 
-  struct Target {
-    glm::dvec3 from, to;
-    double size;  // elements touching it are split while larger
-  };
-  // A polygon's targets in a uniform grid of cells of twice its largest element (a forest on
-  // a plot has thousands of them, and a leaf is split only for those within twice its size).
-  struct Graded {
-    PolygonId polygon = 0;
-    double smallest_area = 0.0;  // kMaxGradeLevels below its largest element (less rounding)
-    std::vector<Target> targets;
-    double cell = 0.0;
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;  // cell -> targets
-
-    static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
-      // 21 bits a coordinate: cells repeat every 2^21 (aliases only cost a few extra tests).
-      constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
-      return (static_cast<std::uint64_t>(x) & mask) | ((static_cast<std::uint64_t>(y) & mask) << 21) |
-             ((static_cast<std::uint64_t>(z) & mask) << 42);
-    }
-    std::int64_t at(double v) const { return static_cast<std::int64_t>(std::floor(v / cell)); }
-    void index(double element) {
-      cell = 2.0 * element;
-      for (std::uint32_t t = 0; t < targets.size(); ++t) {
-        const glm::dvec3 lo = glm::min(targets[t].from, targets[t].to), hi = glm::max(targets[t].from, targets[t].to);
-        for (std::int64_t x = at(lo.x); x <= at(hi.x); ++x)
-          for (std::int64_t y = at(lo.y); y <= at(hi.y); ++y)
-            for (std::int64_t z = at(lo.z); z <= at(hi.z); ++z) grid[key(x, y, z)].push_back(t);
-      }
-    }
-    /// Whether a leaf (centre, bounding radius, edge) is to be split for a target near it.
-    bool wants_split(const glm::dvec3& centre, double radius, double edge) const {
-      const double reach = radius + edge / kGradeDistanceShare;  // beyond it no target splits the leaf
-      const glm::dvec3 lo = centre - reach, hi = centre + reach;
-      for (std::int64_t x = at(lo.x); x <= at(hi.x); ++x)
-        for (std::int64_t y = at(lo.y); y <= at(hi.y); ++y)
-          for (std::int64_t z = at(lo.z); z <= at(hi.z); ++z) {
-            const auto cell_targets = grid.find(key(x, y, z));
-            if (cell_targets == grid.end()) continue;
-            for (const std::uint32_t k : cell_targets->second) {
-              const Target& t = targets[k];
-              const double gap = std::max(0.0, distance_to_segment(centre, t.from, t.to) - radius);
-              if (edge > t.size && edge > kGradeDistanceShare * gap) return true;
-            }
-          }
-      return false;
-    }
-  };
-  std::vector<Graded> graded;
+  std::vector<GradedPolygon> graded;
   for (std::size_t k = 0; k < segments.size();) {
     const PolygonId id = segments[k].polygon;
     // Only where the polygon's elements are larger than the object: there its shadow and
@@ -357,12 +369,14 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
     // the scene (and a model cut into facets of one size, walls standing on ground facets,
     // stays as it is).
     const double element = std::sqrt(static_cast<double>(largest[id]));
-    Graded g;
+    GradedPolygon g;
     g.polygon = id;
     g.smallest_area = static_cast<double>(largest[id]) / std::pow(4.0, kMaxGradeLevels) * (1.0 - 1e-3);
     for (; k < segments.size() && segments[k].polygon == id; ++k) {
       const Object o = object_size(id, segments[k].other);
-      if (element > o.extent) g.targets.push_back(Target{segments[k].from, segments[k].to, kGradeTargetShare * o.size});
+      if (element > o.extent)
+        g.targets.push_back(
+            GradeTarget{segments[k].from, segments[k].to, kGradeTargetShare * o.size, o.extent, segments[k].other});
     }
     if (g.targets.empty()) continue;
     g.index(element);
@@ -375,9 +389,10 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
   std::size_t added = 0;
   report.polygons = graded.size();
   std::vector<std::uint32_t> stack, split;
-  for (;;) {
-    split.clear();
-    for (const Graded& g : graded)
+  // Calls leaf(g, id, centre, radius, edge) for every leaf of every graded polygon; false when
+  // `keep_going` said no.
+  auto for_each_leaf = [&](const auto& leaf) {
+    for (const GradedPolygon& g : graded)
       for (std::uint32_t patch = first_patch[g.polygon]; patch < first_patch[g.polygon + 1]; ++patch) {
         stack.push_back(h.patches()[patch].root);
         while (!stack.empty()) {
@@ -389,25 +404,53 @@ bool grade_toward_contacts(PatchHierarchy& h, const Scene& scene, const std::vec
             for (std::uint32_t c = 4; c-- > 0;) stack.push_back(element.first_child + c);
             continue;
           }
-          if (static_cast<double>(element.area) / 4.0 < g.smallest_area) continue;
           const glm::dvec3 centre(element.centroid);
           double radius = 0.0;
           for (int c = 0; c < element.corner_count(); ++c)
             radius = std::max(radius, glm::length(glm::dvec3(h.vertices()[element.corners[c]]) - centre));
-          if (g.wants_split(centre, radius, std::sqrt(static_cast<double>(element.area)))) split.push_back(e);
+          leaf(g, e, centre, radius, std::sqrt(static_cast<double>(element.area)));
         }
       }
-    if (split.empty()) return true;
+    return true;
+  };
+  while (!report.budget_reached) {
+    split.clear();
+    if (!for_each_leaf([&](const GradedPolygon& g, std::uint32_t e, const glm::dvec3& centre, double radius, double edge) {
+          if (edge * edge / 4.0 >= g.smallest_area && g.wants_split(centre, radius, edge)) split.push_back(e);
+        }))
+      return false;
+    if (split.empty()) break;
     for (const std::uint32_t e : split) {
       if (added + 3 > budget) {
-        report.budget_reached = true;  // what stays coarse is for `radiosity check` to say
-        return true;
+        report.budget_reached = true;
+        break;
       }
       h.subdivide(e);
       added += 3;
-      report.added_leaves = added;
     }
   }
+  report.added_leaves = added;
+  // What the limits left coarser than the object: the largest leaf touching each contact.
+  std::vector<ContactGrading::Coarse> coarse;
+  if (!for_each_leaf([&](const GradedPolygon& g, std::uint32_t, const glm::dvec3& centre, double radius, double edge) {
+        g.any_near(centre, radius, 0.0, [&](const GradeTarget& t, double gap) {
+          if (gap > 0.0 || !(edge > t.extent)) return false;
+          coarse.push_back(ContactGrading::Coarse{g.polygon, t.other, static_cast<float>(edge),
+                                                  static_cast<float>(t.extent)});
+          return false;
+        });
+      }))
+    return false;
+  // One per polygon and group standing on it: the largest leaf.
+  auto group_of = [&](const ContactGrading::Coarse& c) { return polygons[c.other].group; };
+  std::sort(coarse.begin(), coarse.end(), [&](const ContactGrading::Coarse& a, const ContactGrading::Coarse& b) {
+    return std::make_tuple(a.polygon, group_of(a), -a.element, a.other) <
+           std::make_tuple(b.polygon, group_of(b), -b.element, b.other);
+  });
+  for (const ContactGrading::Coarse& c : coarse)
+    if (report.coarse.empty() || report.coarse.back().polygon != c.polygon || group_of(report.coarse.back()) != group_of(c))
+      report.coarse.push_back(c);
+  return true;
 }
 
 }  // namespace

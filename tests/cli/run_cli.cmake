@@ -9,6 +9,12 @@
 #   -DSTDOUT_JSON=ON          optional: stdout is one JSON object (parsed by string(JSON))
 cmake_minimum_required(VERSION 3.20)
 string(REPLACE "|" ";" args "${ARGS}")
+# The test definitions send a regex's ';' as <semicolon> (a ';' would split the argument).
+foreach(stream STDOUT STDERR)
+  if(DEFINED ${stream})
+    string(REPLACE "<semicolon>" ";" ${stream} "${${stream}}")
+  endif()
+endforeach()
 execute_process(COMMAND ${EXE} ${args} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
 set(what "radiosity ${args}\n--- stdout:\n${out}--- stderr:\n${err}")
 if(NOT code STREQUAL "${CODE}")

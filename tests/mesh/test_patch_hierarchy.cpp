@@ -447,6 +447,20 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
   CHECK(graded.contact_grading().polygons == 1);
   CHECK(graded.contact_grading().added_leaves == graded.leaves().size() - plain.leaves().size());
   CHECK(!graded.contact_grading().budget_reached);
+  CHECK(graded.contact_grading().coarse.empty());
+  // A 0.7 m crate on a 10 km plot: 8 levels below 217 m elements leave 0.85 m, larger than the
+  // crate, and the grading says where (what `radiosity check` warns about).
+  Scene plot;
+  const MaterialId pm = plot.add_material(Material{});
+  plot.add_polygon({{-5000, 0, 5000}, {5000, 0, 5000}, {5000, 0, -5000}, {-5000, 0, -5000}}, pm, "ground");
+  add_box(plot, {0, 0, 0}, {0.7f, 0.7f, 0.7f}, pm, "crate");
+  const ContactGrading crate = PatchHierarchy(plot, MeshOptions{}).contact_grading();
+  REQUIRE(crate.coarse.size() == 1);
+  CHECK(crate.coarse[0].polygon == 0);
+  CHECK(plot.polygons()[crate.coarse[0].other].group == *plot.find_group("crate"));
+  // 23 x 23 patches of 2 x 2 elements (217 m), 8 levels down.
+  CHECK(crate.coarse[0].element == doctest::Approx(10000.0 / 23 / 2 / 256).epsilon(1e-3));
+  CHECK(crate.coarse[0].object == doctest::Approx(0.7));
   CHECK(plain.contact_grading().polygons == 0);
   CHECK(plain.contact_grading().added_leaves == 0);
   // Where the elements are smaller than what stands on them, nothing changes (the Cornell

@@ -55,10 +55,9 @@ struct Estimate {
   bool default_hierarchical = false;
   unsigned default_specular_depth = 0;
   std::size_t memory_budget = 0;  ///< SolveOptions::memory_budget_bytes as solve() applies it
-  /// Per overlap of CheckResult::overlaps, the area of the element of its first and of its
-  /// second polygon nearest the place they meet (scene units^2): what the default mesh, graded
-  /// toward contacts (rad::MeshOptions::grade_at_contacts), has there.
-  std::vector<std::pair<float, float>> contact_element;
+  /// The contacts the default mesh's grading (rad::MeshOptions::grade_at_contacts) left with
+  /// elements larger than what stands there.
+  std::vector<rad::ContactGrading::Coarse> coarse_contacts;
 };
 
 struct CheckResult {
@@ -80,8 +79,7 @@ struct CheckResult {
 
 bool emits(const rad::Material& m) { return m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f; }
 
-Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions& mesh,
-                                const std::vector<rad::PolygonOverlap>& overlaps) {
+Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions& mesh) {
   // The default solve's choices are the library's own (Problem::plan()), so that what check
   // says is what solve does; the two what-if figures (dense matrix, sparse rows) are ours.
   rad::SolveOptions options;
@@ -112,32 +110,7 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   e.dense_matrix_bytes = e.elements * e.patches * sizeof(float);
   const std::size_t row_entries = std::size_t{rad::FormFactorOptions{}.hemisphere_rays} + emitting_patches;
   e.sparse_rows_bytes = rows * std::min(targets, row_entries) * entry;
-  {
-    // The leaf of a polygon at a point: its patch whose root is nearest, then down the
-    // quadtree by the nearest child (children are the parent's quarters). A forest of 20 000
-    // trees on one ground polygon of 250 000 leaves: a walk each, not a search of them all.
-    std::vector<std::uint32_t> first_patch(scene.polygons().size() + 1, 0);
-    for (const rad::Patch& p : hierarchy.patches()) ++first_patch[p.polygon + 1];
-    for (std::size_t k = 1; k < first_patch.size(); ++k) first_patch[k] += first_patch[k - 1];
-    auto leaf_area_at = [&](rad::PolygonId polygon, const glm::vec3& point) {
-      auto distance = [&](std::uint32_t element) { return glm::distance(hierarchy.element(element).centroid, point); };
-      std::uint32_t at = rad::kNone;
-      for (std::uint32_t patch = first_patch[polygon]; patch < first_patch[polygon + 1]; ++patch) {
-        const std::uint32_t root = hierarchy.patches()[patch].root;
-        if (at == rad::kNone || distance(root) < distance(at)) at = root;
-      }
-      if (at == rad::kNone) return 0.0f;
-      while (!hierarchy.element(at).is_leaf()) {
-        const std::uint32_t first = hierarchy.element(at).first_child;
-        at = first;
-        for (std::uint32_t c = first + 1; c < first + 4; ++c)
-          if (distance(c) < distance(at)) at = c;
-      }
-      return hierarchy.element(at).area;
-    };
-    for (const rad::PolygonOverlap& o : overlaps)
-      e.contact_element.emplace_back(leaf_area_at(o.first, o.point), leaf_area_at(o.second, o.point));
-  }
+  e.coarse_contacts = hierarchy.contact_grading().coarse;
   const rad::SolvePlan plan = problem.plan();
   e.default_method = plan.row_form_factor_method;
   e.default_dense = !plan.sparse_rows;
@@ -148,70 +121,58 @@ Estimate estimate_default_solve(const rad::Scene& scene, const rad::MeshOptions&
   return e;
 }
 
-/// Groups that stand on or pass through a polygon whose elements where they meet are larger
-/// than the whole group: its shadow and contact cannot show on that polygon. The default mesh
-/// is graded toward such contacts (rad::MeshOptions::grade_at_contacts), so this is what the
-/// grading's limits left (8 levels below the polygon's elements: a 2 cm pebble on a 1 km
-/// plot; twice as many new elements as the mesh had: thousands of objects on one coarse ground).
-/// One warning per pair of groups, the first kShownPairs of them.
 /// A --max-element-area is suggested only when the scene would have at most this many elements.
 constexpr double kMaxSuggestedElements = 4e6;
 
-void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::PolygonOverlap>& overlaps,
-                             const std::vector<std::pair<float, float>>& contact_element,
+/// What stands on or passes through a polygon whose elements where they meet are larger than
+/// it: its shadow and contact cannot show there. The default mesh is graded toward such
+/// contacts (rad::MeshOptions::grade_at_contacts), so this is what the grading's limits left
+/// (8 levels below the polygon's elements: a 0.7 m crate on a 10 km plot; twice as many new
+/// elements as the mesh had: thousands of objects on one coarse ground), as the mesher found
+/// it (rad::ContactGrading::coarse). One warning per pair of groups (of polygons, in a file of
+/// one group), the first kShownPairs of them.
+void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::ContactGrading::Coarse>& coarse,
                              std::vector<std::string>& warnings) {
   constexpr std::size_t kShownPairs = 3;
   const std::vector<rad::Polygon>& polygons = scene.polygons();
-  // Each group's largest extent along an axis.
-  std::vector<glm::vec3> lower(scene.groups().size(), glm::vec3(std::numeric_limits<float>::max()));
-  std::vector<glm::vec3> upper(scene.groups().size(), glm::vec3(std::numeric_limits<float>::lowest()));
-  for (const rad::Polygon& p : polygons)
-    for (const glm::vec3& v : p.vertices) {
-      lower[p.group] = glm::min(lower[p.group], v);
-      upper[p.group] = glm::max(upper[p.group], v);
-    }
-  auto size_of = [&](rad::GroupId g) {
-    const glm::vec3 d = upper[g] - lower[g];
-    return std::max({d.x, d.y, d.z});
+  auto name = [&](rad::PolygonId p, bool by_polygon) {
+    const std::string group = "group '" + scene.groups()[polygons[p].group] + "'";
+    return by_polygon ? "polygon " + std::to_string(p) + " (" + group + ")" : group;
   };
-  struct Pair {
-    rad::GroupId under, object;
-    float element, object_size;
-  };
-  std::vector<Pair> pairs;
-  for (std::size_t k = 0; k < overlaps.size(); ++k) {
-    const rad::PolygonOverlap& o = overlaps[k];
-    // Contact: coincident and facing apart, or one passing through the other.
-    if (o.z_fighting()) continue;
-    for (const auto& [under, object, area] : {std::make_tuple(o.first, o.second, contact_element[k].first),
-                                              std::make_tuple(o.second, o.first, contact_element[k].second)}) {
-      const rad::GroupId g = polygons[under].group, h = polygons[object].group;
-      const float element = std::sqrt(area), size = size_of(h);
-      if (g == h || !(element > size)) continue;
-      const auto same = std::find_if(pairs.begin(), pairs.end(), [&](const Pair& q) { return q.under == g && q.object == h; });
-      if (same == pairs.end()) pairs.push_back(Pair{g, h, element, size});
-      else same->element = std::max(same->element, element);
-    }
+  // One per pair of groups: coarse is by polygon, then group.
+  std::vector<rad::ContactGrading::Coarse> shown;
+  for (const rad::ContactGrading::Coarse& c : coarse) {
+    const bool by_polygon = polygons[c.polygon].group == polygons[c.other].group;
+    const auto same = std::find_if(shown.begin(), shown.end(), [&](const rad::ContactGrading::Coarse& q) {
+      return by_polygon ? q.polygon == c.polygon && q.other == c.other
+                        : polygons[q.polygon].group == polygons[c.polygon].group &&
+                              polygons[q.other].group == polygons[c.other].group;
+    });
+    if (same == shown.end()) shown.push_back(c);
+    else same->element = std::max(same->element, c.element);
   }
-  for (std::size_t k = 0; k < pairs.size() && k < kShownPairs; ++k) {
-    const Pair& q = pairs[k];
-    const float suggested = 0.0625f * q.object_size * q.object_size;  // elements a quarter of its size
-    char figures[160];
-    std::snprintf(figures, sizeof figures, "elements of %.3g across where group '%s' (%.3g) stands on or passes "
-                  "through it, larger than that group", q.element, scene.groups()[q.object].c_str(), q.object_size);
+  for (std::size_t k = 0; k < shown.size() && k < kShownPairs; ++k) {
+    const rad::ContactGrading::Coarse& q = shown[k];
+    const bool by_polygon = polygons[q.polygon].group == polygons[q.other].group;
+    const float suggested = 0.0625f * q.object * q.object;  // elements a quarter of its size
+    char figures[96];
+    std::snprintf(figures, sizeof figures, " has elements of %.3g across where ", q.element);
+    char size[64];
+    std::snprintf(size, sizeof size, " (%.3g) stands on or passes through it, larger than that", q.object);
     // The option only where the whole scene at that size stays a mesh one can solve.
     char hint[96] = "";
     if (scene.total_area() / static_cast<double>(suggested) <= kMaxSuggestedElements)
       std::snprintf(hint, sizeof hint, ", or lower --max-element-area (%.3g gives elements a quarter of its size)",
                     suggested);
-    warnings.push_back("group '" + scene.groups()[q.under] + "' has " + figures +
+    const std::string under = name(q.polygon, by_polygon);
+    warnings.push_back(under + figures + name(q.other, by_polygon) + size + (by_polygon ? " polygon" : " group") +
                        ": its shadow and contact cannot show there (the mesh is graded toward contacts by at most 8 "
-                       "levels and twice as many new elements as it had, at least 32768); cut '" +
-                       scene.groups()[q.under] + "' finer around it in the model" + hint);
+                       "levels and twice as many new elements as it had, at least 32768); cut " + under +
+                       " finer around it in the model" + hint);
   }
-  if (pairs.size() > kShownPairs)
-    warnings.push_back(std::to_string(pairs.size() - kShownPairs) +
-                       " more pairs of groups where one stands on elements larger than itself");
+  if (shown.size() > kShownPairs)
+    warnings.push_back(std::to_string(shown.size() - kShownPairs) +
+                       " more pairs where one stands on elements larger than itself");
 }
 
 CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
@@ -258,12 +219,12 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   mesh.max_patch_area = a.max_patch_area;
   mesh.max_element_area = a.max_element_area;
   try {
-    r.estimate = estimate_default_solve(scene, mesh, r.overlaps);
+    r.estimate = estimate_default_solve(scene, mesh);
   } catch (const rad::Error& e) {
     r.error = e.what();  // e.g. max_element_area > max_patch_area, or far too many elements
     return r;
   }
-  coarse_contact_warnings(scene, r.overlaps, r.estimate->contact_element, r.warnings);
+  coarse_contact_warnings(scene, r.estimate->coarse_contacts, r.warnings);
   if (r.z_fighting > 0)
     r.warnings.push_back(std::to_string(r.z_fighting) +
                          " pair(s) of coincident polygons face the same way (z-fighting): which is in front is "
