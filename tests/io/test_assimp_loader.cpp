@@ -534,6 +534,12 @@ TEST_CASE("Assimp broken PLY: an ASCII body that Assimp would read past its line
   CHECK(contains(second.what(), "second_face_element.ply:5: a second PLY element of faces ('face' or 'tristrips') "
                                 "(the first is on line 3); the PLY reader (Assimp 5.2) would write its instances into "
                                 "the first one's storage, past its end when it has more"));
+  // A scan's point cloud (vertices, no faces) and an empty STL say what they are.
+  CHECK(contains(load_error(write("points.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                                "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"))
+                     .what(),
+                 "points.ply: it holds points but no faces (a point cloud?), and radiosity needs polygons (Assimp: "));
+  CHECK(contains(load_error(write("empty.stl", "solid x\nendsolid x\n")).what(), "empty.stl: it holds no geometry"));
   // A second format line: Assimp reads the first (line 2: ascii), the walk took the last
   // ("binaryformat" for binary) and let an ASCII list count of 444444444 through, which Assimp
   // reserved (3.5 GB; radiosity_fuzz_ply, session 34). And format words that are none of

@@ -1477,7 +1477,17 @@ Scene load_assimp(const fs::path& path, const LoadOptions& options) {
   Assimp::Importer importer;
   if (add_line_end) importer.SetIOHandler(new LineEndedFiles);  // the importer owns it
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
-  if (!scene) throw Error(ErrorCode::parse_error, path.string() + ": " + importer.GetErrorString());
+  if (!scene) {
+    // Assimp's validation names the mesh but not what the user has: a scan's point cloud
+    // (vertices, no faces), an STL exported from an empty selection.
+    const std::string what = importer.GetErrorString();
+    const char* meaning = what.find("contains no faces") != std::string::npos
+                              ? "it holds points but no faces (a point cloud?), and radiosity needs polygons"
+                          : what.find("contains no vertices") != std::string::npos ? "it holds no geometry"
+                                                                                   : nullptr;
+    throw Error(ErrorCode::parse_error,
+                path.string() + ": " + (meaning ? std::string(meaning) + " (Assimp: " + what + ")" : what));
+  }
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     throw Error(ErrorCode::parse_error, path.string() + ": holds no complete scene (" +
                                             std::string(scene->mNumMeshes == 0 ? "no meshes" : "an animation or skeleton only") + ")");
