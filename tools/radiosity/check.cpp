@@ -8,11 +8,9 @@
 #include <limits>
 #include <memory>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
-#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 namespace cli {
