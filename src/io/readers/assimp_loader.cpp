@@ -212,25 +212,34 @@ class ForwardReader {
 /// element instance from one such line, so the checks below walk the same lines.
 class PlyLines {
  public:
-  PlyLines(ForwardReader& in, std::size_t line) : in_(in), line_(line) {}
+  /// `all_line_ends`: a NUL and a form feed end a line too, as IsLineEnd() has them (the body,
+  /// which Assimp reads so; the header walk keeps them in its lines to refuse them, naming the
+  /// byte). A line cut at one goes on as a new line after it, and one that starts at one is
+  /// skipped through the next '\n' (an element line beginning with NUL bytes, the rest of it
+  /// skipped: Assimp read the next line for it, every line after it one element off, and a
+  /// list count from a line the walk took for another; radiosity_fuzz_ply, session 34).
+  PlyLines(ForwardReader& in, std::size_t line, bool all_line_ends = false)
+      : in_(in), line_(line), all_line_ends_(all_line_ends) {}
   /// The next line's text into `out`, its number into `number`; false at the end of the file.
   bool next(std::string& out, std::size_t& number) {
     int c = in_.peek();
-    if (c == '\r' || c == '\n') {
+    if (line_end(c)) {
       while ((c = in_.get()) >= 0 && c != '\n') {}
       if (c == '\n') ++line_;
     }
     if (in_.peek() < 0) return false;
     out.clear();
     number = line_;
-    while ((c = in_.peek()) >= 0 && c != '\r' && c != '\n') out.push_back(static_cast<char>(in_.get()));
+    while ((c = in_.peek()) >= 0 && !line_end(c)) out.push_back(static_cast<char>(in_.get()));
     if (in_.get() == '\n') ++line_;
     return true;
   }
 
  private:
+  bool line_end(int c) const { return c == '\r' || c == '\n' || (all_line_ends_ && (c == '\0' || c == '\f')); }
   ForwardReader& in_;
   std::size_t line_;
+  bool all_line_ends_;
 };
 
 /// The byte of a header or ASCII line that no PLY file holds (a control character other than
@@ -504,7 +513,7 @@ void check_ply(const fs::path& path, const PlyHeader& header) {
   // - in an element with a list, a value its type's parser does not take whole
   //   (ply_value_whole()): the rest would be read as the next value, a list count among them.
   // An element Assimp does not parse (assimp_parses()) has its lines skipped, whatever they hold.
-  PlyLines lines(in, header.body_line);
+  PlyLines lines(in, header.body_line, true);
   std::string line;
   std::size_t number = header.body_line - 1;
   std::vector<std::string_view> values;
