@@ -40,21 +40,22 @@ struct MeshOptions {
   /// the line: the lit room's light would otherwise show in the dark room. A cut polygon is
   /// meshed as convex pieces (up to 64 lines each) and shares no vertices with its neighbours.
   /// Contacts that end inside a polygon (a block standing on a floor) cut nothing: rays and
-  /// hemicubes find what they hide (grade_at_contacts refines the elements around them). Neither do lines along a polygon's border (T-junctions,
-  /// walls meeting at a corner) nor coplanar neighbours. false meshes every polygon whole.
+  /// hemicubes find what they hide (grade_at_contacts refines the elements around them).
+  /// Neither do lines along a polygon's border (T-junctions, walls meeting at a corner) nor
+  /// coplanar neighbours. false meshes every polygon whole.
   bool split_at_contacts = true;
   /// Grade a polygon's elements toward what stands on it or passes through it when its
   /// elements are larger than that object (a house on a large plot, a chair on a coarse floor):
-  /// elements within reach of the contact are split until they are a quarter of the object's
-  /// size, and beyond it until they are at most half their distance from it, so the contact's
-  /// shadow and darkening show and the mesh coarsens smoothly away from it. The object's size
-  /// is its group's extent (the polygon's own when both are in one group); the elements are
-  /// sized by its height off the polygon's plane within [extent / 4, extent] (a 3 m high
-  /// house's shadow is about 3 m across; a coaster is not worth elements of its thickness),
-  /// and something larger than the elements (a rug, a picture frame) changes nothing. At most 8 levels
-  /// below a polygon's elements, and at most twice as many new elements as the mesh had (at
-  /// least 32768); what stays coarser then is what `radiosity check` warns about. false: elements as
-  /// max_element_area alone gives them.
+  /// elements at the contact are split until they are a quarter of the object's size, and
+  /// around it until they are at most half their distance from it, so the contact's shadow
+  /// and darkening show and the mesh coarsens smoothly away from it. The object's extent is
+  /// its group's (the polygon's own when both are in one group); the elements are sized by
+  /// its height off the polygon's plane within [extent / 4, extent] (a 3 m high house's
+  /// shadow is about 3 m across; a coaster is not worth elements of its thickness), and
+  /// something larger than the elements (a rug, a picture frame) changes nothing. At most 8
+  /// levels below a polygon's elements, and at most twice as many new elements as the mesh
+  /// had (at least 32768); what stays coarser then is reported (contact_grading()) and what
+  /// `radiosity check` warns about. false: elements as max_element_area alone gives them.
   bool grade_at_contacts = true;
 };
 
