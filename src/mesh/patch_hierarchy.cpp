@@ -51,7 +51,7 @@ namespace {
 // (which would quadruple its element count for nothing).
 constexpr double kAreaSlack = 1e-6;
 
-// A polygon is cut along at most this many contact lines (the first in contact_lines()'s
+// A polygon is cut along at most this many contact lines (the first in find_contacts()'s
 // order); beyond, the pieces would be slivers of little use, and their count grows as the
 // square of the lines.
 constexpr std::size_t kMaxContactLines = 64;

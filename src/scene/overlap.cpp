@@ -15,7 +15,7 @@
 //   merely touches the other with an edge or a corner: a block standing on a floor, a
 //   T-junction) and the two chords cut from them by the line where the planes meet overlap by
 //   more than the tolerance (so the crossing is inside both).
-// The same broad phase finds contact lines (contact_lines()): where b stands on a or passes
+// The same broad phase finds contact lines (find_contacts()): where b stands on a or passes
 // through it along a segment that crosses a from border to border (a partition on a floor).
 // Meshes are cut along them so that no element or interpolated vertex straddles a line where
 // the light changes abruptly: D. R. Baum, S. Mann, K. P. Smith & J. M. Winget, "Making radiosity
@@ -62,7 +62,7 @@ struct Search {
   std::vector<Plane> planes;
   std::vector<glm::vec3> lower, upper;  ///< bounds grown by the tolerance
   double tolerance = 0.0;
-  bool contacts = false;  ///< looking for contact lines (contact_lines()) rather than overlaps
+  bool contacts = false;  ///< looking for contacts (find_contacts()) rather than overlaps
   std::atomic<bool> stop{false};  ///< the caller's KeepGoing said no: pairs are skipped
   std::mutex mutex;
   std::vector<PolygonOverlap> found;
@@ -495,10 +495,6 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing
     message += " (" + std::to_string(same_facing.size()) + " such pairs in all; radiosity::find_overlaps() lists them)";
   out.push_back(std::move(message));
   return out;
-}
-
-std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep_going) {
-  return find_contacts(scene, keep_going).lines;
 }
 
 Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going) {

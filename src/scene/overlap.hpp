@@ -49,18 +49,6 @@ struct ContactLine {
   glm::dvec3 direction{0.0};   ///< unit, in the polygon's plane
 };
 
-/// Every line along which a polygon is divided by another that stands on it (an edge in its
-/// plane: a partition wall on a floor running from border to border) or passes through it,
-/// the contact running across the polygon from border to border; not lines along its border
-/// (walls meeting at corners, T-junctions), not contacts that end inside it (a block's sides
-/// on a floor: rays find what those hide) and nothing for coplanar pairs. Sorted by polygon,
-/// one entry per line (several polygons meeting a polygon along the same line give one).
-/// PatchHierarchy cuts the polygons along them (MeshOptions::split_at_contacts): the light on
-/// the two sides of such a line differs by everything the other polygon blocks, and an
-/// element or an interpolated vertex across it would carry light into the dark side (Baum et
-/// al. 1991). Cost: as find_overlaps(). Thread safety: concurrent calls are safe.
-std::vector<ContactLine> contact_lines(const Scene& scene, const KeepGoing& keep_going = {});
-
 /// A segment in a polygon's plane, inside it, along which another polygon stands on it or
 /// passes through it without dividing it: a wall's foot on a ground, a block's sides on a
 /// floor, a leg through a floor.
@@ -70,15 +58,26 @@ struct ContactSegment {
   glm::dvec3 from{0.0}, to{0.0};
 };
 
-/// What one search finds: the lines that divide polygons (as contact_lines()) and the segments
-/// that end inside them (sorted by polygon, then by other polygon).
+/// What one search finds: the lines that divide polygons and the segments that end inside them.
 struct Contacts {
+  /// Every line along which a polygon is divided by another that stands on it (an edge in its
+  /// plane: a partition wall on a floor running from border to border) or passes through it,
+  /// the contact running across the polygon from border to border; not lines along its border
+  /// (walls meeting at corners, T-junctions), not contacts that end inside it (a block's sides
+  /// on a floor: those are `segments`) and nothing for coplanar pairs. Sorted by polygon,
+  /// one entry per line (several polygons meeting a polygon along the same line give one).
+  /// PatchHierarchy cuts the polygons along them (MeshOptions::split_at_contacts): the light on
+  /// the two sides of such a line differs by everything the other polygon blocks, and an
+  /// element or an interpolated vertex across it would carry light into the dark side (Baum et
+  /// al. 1991).
   std::vector<ContactLine> lines;
+  /// The contacts that end inside a polygon, sorted by polygon, then by other polygon.
   std::vector<ContactSegment> segments;
 };
 /// Both kinds at the cost of one search (as find_overlaps()). PatchHierarchy cuts polygons
 /// along the lines and grades their elements toward the segments (MeshOptions::grade_at_contacts):
-/// the shadow and the darkening at a contact are as small as what stands there.
+/// the shadow and the darkening at a contact are as small as what stands there. Thread
+/// safety: concurrent calls are safe.
 Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going = {});
 
 }  // namespace radiosity::detail
