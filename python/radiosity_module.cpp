@@ -556,6 +556,7 @@ py::object view_factor_matrix(const rad::Scene& scene, const std::string& level,
   c["clamped"] = m.correction.clamped;
   c["iterations"] = m.correction.iterations;
   info["correction"] = c;
+  info["warnings"] = string_list(m.warnings);
   info["method"] = m.method;
   info["element_count"] = m.element_count;
   info["seconds"] = m.seconds;

@@ -387,6 +387,10 @@ struct ViewFactorMatrix {
   /// state none (ray_cast, analytic, hemicube, hierarchical).
   std::vector<double> row_standard_error;
   ViewFactorCorrectionReport correction;
+  /// What the caller should know about the result, one line each: polygons that are coincident
+  /// and face the same way (z-fighting: a polygon modelled twice), which the exact mode counts
+  /// twice in the rows that see them.
+  std::vector<std::string> warnings;
   std::string method;              ///< the estimator's name as the command line spells it
   std::size_t element_count = 0;   ///< source elements the rows were summed from
   double seconds = 0.0;            ///< wall time of meshing, form factors and correction

@@ -94,7 +94,9 @@ struct CameraChoice {
   /// and glTF have it)", "the scene has none: framing what stands on its ground from -y, 30
   /// degrees above (z up: the sky's zenith)", or "the scene has none, and from outside 44 % of the view is surfaces no
   /// light reaches (a closed model): inside, at (2, 1.5, 0.2) looking +z, 60 degrees (100 % of
-  /// the view lit surfaces; y up: the emitters face down -y)".
+  /// the view lit surfaces; y up: the emitters face down -y)", "the scene has none, and from -z
+  /// 44 % of the view is surfaces no light reaches: framing its bounds from +z (30 % of the view
+  /// lit surfaces; y up: the emitters face down -y)".
   std::string reason;
 };
 
@@ -109,7 +111,9 @@ struct CameraChoice {
 /// surfaces it meets (and a quarter of the view at least) show no light: the
 /// backs of one-sided polygons, or sides that no emitter (the centroids of the 16 strongest
 /// emitting polygons) or light reaches directly, as a closed room seen from outside (whose
-/// image would be black). Then a view from inside, at mid height 5 % in from a side of the
+/// image would be black). Then the bounds framed from the other sides across the up (from +z,
+/// -x, +x when y is up; a box open on one side is seen through its opening), the one that shows
+/// the most lit surfaces among those not mostly unlit; when none is, a view from inside, at mid height 5 % in from a side of the
 /// bounds looking across (along the two axes across the up) with a 60 degree field of view: the one whose
 /// image shows the most lit surfaces, judged by 24 x 24 rays per candidate and a shadow ray to
 /// each emitter and light from what they meet. Builds a ray scene of the polygons (Embree) when

@@ -50,6 +50,7 @@ def test_enclosure_correction_closes_rows_and_keeps_reciprocity(cube):
     assert info["correction"]["name"] == "enclosure"
     assert info["correction"]["row_sum_error_before"] < 5e-3
     assert info["seconds"] >= 0 and not info["cancelled"]
+    assert info["warnings"] == []
 
 
 def test_reciprocity_correction_and_float32_values(cube):

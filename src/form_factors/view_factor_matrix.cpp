@@ -35,6 +35,7 @@
 #include "form_factors/exact_view_factors.hpp"
 #include "form_factors/view_factor_correction.hpp"
 #include "form_factors/view_factor_rows.hpp"
+#include "scene/overlap.hpp"
 #include "solver/hierarchical/link_view_factors.hpp"
 #include "radiosity/form_factors.hpp"
 
@@ -669,6 +670,14 @@ void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& opti
     out.values = std::move(F.values);
   }
   fill_missing_sky(out);
+  // A polygon modelled twice (McGuire's Cornell box indexes a side of each box again as its
+  // "bottom face") is two receivers to the view factors: the exact mode integrates each, so a
+  // row that sees them counts that area twice (its sum 1.28 in that box), silently but for this.
+  if (!out.cancelled)
+    out.warnings = z_fighting_warnings(scene, {},
+                                       "each is a surface of its own to the view factors: the exact mode (ray-cast, "
+                                       "the default) counts that area twice in the rows that see it (sums above 1), "
+                                       "the others split it between the two by rounding; remove one of them");
 }
 
 }  // namespace radiosity::detail

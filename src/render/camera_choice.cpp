@@ -270,6 +270,16 @@ bool open_ground(const Levels& l) { return l.any_rest && l.cover > 0.5 && l.cove
 /// How far above the horizontal the view of a ground open to the sky looks down.
 constexpr float kAerialElevationDeg = 30.0f;
 
+/// Scene::camera()'s framing of the bounds (their sphere in a 45 degree view), looking along
+/// `toward` (a unit axis across the up) from outside.
+Camera framed_from(const Scene& scene, const glm::vec3& toward, const Up& up) {
+  Camera c = scene.camera();
+  const float distance = glm::length(c.eye - c.look_at);
+  c.eye = c.look_at - distance * toward;
+  c.up = up.vector();
+  return c;
+}
+
 /// The choice that needs no look: the scene's camera; else, on a ground open to the sky (a
 /// site, a city), the view 30 degrees from above that frames what stands on it and as much
 /// ground again around it (the ground's
@@ -277,7 +287,8 @@ constexpr float kAerialElevationDeg = 30.0f;
 /// else the view that frames the bounds from the side, its up the scene's (Scene::camera()'s
 /// view from -z when y is up; from -y when z is). `up`: scene_up(scene), unused (and not worth
 /// computing) when the scene has a camera.
-CameraChoice unjudged_choice(const Scene& scene, const Up& up) {
+CameraChoice unjudged_choice(const Scene& scene, const Up& up, bool* aerial = nullptr) {
+  if (aerial) *aerial = false;
   CameraChoice out;
   out.camera = scene.camera();
   if (scene.has_camera()) {
@@ -290,6 +301,7 @@ CameraChoice unjudged_choice(const Scene& scene, const Up& up) {
   toward[front] = 1.0f;
   const Levels ground = levels(scene, up.axis, up.sign);
   if (open_ground(ground)) {
+    if (aerial) *aerial = true;
     // What stands on the ground, with as much ground again around it across the up (within the
     // scene's bounds): a house shows its plot; a lamp over a small floor shows the floor.
     const Bounds scene_box = scene.bounds();
@@ -314,11 +326,7 @@ CameraChoice unjudged_choice(const Scene& scene, const Up& up) {
                  degrees + " degrees above (" + up_text(up) + ")";
     return out;
   }
-  if (front != 2 || up.axis != 1 || up.sign < 0.0f) {
-    const float distance = glm::length(out.camera.eye - out.camera.look_at);
-    out.camera.eye = out.camera.look_at - distance * toward;
-    out.camera.up = up.vector();
-  }
+  if (front != 2 || up.axis != 1 || up.sign < 0.0f) out.camera = framed_from(scene, toward, up);
   out.reason = "the scene has none: framing its bounds from " + axis_name(front, -1.0f) + " (" + up_text(up) + ")";
   return out;
 }
@@ -337,7 +345,8 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
                            const std::function<PolygonId(std::uint32_t)>& polygon_of) {
   if (!judged(scene)) return unjudged_choice(scene);
   const Up up = scene_up(scene);  // once: the view from outside and those from inside
-  CameraChoice out = unjudged_choice(scene, up);
+  bool aerial = false;
+  CameraChoice out = unjudged_choice(scene, up, &aerial);
   const LightProbe light(scene, rays);
   if (light.empty()) return out;  // nothing lights any view
   const ViewContent outside = view_content(scene, rays, polygon_of, light, out.camera);
@@ -345,7 +354,35 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
   // object, a city, a box open toward the camera. Only one whose surfaces are mostly unlit (a
   // closed model seen from outside: backs, or outer sides no light reaches) is replaced.
   // (A closed room framed by its bounding sphere fills about 40 % of the view.)
-  if (!(outside.unlit > 0.5 * (outside.lit + outside.unlit) && outside.unlit > 0.25)) return out;
+  auto mostly_unlit = [](const ViewContent& v) { return v.unlit > 0.5 * (v.lit + v.unlit) && v.unlit > 0.25; };
+  if (!mostly_unlit(outside)) return out;
+
+  // The bounds framed from the other sides across the up: a box open on one side (the Cornell
+  // box as McGuire's OBJ has it, open toward +z, where glTF's assets face) is seen through its
+  // opening, as people photograph it. Found with that file: the view from -z showed the back
+  // wall's back, and the view from inside stood in the opening, too close to show the room.
+  const int front = up.axis == 2 ? 1 : 2, side = 3 - up.axis - front;
+  const int first_side = aerial ? 3 : 0;  // a ground open to the sky keeps its own view
+  double best_outside = 0.0;
+  for (int k = first_side; k < 3; ++k) {
+    const int axis = k == 0 ? front : side;
+    const float sign = k == 0 ? -1.0f : (k == 1 ? 1.0f : -1.0f);  // +front, -side, +side
+    glm::vec3 toward(0.0f);
+    toward[axis] = sign;
+    const Camera camera = framed_from(scene, toward, up);
+    const ViewContent view = view_content(scene, rays, polygon_of, light, camera);
+    if (mostly_unlit(view) || !(view.lit > best_outside)) continue;
+    best_outside = view.lit;
+    out.camera = camera;
+    char share[200];
+    std::snprintf(share, sizeof share,
+                  "the scene has none, and from %s %.0f %% of the view is surfaces no light reaches: framing its "
+                  "bounds from %s (%.0f %% of the view lit surfaces; ",
+                  axis_name(front, -1.0f).c_str(), 100.0 * outside.unlit, axis_name(axis, -sign).c_str(),
+                  100.0 * view.lit);
+    out.reason = share + up_text(up) + ")";
+  }
+  if (best_outside > 0.0) return out;
 
   // From inside: at mid height, 5 % of the way in from each side of the bounds, looking across
   // to the opposite side (along the two axes across the scene's up), with a wide lens.

@@ -477,7 +477,7 @@ std::vector<PolygonOverlap> overlaps(const Scene& scene, const KeepGoing& keep_g
 
 }  // namespace
 
-std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing& keep_going) {
+std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing& keep_going, const char* consequence) {
   std::vector<std::string> out;
   std::vector<const PolygonOverlap*> same_facing;
   const std::vector<PolygonOverlap> found = overlaps(scene, keep_going);
@@ -489,8 +489,8 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing
     return "polygon " + std::to_string(p) + " (group '" + scene.groups()[scene.polygons()[p].group] + "')";
   };
   std::string message = name(o.first) + " and " + name(o.second) +
-                        " are coincident and face the same way (z-fighting) around " + point_text(o.point) +
-                        ": which of them is in front is decided by rounding; remove one or move them apart";
+                        " are coincident and face the same way (z-fighting) around " + point_text(o.point) + ": " +
+                        consequence;
   if (same_facing.size() > 1)
     message += " (" + std::to_string(same_facing.size()) + " such pairs in all; radiosity::find_overlaps() lists them)";
   out.push_back(std::move(message));

@@ -32,8 +32,11 @@ using KeepGoing = std::function<bool()>;
 /// One warning (or none) for the coincident pairs of find_overlaps(scene) whose normals point
 /// the same way: it names the first pair by index and group, where they meet, and how many
 /// pairs there are. Coincident pairs facing each other (contact) and interpenetrating pairs
-/// are not warned about: they are lit correctly.
-std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing& keep_going = {});
+/// are not warned about: they are lit correctly. `consequence` says what it does to the caller's
+/// result (by default: to a solve and a render).
+std::vector<std::string> z_fighting_warnings(
+    const Scene& scene, const KeepGoing& keep_going = {},
+    const char* consequence = "which of them is in front is decided by rounding; remove one or move them apart");
 
 /// The distance below which two surfaces count as touching in `scene`:
 /// kOverlapRelativeTolerance of its bounding-box diagonal, and at least a few ulps of its

@@ -209,6 +209,38 @@ TEST_SUITE("form_factors") {
     for (std::size_t i = 0; i < got.rows(); ++i) CHECK(std::fabs(row_sum(got, i) - 1.0) < 1e-4);
   }
 
+  TEST_CASE("view_factor_matrix of a cube with a face modelled twice: the exact rows count it twice, and a warning "
+            "says so - none without the copy") {
+    // McGuire's Cornell box indexes a side of each box again as its "bottom face": a polygon
+    // coincident with another and facing the same way. Each is a receiver of its own, so the
+    // exact mode's rows that see it sum to 1 + F (Howell C-11 / C-14 for the unit cube).
+    rad::Material grey;
+    grey.reflectance = rad::Rgb(0.5f);
+    const rad::Scene cube = test::closed_box(grey);
+    rad::Scene twice = cube;
+    const rad::Polygon& x1 = cube.polygons()[1];  // the face at x = 1, facing -x
+    REQUIRE(x1.normal.x < -0.99f);
+    twice.add_polygon(x1.vertices, x1.material, "x1 again");
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.mesh.max_patch_area = 1.0f;
+    o.mesh.max_element_area = 0.25f;
+    const rad::ViewFactorMatrix once = rad::view_factor_matrix(cube, o);
+    CHECK(once.warnings.empty());
+    for (std::size_t i = 0; i < once.rows(); ++i) CHECK(std::fabs(row_sum(once, i) - 1.0) < 1e-4);
+    const rad::ViewFactorMatrix got = rad::view_factor_matrix(twice, o);
+    REQUIRE(got.warnings.size() == 1);
+    MESSAGE(got.warnings[0]);
+    CHECK(got.warnings[0].find("polygon 1 (group 'x1') and polygon 6 (group 'x1 again') are coincident and face the "
+                               "same way (z-fighting)") == 0);
+    CHECK(got.warnings[0].find("the exact mode (ray-cast, the default) counts that area twice") != std::string::npos);
+    const double opposite = 0.1998249, adjacent = 0.2000438;  // Howell C-11, C-14
+    CHECK(row_sum(got, 0) == doctest::Approx(1.0 + opposite).epsilon(1e-4));  // x0 sees x1 twice
+    CHECK(row_sum(got, 2) == doctest::Approx(1.0 + adjacent).epsilon(1e-4));  // y0 too
+    CHECK(row_sum(got, 1) == doctest::Approx(1.0).epsilon(1e-4));  // the copies see the rest once
+    CHECK(row_sum(got, 6) == doctest::Approx(1.0).epsilon(1e-4));
+  }
+
   TEST_CASE("view_factor_matrix corrections: reciprocity to 1e-6 - enclosure rows to 1e-6 - the changes stated and "
             "small - the closed forms within 0.01 after it") {
     const rad::Scene s = faceted_box(1, 2, 3, 0.5f);

@@ -105,6 +105,45 @@ TEST_SUITE("render") {
     CHECK(rad::choose_camera(blocks).reason ==
           "the scene has none: framing what stands on its ground from -z, 30 degrees above (y up: the sky's zenith)");
 
+    // A box open toward +z (the Cornell box as McGuire's OBJ has it, and as glTF's assets face),
+    // lit by a lamp under its ceiling: from -z the view shows the back wall's back, so the bounds
+    // are framed from +z, through the opening; not from inside, whose camera would stand in the
+    // opening, too close to show the room.
+    rad::Scene open_box;
+    {
+      rad::Material white;
+      white.reflectance = rad::Rgb(0.7f);
+      const rad::Scene closed = test::closed_box(white, glm::vec3(2.0f));
+      const rad::MaterialId w = open_box.add_material(white);
+      for (const rad::Polygon& p : closed.polygons())
+        if (p.normal.z > -0.5f) open_box.add_polygon(p.vertices, w, "wall");  // all but the +z side
+      rad::Material lamp;
+      lamp.emission = rad::Rgb(10.0f);
+      rad::add_quad(open_box, {0.8f, 1.99f, 0.8f}, {0.4f, 0, 0}, {0, 0, 0.4f}, open_box.add_material(lamp), "lamp");
+      REQUIRE(open_box.polygons().back().normal.y < -0.99f);
+    }
+    const rad::CameraChoice through = rad::choose_camera(open_box);
+    MESSAGE(through.reason);
+    CHECK(through.reason.find("the scene has none, and from -z ") == 0);
+    CHECK(through.reason.find("of the view is surfaces no light reaches: framing its bounds from +z (") !=
+          std::string::npos);
+    CHECK(through.reason.find("; y up: the emitters face down -y)") != std::string::npos);
+    CHECK(through.camera.eye.z > open_box.bounds().upper.z);
+    CHECK(through.camera.look_at.z == doctest::Approx(1.0f));
+    CHECK(through.camera.eye.x == doctest::Approx(1.0f));
+    // What it sees is lit: the render through the opening is not black.
+    {
+      rad::SolveOptions box_solve;
+      box_solve.mesh.max_patch_area = 0.25f;
+      const rad::Solution box_solution = rad::solve(open_box, box_solve);
+      rad::RenderOptions view;
+      view.width = view.height = 16;
+      view.camera = through.camera;
+      int lit = 0;
+      for (const rad::Rgb& p : rad::render(open_box, box_solution, view).pixels) lit += p.y > 0.0f;
+      CHECK(lit > 256 / 4);
+    }
+
     // A scene with its own camera keeps it.
     rad::Scene with_camera = room;
     rad::Camera own;

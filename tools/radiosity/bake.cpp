@@ -70,12 +70,6 @@ double texel_density(const rad::Mesh& m, int size) {
   return area > 0.0 ? static_cast<double>(size) * std::sqrt(uv_area / area) : 0.0;
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 bool is_gltf(const std::string& path) {
   const std::string ext = lower_extension(path);
   return ext == ".glb" || ext == ".gltf";

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <limits>
@@ -31,6 +32,13 @@ namespace rad = radiosity;
 // NonNegativeNumber and Range print the bounds of `double` in full (hundreds of digits) and call
 // "abc" out of range; these say "'abc' is not a number" or "must be > 0 (got -1)", and CLI11
 // prefixes the option's name. The type's own range counts too (an unsigned option refuses -1).
+
+/// A path's extension in lower case, with its dot (".png"; "" when it has none).
+inline std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
 
 /// `s` as a number when all of it is one (an integer for integral T) and finite, else nullopt.
 template <typename T>

@@ -101,6 +101,8 @@ int write_blocks(const rad::Scene& scene, const rad::ViewFactorOptions& o, const
     ranges.push_back(Range{0, rows.rows(), rows.non_zeros(), rows.element_count});
   }
   bar.finish();
+  if (process_rank() == 0)
+    for (const std::string& w : rows.warnings) std::fprintf(stderr, "warning: factors: %s\n", w.c_str());
   const int rank = process_rank();
   const std::filesystem::path folder(a.blocks);
   const std::string matrix_file = "block-" + std::to_string(rank) + ".mtx",
@@ -158,9 +160,7 @@ int run_factors(const FactorsArgs& a) {
   return run_guarded([&] {
     // A View3D file brings its control line: encl=1 asks for the enclosure correction, and its
     // factors are per surface (a polygon each).
-    std::string extension = std::filesystem::path(a.scene).extension().string();
-    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const bool vs3 = extension == ".vs3";
+    const bool vs3 = lower_extension(a.scene) == ".vs3";
     rad::View3DControl control;
     std::string title;
     rad::Scene scene;
@@ -298,6 +298,7 @@ int run_factors(const FactorsArgs& a) {
       std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s%s, %.3f s%s%s\n", m.rows(),
                    level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), processes_text.c_str(), m.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
+      for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: factors: %s\n", w.c_str());
       // Rows that see nothing: one-sided polygons whose fronts face away from everything, or
       // (per polygon, told apart) polygons lying against another, in contact: a box's bottom on
       // a floor, hidden as it should be.

@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   float exposure = 0.0f;  // 0: automatic (preview_exposure())
   CLI::App* render = app.add_subcommand("render", "Solve and render a scene to EXR (linear) and PNG (preview)");
   render->add_option("scene", render_args.scene, kSceneHelp);
-  render->add_option("-o,--output", out, "EXR output")->capture_default_str();
+  render->add_option("-o,--output", out, "EXR output (a .png name writes the sRGB preview alone)")->capture_default_str();
   render->add_option("--png", png, "PNG preview (default: the EXR path with .png)");
   render->add_flag("--no-png", no_png, "Do not write a PNG preview");
   render->add_flag("--no-default-light", no_default_light,
@@ -120,6 +120,13 @@ int main(int argc, char** argv) {
                   .add(direct_only ? rad::RenderMode::two_pass : rad::RenderMode::automatic, "--direct-only")
                   .conflict;
     if (!conflict.empty()) return argument_error("render", conflict);
+    // `-o image.png` asks for a PNG: the preview goes there, and no EXR is written (it was
+    // written and then overwritten by the preview, and said so twice).
+    if (lower_extension(out) == ".png" && no_png)
+      return argument_error("render", "-o " + out + " names a PNG and --no-png asks for none: nothing would be written");
+    if (lower_extension(out) == ".png" && !png.empty())
+      return argument_error("render", "-o " + out + " writes the PNG preview and --png names a second one (give -o "
+                                      "FILE.exr --png FILE.png for both)");
     if (render_args.light_groups && requested.mode == rad::RenderMode::path)
       return argument_error("render", "--light-groups needs a solve: --mode radiosity, two-pass or auto (the path "
                                       "tracer solves nothing)");
@@ -244,11 +251,15 @@ int main(int argc, char** argv) {
         add_light_group_layers(image, sol, [&](const rad::Solution& part) { return rad::render(scene, part, ro); });
         bar.finish();
       }
-      rad::write_exr(image, out);
-      std::string layers;
-      for (const auto& layer : image.layers) layers += (layers.empty() ? "; layers " : ", ") + layer.first;
-      std::printf("wrote %s (%dx%d, linear float RGB%s)\n", std::filesystem::absolute(out).c_str(), width, height,
-                  layers.c_str());
+      if (lower_extension(out) == ".png") {
+        png = out;
+      } else {
+        rad::write_exr(image, out);
+        std::string layers;
+        for (const auto& layer : image.layers) layers += (layers.empty() ? "; layers " : ", ") + layer.first;
+        std::printf("wrote %s (%dx%d, linear float RGB%s)\n", std::filesystem::absolute(out).c_str(), width, height,
+                    layers.c_str());
+      }
       if (!no_png) {
         if (png.empty()) png = std::filesystem::path(out).replace_extension(".png").string();
         rad::PngOptions po;
