@@ -445,10 +445,21 @@ struct OutwardFacing {
   std::vector<PolygonId> polygons;  ///< in polygon order
   double area = 0.0;                ///< theirs, scene units^2
   double one_sided_area = 0.0;      ///< of every polygon tested (the one-sided ones)
-  /// Whether they are more than half of the one-sided area: a closed model wound outward (a
-  /// roof under an open sky is found too, but it is not most of a scene). `radiosity check`
-  /// warns then, and so does solve() when most of the emitted light escaped.
-  bool looks_wound_outward() const { return one_sided_area > 0.0 && area > 0.5 * one_sided_area; }
+  /// The scene has light and none of it is inside what the polygons found enclose: only
+  /// directional or sky lights, point and spot lights and emitting polygons whose rays get
+  /// away (a light counts as inside when all of 14 rays from a point or spot light, or 15 of
+  /// 16 from an emitting polygon's front, meet a polygon). The polygons then face out of an
+  /// object seen from outside (a glTF asset, a CAD part under a sky), as they should. A room
+  /// wound outward and lit only through its windows reads so too (its walls' outsides take the
+  /// sun on their fronts). False when the scene has no light: nothing tells the two apart.
+  bool lit_from_outside = false;
+  /// Whether they are more than half of the one-sided area and the scene is not lit from
+  /// outside: a closed model wound outward (a roof under an open sky is found too, but it is not
+  /// most of a scene). `radiosity check` warns then, and so does solve() when most of the
+  /// emitted light escaped.
+  bool looks_wound_outward() const {
+    return one_sided_area > 0.0 && area > 0.5 * one_sided_area && !lit_from_outside;
+  }
 };
 
 /// One-sided polygons (material neither two-sided nor translucent, nor glass) that look wound
@@ -458,13 +469,13 @@ struct OutwardFacing {
 /// 4 x 4 grid, directions shuffled against the points); a polygon is reported when at most 1
 /// of its front's rays and at least 15 of its back's meet a polygon. An exterior seen alone (a
 /// box with nothing around it) is reported too, and so is a roof under an open sky (its back
-/// sees the building's inside), so the caller judges the share of the one-sided area
-/// (OutwardFacing::looks_wound_outward()). Rays cannot judge a polygon coincident with another
+/// sees the building's inside), so the caller judges the share of the one-sided area and where
+/// the light is (OutwardFacing::looks_wound_outward(), OutwardFacing::lit_from_outside). Rays cannot judge a polygon coincident with another
 /// (find_overlaps(): a box's bottom on a floor), so such pairs are reported so that turning the
 /// polygons found leaves them facing opposite ways (in contact), not the same way: of a pair
 /// facing the same way one (the larger, when rays found both: the floor, not the box's bottom),
 /// of a pair in contact both or neither. Scene::reverse_winding() turns the polygons found over. Deterministic
-/// (a fixed seed). Cost: a BVH over the scene, 32 rays per one-sided polygon, and find_overlaps(). Throws Error{internal} if Embree cannot create a
+/// (a fixed seed). Cost: a BVH over the scene, 32 rays per one-sided polygon (16 per emitting one), and find_overlaps(). Throws Error{internal} if Embree cannot create a
 /// device. Thread safety: concurrent calls are safe.
 RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene);
 /// The same, with find_overlaps(scene)'s result that the caller already has (it is most of the

@@ -313,6 +313,54 @@ OutwardFacing find_polygons_facing_outward(const Scene& scene, const std::vector
     out.polygons.push_back(p);
     out.area += polygon.area;
   }
+  if (out.polygons.empty()) return out;
+
+  // Where the light is. A closed model whose polygons face out is a room wound outward when
+  // light is inside it, and an object seen from outside (a glTF asset, a CAD part) when all of
+  // its light comes from outside: a sun, a sky, lamps whose rays get away. Found with Khronos'
+  // Box.gltf under a sky: `check` called the box "a closed model wound outward". A source is
+  // inside when at least 15 of its 16 rays meet a polygon (an emitting polygon: from its
+  // front, or either side if two-sided) or all 14 of a point or spot light's (the axes and
+  // the diagonals).
+  bool any_light = false, enclosed = false;
+  for (const Light& light : scene.lights()) {
+    any_light = true;
+    if (enclosed || (light.type != LightType::point && light.type != LightType::spot)) continue;
+    std::array<glm::vec3, 14> dir;
+    std::array<glm::vec3, 14> origin;
+    std::size_t k = 0;
+    for (int axis = 0; axis < 3; ++axis)
+      for (const float sign : {-1.0f, 1.0f}) {
+        dir[k] = glm::vec3(0.0f);
+        dir[k++][axis] = sign;
+      }
+    for (const float x : {-1.0f, 1.0f})
+      for (const float y : {-1.0f, 1.0f})
+        for (const float z : {-1.0f, 1.0f}) dir[k++] = glm::vec3(x, y, z) * 0.57735027f;
+    origin.fill(light.position);
+    std::array<std::uint8_t, 14> hit{};
+    rays_scene.occluded(dir.size(), origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(),
+                        hit.data());
+    enclosed = std::count(hit.begin(), hit.end(), std::uint8_t{1}) == static_cast<std::ptrdiff_t>(hit.size());
+  }
+  {
+    std::vector<glm::vec3> origin, dir;
+    std::vector<std::uint8_t> hit;
+    std::vector<std::uint32_t> order;
+    for (PolygonId p = 0; p < polygons.size() && !enclosed; ++p) {
+      const Material& m = scene.material(polygons[p].material);
+      if (!(detail::max_channel(m.emission) > 0.0f)) continue;
+      any_light = true;
+      for (int side = 0; side < (m.two_sided ? 2 : 1) && !enclosed; ++side) {
+        detail::Rng rng(detail::kSeed, 2 * std::uint64_t{p} + static_cast<std::uint64_t>(side));
+        const double seen = detail::hit_fraction(rays_scene, polygons[p], side == 0 ? polygons[p].normal
+                                                                                    : -polygons[p].normal,
+                                                 kSide, lift, rng, order, origin, dir, hit);
+        enclosed = seen * kRays + 1.0 >= kRays;
+      }
+    }
+  }
+  out.lit_from_outside = any_light && !enclosed;
   return out;
 }
 

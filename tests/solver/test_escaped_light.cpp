@@ -219,6 +219,46 @@ TEST_SUITE("solver") {
     rad::Scene two_sided = outward;
     two_sided.make_two_sided();
     CHECK(rad::find_polygons_facing_outward(two_sided).polygons.empty());
+    // Where the light is tells a room wound outward from an object seen from outside (Khronos'
+    // Box.gltf): without light, nothing does; a lamp inside makes it a room; a sky, a sun or a
+    // lamp outside an object, whose faces face out as they should.
+    CHECK(rad::find_polygons_facing_outward(outward).looks_wound_outward());
+    CHECK(!rad::find_polygons_facing_outward(outward).lit_from_outside);
+    auto with_light = [&](rad::LightType type, glm::vec3 position) {
+      rad::Scene lit = outward;
+      rad::Light light;
+      light.type = type;
+      light.position = position;
+      light.direction = glm::vec3(0.3f, -1.0f, 0.2f);
+      lit.add_light(light);
+      return rad::find_polygons_facing_outward(lit);
+    };
+    CHECK(with_light(rad::LightType::point, {1.0f, 0.5f, 1.5f}).looks_wound_outward());  // inside the box
+    CHECK(!with_light(rad::LightType::point, {1.0f, 0.5f, 1.5f}).lit_from_outside);
+    for (const rad::LightType type : {rad::LightType::point, rad::LightType::sky, rad::LightType::directional}) {
+      const rad::OutwardFacing object = with_light(type, {5.0f, 3.0f, -4.0f});
+      CHECK(object.polygons.size() == 6);  // found, as before
+      CHECK(object.lit_from_outside);
+      CHECK(!object.looks_wound_outward());
+    }
+    // An emitting polygon: inside (a lamp under the ceiling, facing down) or outside the box.
+    rad::Material lamp_material;
+    lamp_material.emission = rad::Rgb(10.0f);
+    rad::Scene lamp_inside = outward, lamp_outside = outward;
+    rad::add_quad(lamp_inside, {0.8f, 0.9f, 1.3f}, {0.4f, 0, 0}, {0, 0, 0.4f}, lamp_inside.add_material(lamp_material),
+                  "lamp");
+    rad::add_quad(lamp_outside, {0.8f, 3.0f, 1.3f}, {0.4f, 0, 0}, {0, 0, 0.4f},
+                  lamp_outside.add_material(lamp_material), "lamp");
+    REQUIRE(lamp_inside.polygons().back().normal.y < -0.99f);
+    CHECK(rad::find_polygons_facing_outward(lamp_inside).looks_wound_outward());
+    CHECK(rad::find_polygons_facing_outward(lamp_outside).lit_from_outside);
+    CHECK(!rad::find_polygons_facing_outward(lamp_outside).looks_wound_outward());
+    // And a solve of the box lit from outside by that lamp: most of the light leaves (it is an
+    // open scene), but nothing is said about winding.
+    const rad::Solution object_solve = rad::solve(lamp_outside, coarse());
+    CHECK(share(object_solve.report().escaped_power, object_solve.report().emitted_power) > 0.5);
+    CHECK(!has_warning(object_solve.report(), "wound outward"));
+    CHECK(!has_warning(object_solve.report(), "looks closed"));
     // A box standing on a large ground, wound outward as an exterior should be: only its roof
     // (open sky in front, the box's inside behind) is reported, a small share of the area, which
     // is why `radiosity check` warns only above half of it.

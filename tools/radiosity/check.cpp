@@ -204,11 +204,15 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     if (outward.looks_wound_outward()) {
       char share[32];
       std::snprintf(share, sizeof share, "%.0f", 100.0 * outward.area / outward.one_sided_area);
+      // Without light nothing tells a room wound outward from an object seen from outside.
       r.warnings.push_back(std::to_string(outward.polygons.size()) + " of " + std::to_string(scene.polygons().size()) +
                            " polygons (" + share +
                            " % of the one-sided area) see nothing in front of them and surfaces behind: a closed "
-                           "model wound outward (a CAD solid's facets point out of it)? Its inside then stays dark "
-                           "and its view factors are 0; reverse the winding (--reverse-winding outward), or use "
+                           "model wound outward (a CAD solid's facets point out of it)" +
+                           (has_light(scene) ? "? Its inside then stays dark"
+                                             : ", or an object seen from outside (then all is well)? If it is an "
+                                               "enclosure, its inside stays dark") +
+                           " and its view factors are 0; reverse the winding (--reverse-winding outward), or use "
                            "two-sided materials (--two-sided) to light it");
     }
   }
