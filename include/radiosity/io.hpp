@@ -45,6 +45,9 @@ inline namespace v1 {
 /// Every other extension Assimp reads (FBX, COLLADA, 3DS, PLY, STL, ...): its scene graph and
 /// materials read the same way, where the format carries them.
 /// NIST View3D (.vs3): load_view3d()'s scene (its control line and title are dropped).
+/// Whatever the format, a model too far from the origin for its size to be held in single
+/// precision (floats 1 % of its median polygon's size apart or more at its largest coordinate: a
+/// city at its UTM position) gets a warning with the figures (Error{parse_error} under strict).
 /// Throws Error{invalid_argument} for an unsupported extension, and only radiosity::Error (or
 /// std::bad_alloc) whatever the file holds.
 /// Thread safety: may be called concurrently.

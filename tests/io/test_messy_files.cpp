@@ -5,6 +5,9 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <fstream>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -136,5 +139,48 @@ TEST_SUITE("io") {
     // pane, which this pass does not carry (specular depth 0) and whose back is one-sided.
     MESSAGE("turned room: " << 100.0 * r.escaped_power.x / r.emitted_power.x << " % escaped");
     CHECK(r.escaped_power.x < 0.4f * r.emitted_power.x);
+  }
+
+  TEST_CASE("a model at georeferenced coordinates (McGuire's box moved to UTM) is said to lose its shape in single "
+            "precision - strict refuses it - the box where it was is not") {
+    // As a GIS or BIM export writes it: the model at its site's coordinates (500 000 E, 5 700 000 N).
+    // Floats are 0.5 apart at 5.7e6, so the 2 m box's corners move by up to 0.25 and its light
+    // (0.38 deep) collapses and is dropped.
+    const fs::path original = fs::path(RADIOSITY_TEST_DATA) / "mcguire" / "CornellBox-Original.obj";
+    const fs::path dir = fs::temp_directory_path() / "radiosity_test_utm";
+    fs::create_directories(dir);
+    fs::copy_file(fs::path(RADIOSITY_TEST_DATA) / "mcguire" / "CornellBox-Original.mtl",
+                  dir / "CornellBox-Original.mtl", fs::copy_options::overwrite_existing);
+    {
+      std::ifstream in(original);
+      std::ofstream out(dir / "utm.obj");
+      std::string line;
+      while (std::getline(in, line)) {
+        std::istringstream words(line);
+        std::string tag;
+        double x = 0, y = 0, z = 0;
+        if ((words >> tag) && tag == "v" && (words >> x >> y >> z)) {
+          char moved[128];
+          std::snprintf(moved, sizeof moved, "v %.6f %.6f %.6f", x + 500000.0, y + 30.0, z + 5700000.0);
+          line = moved;
+        }
+        out << line << "\n";
+      }
+    }
+    const rad::Scene utm = rad::load_scene(dir / "utm.obj");
+    bool said = false;
+    for (const std::string& w : utm.warnings()) {
+      MESSAGE(w);
+      said = said || contains(w, "utm.obj: coordinates reach 5700001 while a typical polygon is ");
+      if (contains(w, "coordinates reach")) CHECK(contains(w, "single precision, in which polygons are stored, is 0.5 apart there"));
+    }
+    CHECK(said);
+    rad::LoadOptions strict;
+    strict.strict = true;
+    CHECK_THROWS_AS(rad::load_scene(dir / "utm.obj", strict), rad::Error);
+    // Where it was modelled (and at 1 km from the origin) nothing is said.
+    const rad::Scene at_home = rad::load_scene(original);
+    for (const std::string& w : at_home.warnings()) CHECK(!contains(w, "coordinates reach"));
+    fs::remove_all(dir);
   }
 }
