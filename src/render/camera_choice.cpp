@@ -254,6 +254,9 @@ Up scene_up(const Scene& scene) {
   return up;
 }
 
+/// A share in [0, 1] as the reasons print it: "44 %".
+std::string percent(double share) { return std::to_string(static_cast<int>(100.0 * share + 0.5)) + " %"; }
+
 /// Axis names for the reasons: "+x", "-z", ...
 std::string axis_name(int axis, float sign) { return std::string(sign < 0.0f ? "-" : "+") + "xyz"[axis]; }
 
@@ -374,13 +377,9 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
     if (mostly_unlit(view) || !(view.lit > best_outside)) continue;
     best_outside = view.lit;
     out.camera = camera;
-    char share[200];
-    std::snprintf(share, sizeof share,
-                  "the scene has none, and from %s %.0f %% of the view is surfaces no light reaches: framing its "
-                  "bounds from %s (%.0f %% of the view lit surfaces; ",
-                  axis_name(front, -1.0f).c_str(), 100.0 * outside.unlit, axis_name(axis, -sign).c_str(),
-                  100.0 * view.lit);
-    out.reason = share + up_text(up) + ")";
+    out.reason = "the scene has none, and from " + axis_name(front, -1.0f) + " " + percent(outside.unlit) +
+                 " of the view is surfaces no light reaches: framing its bounds from " + axis_name(axis, -sign) +
+                 " (" + percent(view.lit) + " of the view lit surfaces; " + up_text(up) + ")";
   }
   if (best_outside > 0.0) return out;
 
@@ -412,13 +411,9 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
     if (inside.lit > best_lit) {
       best_lit = inside.lit;
       out.camera = camera;
-      char share[160];
-      std::snprintf(share, sizeof share,
-                    "the scene has none, and from outside %.0f %% of the view is surfaces no light reaches (a "
-                    "closed model): inside, at ",
-                    100.0 * outside.unlit);
-      out.reason = share + point_text(camera.eye) + " looking " + c.name + ", 60 degrees (" +
-                   std::to_string(static_cast<int>(100.0 * inside.lit + 0.5)) + " % of the view lit surfaces; " +
+      out.reason = "the scene has none, and from outside " + percent(outside.unlit) +
+                   " of the view is surfaces no light reaches (a closed model): inside, at " + point_text(camera.eye) +
+                   " looking " + c.name + ", 60 degrees (" + percent(inside.lit) + " of the view lit surfaces; " +
                    up_text(up) + ")";
     }
   }
