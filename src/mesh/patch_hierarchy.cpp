@@ -60,6 +60,10 @@ constexpr std::size_t kMaxContactLines = 64;
 // before any memory is spent on them.
 constexpr double kMaxEstimatedElements = 1u << 28;
 
+// Splits of one patch's root before the mesher gives up on an element that does not shrink
+// (corners that single precision cannot tell apart); see the split loop.
+constexpr int kMaxSplitDepth = 40;
+
 // Grading toward contacts (MeshOptions::grade_at_contacts): elements reach a quarter of the
 // object's size near it, at most this many levels below the polygon's own elements, and grow
 // to at most half their distance from it (a 2:1 grading, so neighbours differ by a level or so).
@@ -861,6 +865,20 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
       const std::uint32_t e = stack.back();
       stack.pop_back();
       if (fits(elements_[e].area, options_.max_element_area)) continue;
+      // An element that does not shrink when split: its corners are too close together for
+      // single precision (a model far from the origin: a city at its UTM coordinates, where
+      // floats are 0.5 apart), and splitting would go on to the depth limit. Found so: the
+      // message was "element 2161 is at the maximum depth". 40 levels divide an area by 4^40
+      // (1e24): no mesh within any memory budget is that fine.
+      if (elements_[e].depth >= kMaxSplitDepth) {
+        const Patch& stuck = patches_[elements_[e].patch];
+        throw Error(ErrorCode::invalid_scene,
+                    "polygon " + std::to_string(stuck.polygon) + " (group '" + scene.groups()[stuck.group] +
+                        "') does not shrink into elements of max_element_area " +
+                        std::to_string(options_.max_element_area) + " after " + std::to_string(kMaxSplitDepth) +
+                        " splits: its corners are too close together for single precision (is the model far "
+                        "from the origin for its size? load_scene() warns then)");
+      }
       const std::uint32_t first = subdivide(e);
       for (std::uint32_t k = 4; k-- > 0;) stack.push_back(first + k);
     }

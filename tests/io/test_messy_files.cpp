@@ -175,6 +175,17 @@ TEST_SUITE("io") {
       if (contains(w, "coordinates reach")) CHECK(contains(w, "single precision, in which polygons are stored, is 0.5 apart there"));
     }
     CHECK(said);
+    // Its solve cannot mesh the floor (midpoints round onto its corners) and says why, rather
+    // than "element 2161 is at the maximum depth".
+    std::string why;
+    try {
+      (void)rad::solve(utm);  // the default mesh, as the command line has it
+    } catch (const rad::Error& e) {
+      why = e.what();
+    }
+    MESSAGE(why);
+    CHECK(contains(why, "does not shrink into elements of max_element_area"));
+    CHECK(contains(why, "too close together for single precision (is the model far from the origin for its size?"));
     rad::LoadOptions strict;
     strict.strict = true;
     CHECK_THROWS_AS(rad::load_scene(dir / "utm.obj", strict), rad::Error);
