@@ -89,9 +89,17 @@ class CellSampler {
     if (count == 4) {
       const glm::vec3 n = glm::cross(c_[1] - c_[0], c_[2] - c_[0]) + glm::cross(c_[2] - c_[0], c_[3] - c_[0]);
       const glm::vec3 e0 = c_[1] - c_[0], e3 = c_[3] - c_[0], d = c_[0] - c_[1] + c_[2] - c_[3];
-      A_ = glm::dot(n, glm::cross(e0, e3));
-      B_ = glm::dot(n, glm::cross(e0, d));
-      C_ = glm::dot(n, glm::cross(d, e3));
+      // In double and divided by |n|^2: the terms grow as the fourth power of the cell's size
+      // and linear() squares them, while the inverse CDF is the same for any common factor. In
+      // float, a cell 0.1 mm across took f0^2 into the denormals, which a thread with
+      // flush-to-zero set reads as 0: McGuire's Cornell box scaled to 0.5 mm came out 3 % dark,
+      // and its rows depended on which thread computed them.
+      const glm::dvec3 dn(n);
+      const double scale = glm::dot(dn, dn);
+      const double inverse = scale > 0.0 ? 1.0 / scale : 1.0;
+      A_ = static_cast<float>(glm::dot(dn, glm::cross(glm::dvec3(e0), glm::dvec3(e3))) * inverse);
+      B_ = static_cast<float>(glm::dot(dn, glm::cross(glm::dvec3(e0), glm::dvec3(d))) * inverse);
+      C_ = static_cast<float>(glm::dot(dn, glm::cross(glm::dvec3(d), glm::dvec3(e3))) * inverse);
       parallelogram_ = std::fabs(B_) <= 1e-6f * std::fabs(A_) && std::fabs(C_) <= 1e-6f * std::fabs(A_);
     }
   }
