@@ -29,8 +29,8 @@ double polygon_factor(const rad::Scene& scene, rad::FormFactorOptions o, std::ui
 
 TEST_SUITE("form_factors") {
   TEST_CASE("factors and radiosity do not depend on the scene's scale or the thread count: McGuire's box at 1 and at "
-            "1.4e-4 of its size (0.5 mm)") {
-    // Found by scaling a file we did not make: at 1.4e-4 the floor came out 3 % dark, and the
+            "1.2e-4 of its size (0.4 mm)") {
+    // Found by scaling a file we did not make: at 1.2e-4 the floor came out 3 % dark, and the
     // ray-cast rows differed between threads = 0 and 2 in 78 984 entries. The area-uniform
     // quad sampler squared terms that grow as the fourth power of the cell's size, which fell
     // into float's denormals, read as 0 on threads with flush-to-zero set (CellSampler).
@@ -45,7 +45,7 @@ TEST_SUITE("form_factors") {
       }
       return out;
     };
-    const rad::Scene big = scaled(1.0f), tiny = scaled(1.4e-4f);
+    const rad::Scene big = scaled(1.0f), tiny = scaled(1.2e-4f);
     REQUIRE(tiny.polygons().size() == big.polygons().size());
     // Rows of every element by ray casting, threads 0 (every core, TBB's own arena) and 2.
     const rad::PatchHierarchy mesh(tiny, rad::MeshOptions{});
