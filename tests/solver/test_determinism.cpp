@@ -1,5 +1,5 @@
 // Issue #17: every estimator, solver and renderer gives bit-identical results at 1, 2 and 4
-// threads for a seed, in one parameterised test. Each case below turns the small Cornell box
+// threads (and at the default, 0) for a seed, in one parameterised test. Each case below turns the small Cornell box
 // (or its mirror-and-glass variant) into a flat list of floats with the given thread count; the
 // lists at 2 and 4 threads must equal the one at 1, bit for bit. 4 threads on a 2-core machine
 // still interleave, so chunking and scheduling differ between the runs; in the ThreadSanitizer
@@ -166,7 +166,8 @@ bool bit_identical(const std::vector<float>& a, const std::vector<float>& b) {
 
 TEST_SUITE("solver") {
 
-TEST_CASE("determinism: every estimator, solver and renderer is bit-identical at 1, 2 and 4 threads") {
+TEST_CASE("determinism: every estimator, solver and renderer is bit-identical at 1, 2 and 4 threads and at the "
+          "default (0)") {
   for (const Case& c : cases()) {
     CAPTURE(std::string(c.name));
     const auto start = std::chrono::steady_clock::now();
@@ -176,11 +177,14 @@ TEST_CASE("determinism: every estimator, solver and renderer is bit-identical at
     bool any = false;
     for (const float v : one) any |= v != 0.0f;
     CHECK(any);
-    for (const unsigned threads : {2u, 4u}) {
+    // 0 is the default (every core, in TBB's own arena rather than one of our explicit ones):
+    // session 35 found results there that 1, 2 and 4 did not reproduce (a float that fell into
+    // the denormals, on a scene 0.4 mm across; test_ray_cast.cpp's scale test has that case).
+    for (const unsigned threads : {0u, 2u, 4u}) {
       CAPTURE(threads);
       CHECK(bit_identical(c.run(threads), one));
     }
-    MESSAGE(std::string(c.name) << ": " << one.size() << " values, bit-identical at 1, 2 and 4 threads in "
+    MESSAGE(std::string(c.name) << ": " << one.size() << " values, bit-identical at 1, 2, 4 and 0 threads in "
                    << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s");
   }
 }
