@@ -304,7 +304,10 @@ int run_factors(const FactorsArgs& a) {
       // a floor, hidden as it should be.
       std::size_t blind = 0, in_contact = 0;
       std::vector<bool> touching;
-      if (level == "polygon") {
+      // The overlap search (0.5 s at 246k polygons) only when some row is empty.
+      bool any_empty = false;
+      for (std::size_t i = 0; i < m.rows() && !any_empty; ++i) any_empty = m.row_offsets[i + 1] == m.row_offsets[i];
+      if (level == "polygon" && any_empty) {
         touching.assign(scene.polygons().size(), false);
         for (const rad::PolygonOverlap& p : rad::find_overlaps(scene))
           if (p.lying_against()) touching[p.first] = touching[p.second] = true;
