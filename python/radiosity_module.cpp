@@ -785,6 +785,19 @@ PYBIND11_MODULE(radiosity, m) {
              return py::make_tuple(vec3(b.lower), vec3(b.upper));
            },
            "(lower, upper) corners of the bounding box.")
+      .def_property_readonly("origin",
+                             [](const rad::Scene& s) {
+                               const glm::dvec3 o = s.origin();
+                               Doubles out(3);
+                               double* p = out.mutable_data();
+                               p[0] = o.x;
+                               p[1] = o.y;
+                               p[2] = o.z;
+                               return out;
+                             },
+                             "(3,): the point of the file's coordinates that the scene's (0, 0, 0) stands for; "
+                             "positions are relative to it. (0, 0, 0) unless the reader moved a model that lay far "
+                             "from the origin for its size (georeferenced coordinates).")
       .def_property_readonly("light_count", [](const rad::Scene& s) { return s.lights().size(); },
                              "Lights that are not polygons (point, spot, directional, sky).")
       .def_property_readonly("warnings", [](const rad::Scene& s) { return string_list(s.warnings()); },
@@ -910,19 +923,22 @@ PYBIND11_MODULE(radiosity, m) {
 
   m.def(
       "load_scene",
-      [](const py::object& path, bool strict, bool photometric) {
+      [](const py::object& path, bool strict, bool photometric, bool local_origin) {
         const std::string file = py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
         rad::LoadOptions o;
         o.strict = strict;
         o.photometric = photometric;
+        o.local_origin = local_origin;
         py::gil_scoped_release release;
         return rad::load_scene(file, o);
       },
-      py::arg("path"), py::arg("strict") = false, py::arg("photometric") = false,
-      "load_scene(path, strict=False, photometric=False) -> Scene\n\n"
+      py::arg("path"), py::arg("strict") = false, py::arg("photometric") = false, py::arg("local_origin") = true,
+      "load_scene(path, strict=False, photometric=False, local_origin=True) -> Scene\n\n"
       "Loads .obj (+ .mtl), .json, .gltf/.glb, .vs3 (View3D) or any format Assimp reads. strict: what a "
       "renderer would step over (degenerate faces, Kd >= 1, a missing MTL) is an error instead of a warning "
-      "(Scene.warnings). photometric: light intensities in candela and lux. Raises radiosity.Error naming "
+      "(Scene.warnings). photometric: light intensities in candela and lux. local_origin: an OBJ or .vs3 "
+      "model far from the origin for its size (georeferenced coordinates) is held relative to a point near "
+      "it (Scene.origin); False keeps the file's coordinates. Raises radiosity.Error naming "
       "the file and line. Thread safety: releases the GIL; concurrent calls are safe.");
   m.def(
       "find_polygons_facing_outward",

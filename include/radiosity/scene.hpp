@@ -153,6 +153,14 @@ struct LoadOptions {
   /// (KHR_lights_punctual) and the Assimp reader (its point, spot and directional lights); see
   /// docs/LIGHTS.md.
   bool photometric = false;
+  /// true (the default): a model so far from the origin for its size that single precision,
+  /// in which Polygon stores positions, would move its corners by 0.1 % of a typical polygon
+  /// or more (georeferenced coordinates: a city in UTM, a building at its national-grid
+  /// position) is read relative to a round point near its centre, and that point kept as
+  /// Scene::origin(). Done by the readers that parse coordinates in double precision: OBJ and
+  /// View3D `.vs3`. false keeps the file's coordinates as they are; load_scene() then warns
+  /// (for every format) when single precision cannot hold them.
+  bool local_origin = true;
 };
 
 /// An indexed triangle mesh as a host renderer holds it, in meshoptimizer's pointer-and-count
@@ -375,6 +383,17 @@ class RADIOSITY_API Scene {
   /// The camera set on the scene, or one that frames the scene's bounds from -z.
   Camera camera() const;
 
+  /// The point of the file's coordinate system that the scene's (0, 0, 0) stands for, in
+  /// double precision: every position of the scene (polygons, meshes, lights, the camera) is
+  /// relative to it. (0, 0, 0) unless a reader moved a model that lay far from the origin
+  /// (LoadOptions::local_origin). The writers add it back to the positions they write
+  /// (write_ply(), write_mesh_ply(), write_baked_gltf(), save_view3d()), so outputs are in the
+  /// file's coordinates; view factors and radiosity do not depend on it.
+  glm::dvec3 origin() const { return origin_; }
+  /// Sets origin(); it moves nothing (the positions are already relative to it). Throws
+  /// Error{invalid_argument} for a NaN or infinite coordinate. Thread safety: mutates the scene.
+  void set_origin(const glm::dvec3& origin);
+
   Bounds bounds() const;
   double total_area() const;
   /// Non-fatal problems found while building (triangulated polygons, ...).
@@ -390,6 +409,7 @@ class RADIOSITY_API Scene {
   std::vector<Light> lights_;
   std::vector<std::string> groups_;
   std::optional<Camera> camera_;
+  glm::dvec3 origin_{0.0};
   std::vector<std::string> warnings_;
 };
 

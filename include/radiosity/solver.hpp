@@ -356,6 +356,11 @@ class RADIOSITY_API Solution {
   /// Gives the solution its scene's meshes (solve() does), for the mesh_*_values() calls.
   void set_meshes(std::vector<SolvedMesh> meshes) { meshes_ = std::move(meshes); }
   const std::vector<std::string>& groups() const { return groups_; }
+  /// The solved scene's origin (Scene::origin(); solve() sets it): the positions of
+  /// hierarchy() and meshes() are relative to it, and write_ply() and write_mesh_ply() add it
+  /// back, so that their files are in the scene file's coordinates.
+  glm::dvec3 origin() const { return origin_; }
+  void set_origin(const glm::dvec3& origin) { origin_ = origin; }
 
  private:
   GroupId group_id(std::string_view group) const;
@@ -375,6 +380,7 @@ class RADIOSITY_API Solution {
   std::vector<Rgb> direct_irradiance_;
   std::vector<float> exposure_;
   std::vector<SolvedMesh> meshes_;
+  glm::dvec3 origin_{0.0};
   /// Shared between a solution and the solutions relit from it (immutable); null for none.
   std::shared_ptr<const std::vector<LightGroupSolution>> light_groups_;
   std::vector<Rgb> light_group_weights_;

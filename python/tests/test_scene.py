@@ -27,6 +27,24 @@ def test_load_scene_reads_view3d_and_accepts_str_paths(data_dir):
     np.testing.assert_allclose(lower, [0, 0, 0])
     np.testing.assert_allclose(upper, [2, 2, 2])
 
+    np.testing.assert_array_equal(scene.origin, [0, 0, 0])
+
+
+def test_load_scene_moves_a_georeferenced_model_to_a_local_origin(data_dir):
+    # The 2 m cube at UTM coordinates (x.3, y.7, z.1): held relative to its rounded centre.
+    scene = radiosity.load_scene(data_dir / "view3d" / "cube_utm.vs3")
+    np.testing.assert_array_equal(scene.origin, [512341.0, 5701232.0, 31.0])
+    lower, upper = scene.bounds()
+    np.testing.assert_allclose(lower, [-0.7, -1.3, -0.9], atol=1e-6)
+    np.testing.assert_allclose(upper, [1.3, 0.7, 1.1], atol=1e-6)
+    # Its view factors are the cube's at home (Howell C-14: 0.199825 opposite).
+    home = radiosity.view_factor_matrix(radiosity.load_scene(data_dir / "view3d" / "cube.vs3"), level="polygon")
+    moved = radiosity.view_factor_matrix(scene, level="polygon")
+    np.testing.assert_allclose(moved.toarray(), home.toarray(), atol=1e-6)
+    kept = radiosity.load_scene(data_dir / "view3d" / "cube_utm.vs3", local_origin=False)
+    np.testing.assert_array_equal(kept.origin, [0, 0, 0])
+    assert any("coordinates reach" in w for w in kept.warnings)
+
 
 def test_load_scene_errors_are_radiosity_errors_with_the_library_message(data_dir):
     with pytest.raises(radiosity.Error) as info:

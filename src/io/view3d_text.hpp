@@ -25,6 +25,14 @@ inline std::string shortest(float x) {
   return ec == std::errc() ? std::string(buffer, end) : std::string("0");
 }
 
+/// The same for a double: a vertex of a scene with a local origin (Scene::origin()), written in
+/// the file's coordinates.
+inline std::string shortest(double x) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, x);
+  return ec == std::errc() ? std::string(buffer, end) : std::string("0");
+}
+
 /// Whether `c` would end or split a View3D word: blanks and commas separate words, '!' starts
 /// a comment, '=' separates a control word from its value, a line break ends the line.
 inline bool breaks_word(char c) {

@@ -412,7 +412,7 @@ CameraChoice choose_camera(const Scene& scene, const RayScene& rays,
       best_lit = inside.lit;
       out.camera = camera;
       out.reason = "the scene has none, and from outside " + percent(outside.unlit) +
-                   " of the view is surfaces no light reaches (a closed model): inside, at " + point_text(camera.eye) +
+                   " of the view is surfaces no light reaches (a closed model): inside, at " + point_text(camera.eye, scene.origin()) +
                    " looking " + c.name + ", 60 degrees (" + percent(inside.lit) + " of the view lit surfaces; " +
                    up_text(up) + ")";
     }

@@ -489,7 +489,7 @@ std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing
     return "polygon " + std::to_string(p) + " (group '" + scene.groups()[scene.polygons()[p].group] + "')";
   };
   std::string message = name(o.first) + " and " + name(o.second) +
-                        " are coincident and face the same way (z-fighting) around " + point_text(o.point) + ": " +
+                        " are coincident and face the same way (z-fighting) around " + point_text(o.point, scene.origin()) + ": " +
                         consequence;
   if (same_facing.size() > 1)
     message += " (" + std::to_string(same_facing.size()) + " such pairs in all; radiosity::find_overlaps() lists them)";

@@ -187,6 +187,12 @@ void Scene::set_camera(const Camera& camera) {
   camera_ = camera;
 }
 
+void Scene::set_origin(const glm::dvec3& origin) {
+  if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z))
+    throw Error(ErrorCode::invalid_argument, "Scene::set_origin: a coordinate is NaN or infinite");
+  origin_ = origin;
+}
+
 Camera Scene::camera() const {
   if (camera_) return *camera_;
   // Frame the bounding sphere from -z with a 45 degree field of view.

@@ -415,6 +415,7 @@ Solution Problem::Impl::solve(const std::vector<Rgb>* emission, bool last) {
   // Cancelled while meshing, the solution has no elements, and nothing to align with the
   // meshes (whose copy would take a host's million triangles some 0.1 s after the cancel).
   if (!meshing_cancelled) solution.set_meshes(solved_meshes(scene));
+  solution.set_origin(scene.origin());
   return solution;
 }
 

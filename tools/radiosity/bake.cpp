@@ -139,7 +139,7 @@ int run_bake(const BakeArgs& a) {
       throw rad::Error(rad::ErrorCode::invalid_argument,
                        "--light-groups needs an output folder (a .glb/.gltf holds the total only)");
     rad::Scene scene = load(a.solve.scene, a.solve.strict, a.solve.photometric, {a.solve.two_sided, a.solve.reverse_winding});
-    print_warnings(scene.warnings());
+    print_load_notes(scene);
     // Surfaces that came as polygons (OBJ faces, JSON shapes, the built-in scenes) are baked per
     // group, as meshes welded at shared corners.
     const std::size_t given = scene.meshes().size();

@@ -248,10 +248,23 @@ std::string mib(std::size_t bytes) {
   return s;
 }
 
+/// A place in the file's coordinates (Scene::origin() added), with the digits georeferenced
+/// coordinates need when there is an origin.
+std::string place(const glm::vec3& p, const glm::dvec3& origin) {
+  const bool moved = origin != glm::dvec3(0.0);
+  char text[128];
+  std::snprintf(text, sizeof text, moved ? "(%.10g, %.10g, %.10g)" : "(%.6g, %.6g, %.6g)",
+                static_cast<double>(p.x) + origin.x, static_cast<double>(p.y) + origin.y,
+                static_cast<double>(p.z) + origin.z);
+  return text;
+}
+
 void print_text(const CheckResult& r, const rad::Scene& scene) {
   std::printf("scene: %s\n", r.scene.c_str());
   std::printf("polygons: %zu\nmaterials: %zu\nemitters: %zu\nlights: %zu\ngroups: %zu\narea: %.6g\n", r.polygons,
               r.materials, r.emitters, r.lights, r.groups, r.area);
+  const glm::dvec3 origin = scene.origin();
+  if (!origin_note(scene).empty()) std::printf("origin: %s\n", origin_note(scene).c_str());
   std::printf("warnings: %zu\n", r.warnings.size());
   for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
   // Contact (a box on a floor, a prop sunk into it) is lit correctly; only z-fighting is a problem.
@@ -259,9 +272,9 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
               r.overlaps.size(), r.coincident, r.interpenetrating, r.z_fighting);
   for (std::size_t k = 0; k < r.overlaps.size() && k < kOverlapsShown; ++k) {
     const rad::PolygonOverlap& o = r.overlaps[k];
-    std::printf("  %s: polygon %u (group '%s') and polygon %u (group '%s') at (%.6g, %.6g, %.6g)\n",
-                kind_name(o.kind), o.first, group_of(scene, o.first).c_str(), o.second,
-                group_of(scene, o.second).c_str(), o.point.x, o.point.y, o.point.z);
+    std::printf("  %s: polygon %u (group '%s') and polygon %u (group '%s') at %s\n", kind_name(o.kind), o.first,
+                group_of(scene, o.first).c_str(), o.second, group_of(scene, o.second).c_str(),
+                place(o.point, origin).c_str());
   }
   if (r.overlaps.size() > kOverlapsShown) std::printf("  ... and %zu more\n", r.overlaps.size() - kOverlapsShown);
   std::printf("emitters facing away: %zu\n", r.facing_away.size());
@@ -306,6 +319,8 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
   j["lights"] = r.lights;
   j["groups"] = r.groups;
   j["area"] = r.area;
+  const glm::dvec3 origin = scene.origin();
+  j["origin"] = {origin.x, origin.y, origin.z};
   j["warnings"] = r.warnings;
   Json first = Json::array();
   for (std::size_t k = 0; k < r.overlaps.size() && k < kOverlapsShown; ++k) {
@@ -315,7 +330,7 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
                          {"first_group", group_of(scene, o.first)},
                          {"second", o.second},
                          {"second_group", group_of(scene, o.second)},
-                         {"point", Json::array({o.point.x, o.point.y, o.point.z})}});
+                         {"point", Json::array({o.point.x + origin.x, o.point.y + origin.y, o.point.z + origin.z})}});
   }
   j["overlaps"] = Json{{"coincident", r.coincident},
                        {"interpenetrating", r.interpenetrating},
@@ -325,8 +340,8 @@ void print_json(const CheckResult& r, const rad::Scene& scene) {
   for (rad::PolygonId p : r.facing_away) away.push_back(Json{{"polygon", p}, {"group", group_of(scene, p)}});
   j["emitters_facing_away"] = std::move(away);
   const rad::Camera& c = r.camera.camera;
-  j["camera"] = Json{{"eye", {c.eye.x, c.eye.y, c.eye.z}},
-                     {"look_at", {c.look_at.x, c.look_at.y, c.look_at.z}},
+  j["camera"] = Json{{"eye", {c.eye.x + origin.x, c.eye.y + origin.y, c.eye.z + origin.z}},
+                     {"look_at", {c.look_at.x + origin.x, c.look_at.y + origin.y, c.look_at.z + origin.z}},
                      {"up", {c.up.x, c.up.y, c.up.z}},
                      {"fov_deg", c.fov_deg},
                      {"reason", r.camera.reason}};

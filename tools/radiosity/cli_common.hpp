@@ -106,8 +106,9 @@ CLI::Validator in_range(T lo, T hi) {
 }
 
 /// `s` as x,y,z, or nullopt.
-inline std::optional<glm::vec3> try_parse_vec3(const std::string& s) {
-  glm::vec3 v;
+/// Read in double: a place in georeferenced coordinates (Scene::origin()) needs the digits.
+inline std::optional<glm::dvec3> try_parse_vec3(const std::string& s) {
+  glm::dvec3 v;
   char c1 = 0, c2 = 0;
   std::istringstream in(s);
   if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !in.eof()) return std::nullopt;
@@ -493,6 +494,27 @@ inline void print_warnings(const std::vector<std::string>& warnings) {
   for (const std::string& w : warnings) std::cerr << "warning: " << w << "\n";
 }
 
+/// "(x, y, z): why" for a scene read with a local origin (Scene::origin()), else empty.
+inline std::string origin_note(const rad::Scene& scene) {
+  const glm::dvec3 o = scene.origin();
+  if (o == glm::dvec3(0.0)) return {};
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "(%.10g, %.10g, %.10g): the model lies far from (0, 0, 0) for its size, so its positions are held "
+                "relative to this point (single precision would move its corners); outputs and --eye / --look-at "
+                "are in the file's coordinates",
+                o.x, o.y, o.z);
+  return text;
+}
+
+/// What loading a scene file did that a user should know: the local origin the reader chose,
+/// then the readers' warnings.
+inline void print_load_notes(const rad::Scene& scene) {
+  const std::string origin = origin_note(scene);
+  if (!origin.empty()) std::fprintf(stderr, "origin: %s\n", origin.c_str());
+  print_warnings(scene.warnings());
+}
+
 /// The solve's own warnings (report.warnings repeats the scene's, printed before the solve).
 inline void print_solve_warnings(const rad::Scene& scene, const rad::Solution& sol) {
   const std::vector<std::string>& known = scene.warnings();
@@ -596,9 +618,17 @@ inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& o
 }
 
 inline glm::vec3 parse_vec3(const std::string& s, const char* name) {
-  const std::optional<glm::vec3> v = try_parse_vec3(s);
+  const std::optional<glm::dvec3> v = try_parse_vec3(s);
   if (!v) throw CLI::ValidationError(name, "expected x,y,z (three numbers), got '" + s + "'");
-  return *v;
+  return glm::vec3(*v);
+}
+
+/// A place given in the scene file's coordinates (--eye, --look-at), as the scene holds it:
+/// relative to its origin (Scene::origin(), (0, 0, 0) unless the reader moved a far model).
+inline glm::vec3 parse_point(const std::string& s, const char* name, const rad::Scene& scene) {
+  const std::optional<glm::dvec3> v = try_parse_vec3(s);
+  if (!v) throw CLI::ValidationError(name, "expected x,y,z (three numbers), got '" + s + "'");
+  return glm::vec3(*v - scene.origin());
 }
 
 /// Runs a command body and turns exceptions into the CLI's exit codes: 1 for a

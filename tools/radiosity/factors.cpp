@@ -175,7 +175,7 @@ int run_factors(const FactorsArgs& a) {
     } else {
       scene = load(a.scene, a.strict, a.photometric, {false, a.reverse_winding});
     }
-    print_warnings(scene.warnings());
+    print_load_notes(scene);
     rad::ViewFactorOptions o;
     if (a.method == "hierarchical") {
       o.method = rad::ViewFactorMethod::hierarchical;

@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
     ProgressBar bar;
     if (*render) {
       rad::Scene scene = load(render_args.scene, render_args.strict, render_args.photometric, {render_args.two_sided, render_args.reverse_winding});
-      print_warnings(scene.warnings());
+      print_load_notes(scene);
       // A scene without any light (an STL, a PLY, an OBJ without an emitting material) would
       // render black: as a modeller's viewport does, a preview lights it, by a uniform sky
       // around the scene's up (the camera choice's), and says so. solve, bake and the library
@@ -160,8 +160,8 @@ int main(int argc, char** argv) {
       std::optional<rad::Camera> camera = chosen.camera;
       if (!eye.empty() || !look_at.empty() || !up.empty() || fov > 0.0f) {
         rad::Camera c = chosen.camera;
-        if (!eye.empty()) c.eye = parse_vec3(eye, "--eye");
-        if (!look_at.empty()) c.look_at = parse_vec3(look_at, "--look-at");
+        if (!eye.empty()) c.eye = parse_point(eye, "--eye", scene);
+        if (!look_at.empty()) c.look_at = parse_point(look_at, "--look-at", scene);
         if (!up.empty()) c.up = parse_vec3(up, "--up");
         if (fov > 0.0f) c.fov_deg = fov;
         scene.set_camera(c);  // validates
@@ -279,7 +279,7 @@ int main(int argc, char** argv) {
       }
     } else if (*solve) {
       rad::Scene scene = load(solve_args.scene, solve_args.strict, solve_args.photometric, {solve_args.two_sided, solve_args.reverse_winding});
-      print_warnings(scene.warnings());
+      print_load_notes(scene);
       rad::SolveOptions options = to_options(solve_args, bar);
       apply_specular_depth(options, solve_args);
 #if RADIOSITY_HAS_MPI

@@ -25,6 +25,7 @@
 #include <system_error>
 #include <vector>
 
+#include "io/readers/local_origin.hpp"
 #include "io/readers/material_mapping.hpp"
 #include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
@@ -377,7 +378,8 @@ struct ObjFace {
 
 /// What an OBJ file says, read in one pass.
 struct ObjFile {
-  std::vector<glm::vec3> corners;      ///< every face's corner positions, face after face
+  std::vector<glm::dvec3> positions;   ///< the `v` lines, in double precision (LoadOptions::local_origin)
+  std::vector<std::size_t> corners;    ///< every face's corners (into positions), face after face
   std::vector<ObjFace> faces;          ///< in file order; those of fewer than 3 corners left out
   std::vector<std::string> groups;     ///< [0] "" (before any g or o), then one per g or o
   std::vector<UseMaterial> materials;  ///< [0] before any usemtl, then one per usemtl
@@ -466,7 +468,7 @@ ObjFile read_obj(const fs::path& file, std::string_view text, ReaderWarnings& wa
   ObjFile obj;
   obj.groups.emplace_back();
   obj.materials.emplace_back();
-  std::vector<glm::vec3> positions;
+  std::vector<glm::dvec3>& positions = obj.positions;
   std::set<fs::path> seen_mtl;
   bool after_mtllib = false;
   Lines lines(text);
@@ -480,17 +482,19 @@ ObjFile read_obj(const fs::path& file, std::string_view text, ReaderWarnings& wa
       if (xyz[2].empty())
         fail(ErrorCode::parse_error, file, line_no,
              "vertex has " + std::to_string(xyz[0].empty() ? 0 : xyz[1].empty() ? 1 : 2) + " coordinates; x y z needed");
-      glm::vec3 p;
+      glm::dvec3 p;
       for (int i = 0; i < 3; ++i) {
-        const std::optional<float> c = parse_finite_float(xyz[i]);
-        if (!c) fail(ErrorCode::parse_error, file, line_no, "vertex coordinate " + in_quotes(xyz[i]) + " is not a finite number");
+        // Within float's range (what a Polygon can hold once a local origin is subtracted).
+        const std::optional<double> c = parse_real(xyz[i]);
+        if (!c || !std::isfinite(*c) || std::fabs(*c) > static_cast<double>(FLT_MAX))
+          fail(ErrorCode::parse_error, file, line_no, "vertex coordinate " + in_quotes(xyz[i]) + " is not a finite number");
         p[i] = *c;
       }
       positions.push_back(p);
     } else if (key == "f") {
       const std::size_t first = obj.corners.size();
       for (std::string_view corner = words.next(); !corner.empty(); corner = words.next())
-        obj.corners.push_back(positions[corner_vertex(file, line_no, corner, positions.size())]);
+        obj.corners.push_back(corner_vertex(file, line_no, corner, positions.size()));
       const std::size_t count = obj.corners.size() - first;
       if (count < 3) {
         obj.corners.resize(first);
@@ -655,13 +659,28 @@ Scene load_obj(const fs::path& path, const LoadOptions& options) {
     return *default_material;
   };
 
+  // A model far from the origin for its size is stored relative to a point near it.
+  glm::dvec3 origin(0.0);
+  if (options.local_origin) {
+    LocalOriginFinder finder;
+    std::vector<glm::dvec3> corners;
+    for (const ObjFace& face : obj.faces) {
+      corners.clear();
+      for (std::size_t c = 0; c < face.count; ++c) corners.push_back(obj.positions[obj.corners[face.first + c]]);
+      finder.add_polygon(corners.data(), corners.size());
+    }
+    origin = finder.origin();
+    scene.set_origin(origin);
+  }
+
   // Faces, in file order.
   FaceAdder adder(scene, path, warnings);
   std::vector<glm::vec3> vertices;
   for (const ObjFace& face : obj.faces) {
     RADIOSITY_ASSERT(face.count >= 3 && face.first + face.count <= obj.corners.size());
-    const auto first = obj.corners.begin() + static_cast<std::ptrdiff_t>(face.first);
-    vertices.assign(first, first + static_cast<std::ptrdiff_t>(face.count));
+    vertices.clear();
+    for (std::size_t c = 0; c < face.count; ++c)
+      vertices.push_back(glm::vec3(obj.positions[obj.corners[face.first + c]] - origin));
     adder.add(vertices, material_of(face.material), obj.groups[face.group], face.line);
   }
   if (scene.polygons().empty())

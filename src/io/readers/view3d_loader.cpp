@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "core/assert.hpp"
+#include "io/readers/local_origin.hpp"
 #include "io/readers/reader_files.hpp"
 #include "io/readers/reader_warnings.hpp"
 #include "io/readers/readers.hpp"
@@ -128,7 +129,8 @@ struct Surface {
 
 class Reader {
  public:
-  Reader(const fs::path& file, const LoadOptions& options) : file_(file), warnings_(options.strict) {}
+  Reader(const fs::path& file, const LoadOptions& options)
+      : file_(file), warnings_(options.strict), local_origin_(options.local_origin) {}
 
   View3DFile read(std::string_view text) {
     View3DFile out;
@@ -322,15 +324,23 @@ class Reader {
              "vertex " + std::string(w[1]) + " is out of sequence (expected " + std::to_string(expected) +
                  ": View3D numbers vertices 1, 2, 3, ... in file order)");
       glm::vec3 p;
+      glm::dvec3 exact;
       for (int k = 0; k < 3; ++k) {
-        const std::optional<float> c = parse_float(w[2 + static_cast<std::size_t>(k)]);
+        const std::string_view word = w[2 + static_cast<std::size_t>(k)];
+        const std::optional<float> c = parse_float(word);
         if (!c)
           fail(ErrorCode::parse_error, line->number,
-               "vertex " + std::to_string(expected) + ": coordinate " + in_quotes(w[2 + static_cast<std::size_t>(k)]) +
-                   " is not a finite number");
+               "vertex " + std::to_string(expected) + ": coordinate " + in_quotes(word) + " is not a finite number");
         p[k] = *c;
+        // Also in double, for a local origin (LoadOptions::local_origin); the float read
+        // directly stays what a file near the origin gives (the round trip of save_view3d()).
+        exact[k] = *c;
+        const std::string_view digits = word.front() == '+' ? word.substr(1) : word;
+        const auto parsed = std::from_chars(digits.data(), digits.data() + digits.size(), exact[k]);
+        static_cast<void>(parsed);  // the float parse above checked the digits
       }
       positions_.push_back(p);
+      exact_.push_back(exact);
     }
   }
 
@@ -445,6 +455,21 @@ class Reader {
     if (radiating_ == 0)
       throw Error(ErrorCode::parse_error,
                   "load_scene: '" + file_.string() + "' has no radiating surfaces (S lines), only obstructions");
+    // A model far from the origin for its size is stored relative to a point near it.
+    glm::dvec3 origin(0.0);
+    if (local_origin_) {
+      detail::LocalOriginFinder finder;
+      std::vector<glm::dvec3> exact;
+      for (const Surface& s : surfaces_) {
+        exact.clear();
+        for (int k = 0; k < 4; ++k)
+          if (s.corner[k] > 0) exact.push_back(exact_[static_cast<std::size_t>(s.corner[k] - 1)]);
+        finder.add_polygon(exact.data(), exact.size());
+      }
+      origin = finder.origin();
+      scene.set_origin(origin);
+    }
+    const bool moved = origin != glm::dvec3(0.0);
     std::map<float, MaterialId> materials;
     std::vector<glm::vec3> corners;
     for (std::size_t i = 0; i < surfaces_.size(); ++i) {
@@ -452,8 +477,11 @@ class Reader {
       const std::string what =
           "surface " + std::to_string(i + 1) + " (" + in_quotes(s.name) + ")";
       corners.clear();
-      for (int k = 0; k < 4; ++k)
-        if (s.corner[k] > 0) corners.push_back(positions_[static_cast<std::size_t>(s.corner[k] - 1)]);
+      for (int k = 0; k < 4; ++k) {
+        if (s.corner[k] <= 0) continue;
+        const auto v = static_cast<std::size_t>(s.corner[k] - 1);
+        corners.push_back(moved ? glm::vec3(exact_[v] - origin) : positions_[v]);
+      }
       const detail::CleanPolygon clean = detail::clean_polygon(corners);
       if (clean.vertices.size() < 3 || clean.area <= detail::kDegenerateAreaRatio * clean.diameter * clean.diameter)
         fail(ErrorCode::invalid_scene, s.line,
@@ -488,7 +516,9 @@ class Reader {
 
   const fs::path& file_;
   ReaderWarnings warnings_;
+  bool local_origin_ = true;
   std::vector<glm::vec3> positions_;
+  std::vector<glm::dvec3> exact_;  ///< positions_ in double
   std::vector<Surface> surfaces_;
   std::size_t radiating_ = 0;
   std::size_t row_line_ = 0;  ///< the control line that set row or col last

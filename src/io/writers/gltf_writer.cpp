@@ -502,6 +502,10 @@ void write_new(const Scene& scene, Writer& writer, tinygltf::Model& model) {
     tinygltf::Node node;
     node.name = scene.groups()[mesh.group];
     node.mesh = static_cast<int>(model.meshes.size() - 1);
+    // A scene read with a local origin (Scene::origin()) goes back where the file had it: the
+    // vertices stay small floats and the node moves them (glTF's translation is a double).
+    const glm::dvec3 origin = scene.origin();
+    if (origin != glm::dvec3(0.0)) node.translation = {origin.x, origin.y, origin.z};
     model.nodes.push_back(std::move(node));
     root.nodes.push_back(static_cast<int>(model.nodes.size() - 1));
   }

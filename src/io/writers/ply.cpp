@@ -2,6 +2,7 @@
 // mesh in MeshLab or Blender: per-vertex position, float radiosity and 8-bit sRGB display colour;
 // faces are triangles (quads split in two), since many importers handle nothing else well.
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -28,6 +29,44 @@ void put_f32(std::string& out, float v) {
   std::memcpy(&u, &v, sizeof u);
   put_u32(out, u);
 }
+
+void put_f64(std::string& out, double v) {
+  std::uint64_t u = 0;
+  std::memcpy(&u, &v, sizeof u);
+  for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((u >> (8 * i)) & 0xffu));
+}
+
+/// Vertex positions in the scene file's coordinates (Scene::origin()): floats as the scene
+/// holds them, or, for a scene read with a local origin, doubles with the origin added (a float
+/// could not hold the sum: that is why the origin was taken off).
+class PlyPositions {
+ public:
+  explicit PlyPositions(const glm::dvec3& origin) : origin_(origin), wide_(origin != glm::dvec3(0.0)) {}
+  /// A comment line for the header (before the elements, where every reader accepts one).
+  std::string comment() const {
+    if (!wide_) return {};
+    char text[200];
+    std::snprintf(text, sizeof text, "comment x/y/z: the scene's positions plus its origin (%.17g %.17g %.17g)\n",
+                  origin_.x, origin_.y, origin_.z);
+    return text;
+  }
+  std::string properties() const {
+    std::string out;
+    for (const char* p : {"x", "y", "z"}) out += std::string(wide_ ? "property double " : "property float ") + p + "\n";
+    return out;
+  }
+  void put(std::string& out, const glm::vec3& p) const {
+    for (int c = 0; c < 3; ++c)
+      if (wide_)
+        put_f64(out, static_cast<double>(p[c]) + origin_[c]);
+      else
+        put_f32(out, p[c]);
+  }
+
+ private:
+  glm::dvec3 origin_;
+  bool wide_;
+};
 
 /// Writes header + body to `path`; `who` names the writer in errors.
 void write_file(const std::filesystem::path& path, const std::string& header, const std::string& body, const char* who) {
@@ -98,9 +137,11 @@ void write_ply(const Solution& solution, const std::filesystem::path& path, cons
   header += "comment radiosity_r/g/b: radiosity B in W/m^2 per scene unit^2; red/green/blue: sRGB of B/pi x exposure\n";
   if (!backs.empty())
     header += "comment translucent elements have a back face over their own vertex copies (back radiosity)\n";
+  const PlyPositions xyz(solution.origin());
+  header += xyz.comment();
   header += "element vertex " + std::to_string(vertex_count) + "\n";
-  for (const char* p : {"x", "y", "z", "radiosity_r", "radiosity_g", "radiosity_b"})
-    header += std::string("property float ") + p + "\n";
+  header += xyz.properties();
+  for (const char* p : {"radiosity_r", "radiosity_g", "radiosity_b"}) header += std::string("property float ") + p + "\n";
   for (const char* p : {"red", "green", "blue"}) header += std::string("property uchar ") + p + "\n";
   header += "element face " + std::to_string(triangles) + "\n";
   header += "property list uchar int vertex_indices\n";
@@ -109,7 +150,7 @@ void write_ply(const Solution& solution, const std::filesystem::path& path, cons
   std::string body;
   body.reserve(vertex_count * 27 + triangles * 13);
   auto put_vertex = [&](std::uint32_t v, const Rgb& b) {
-    for (int c = 0; c < 3; ++c) put_f32(body, positions[v][c]);
+    xyz.put(body, positions[v]);
     for (int c = 0; c < 3; ++c) put_f32(body, b[c]);
     // Displayed radiance of a diffuse surface is B / pi.
     for (int c = 0; c < 3; ++c) body.push_back(static_cast<char>(detail::srgb8(options.exposure * b[c] / kPi)));
@@ -158,8 +199,11 @@ void write_mesh_ply(const Scene& scene, const Solution& solution, MeshId mesh, c
   header += std::string("comment written by radiosity ") + version() + "\n";
   header += "comment the host mesh's own vertices and kept triangles; s/t: its lightmap UV1\n";
   header += "comment irradiance_r/g/b: H, radiosity_r/g/b: B, W/m^2 per scene unit^2; red/green/blue: sRGB of B/pi x exposure\n";
+  const PlyPositions xyz(scene.origin());
+  header += xyz.comment();
   header += "element vertex " + std::to_string(m.positions.size()) + "\n";
-  std::vector<const char*> properties = {"x", "y", "z"};
+  header += xyz.properties();
+  std::vector<const char*> properties;
   if (uv) properties.insert(properties.end(), {"s", "t"});
   properties.insert(properties.end(), {"irradiance_r", "irradiance_g", "irradiance_b", "radiosity_r", "radiosity_g", "radiosity_b"});
   for (const char* p : properties) header += std::string("property float ") + p + "\n";
@@ -171,7 +215,7 @@ void write_mesh_ply(const Scene& scene, const Solution& solution, MeshId mesh, c
   std::string body;
   body.reserve(m.positions.size() * 47 + triangles * 13);
   for (std::size_t v = 0; v < m.positions.size(); ++v) {
-    for (int c = 0; c < 3; ++c) put_f32(body, m.positions[v][c]);
+    xyz.put(body, m.positions[v]);
     if (uv) {
       put_f32(body, m.uv1[v].x);
       put_f32(body, m.uv1[v].y);

@@ -139,9 +139,16 @@ void save_view3d(const Scene& scene, const View3DControl& control, const std::st
           " vertices, " + std::to_string(radiating) + " radiating surfaces, " +
           std::to_string(surfaces.size() - radiating) + " obstruction surfaces\n";
   text += "!  #  x y z\n";
-  for (std::size_t v = 0; v < vertices.size(); ++v)
-    text += "V " + std::to_string(v + 1) + " " + v3d::shortest(vertices[v].x) + " " + v3d::shortest(vertices[v].y) +
-            " " + v3d::shortest(vertices[v].z) + "\n";
+  // In the file's coordinates: a scene read with a local origin is written where it was. The
+  // sum is exact in double (a float plus a round origin), so it reads back to the same floats.
+  const glm::dvec3 origin = scene.origin();
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    text += "V " + std::to_string(v + 1);
+    for (int k = 0; k < 3; ++k)
+      text += " " + (origin[k] == 0.0 ? v3d::shortest(vertices[v][k])
+                                      : v3d::shortest(static_cast<double>(vertices[v][k]) + origin[k]));
+    text += "\n";
+  }
   text += "!  #  v1 v2 v3 v4 base cmb emit name\n";
   for (std::size_t s = 0; s < surfaces.size(); ++s) {
     const Polygon& p = polygons[surfaces[s].polygon];
