@@ -936,7 +936,7 @@ PYBIND11_MODULE(radiosity, m) {
       "load_scene(path, strict=False, photometric=False, local_origin=True) -> Scene\n\n"
       "Loads .obj (+ .mtl), .json, .gltf/.glb, .vs3 (View3D) or any format Assimp reads. strict: what a "
       "renderer would step over (degenerate faces, Kd >= 1, a missing MTL) is an error instead of a warning "
-      "(Scene.warnings). photometric: light intensities in candela and lux. local_origin: an OBJ or .vs3 "
+      "(Scene.warnings). photometric: light intensities in candela and lux. local_origin: an OBJ, glTF or .vs3 "
       "model far from the origin for its size (georeferenced coordinates) is held relative to a point near "
       "it (Scene.origin); False keeps the file's coordinates. Raises radiosity.Error naming "
       "the file and line. Thread safety: releases the GIL; concurrent calls are safe.");

@@ -157,9 +157,11 @@ struct LoadOptions {
   /// in which Polygon stores positions, would move its corners by 0.1 % of a typical polygon
   /// or more (georeferenced coordinates: a city in UTM, a building at its national-grid
   /// position) is read relative to a round point near its centre, and that point kept as
-  /// Scene::origin(). Done by the readers that parse coordinates in double precision: OBJ and
-  /// View3D `.vs3`. false keeps the file's coordinates as they are; load_scene() then warns
-  /// (for every format) when single precision cannot hold them.
+  /// Scene::origin(). Done by the readers that have the coordinates in double precision: OBJ,
+  /// View3D `.vs3`, and glTF (its node matrices: a georeferenced root translation). Assimp's
+  /// formats (STL, PLY, FBX, ...) are read in single precision and cannot be moved. false keeps
+  /// the file's coordinates as they are; load_scene() then warns (for every format) when single
+  /// precision cannot hold them.
   bool local_origin = true;
 };
 

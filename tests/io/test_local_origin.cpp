@@ -146,6 +146,51 @@ TEST_SUITE("io") {
     fs::remove_all(dir);
   }
 
+  TEST_CASE("a glTF placed at UTM coordinates by a root node is read relative to a local origin - meshes and "
+            "camera alike - and solves as at home") {
+    // The room of tests/data/gltf (embedded buffer) under a new root node that places it at its
+    // site, as georeferenced exports do (the vertices stay small, the node carries the offset).
+    std::ifstream in(kData / "gltf" / "room.gltf");
+    nlohmann::json j = nlohmann::json::parse(in);
+    const glm::dvec3 site(512340.3, 30.1, 5701230.7);
+    nlohmann::json root = {{"name", "site"}, {"translation", {site.x, site.y, site.z}}, {"children", j["scenes"][0]["nodes"]}};
+    j["nodes"].push_back(root);
+    j["scenes"][0]["nodes"] = {j["nodes"].size() - 1};
+    const fs::path path = fs::path(RADIOSITY_TEST_TMP) / "room_utm.gltf";
+    std::ofstream(path) << j.dump();
+
+    const rad::Scene utm = rad::load_scene(path);
+    const rad::Scene home = rad::load_scene(kData / "gltf" / "room.gltf");
+    const glm::dvec3 origin = utm.origin();
+    MESSAGE("origin " << origin.x << " " << origin.y << " " << origin.z);
+    CHECK(origin != glm::dvec3(0.0));
+    for (int c = 0; c < 3; ++c) CHECK(std::fabs(origin[c] - site[c]) < 10.0);  // near the room
+    for (const std::string& w : utm.warnings()) CHECK(!contains(w, "coordinates reach"));
+    // Every corner is the room's at home moved by site - origin, to float rounding of values
+    // of a few metres (the double world matrix keeps the site's digits).
+    const glm::vec3 moved(site - origin);
+    REQUIRE(utm.polygons().size() == home.polygons().size());
+    float worst = 0.0f;
+    for (std::size_t i = 0; i < home.polygons().size(); ++i)
+      for (std::size_t k = 0; k < home.polygons()[i].vertices.size(); ++k) {
+        const glm::vec3 d = utm.polygons()[i].vertices[k] - moved - home.polygons()[i].vertices[k];
+        worst = std::max({worst, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+      }
+    CHECK(worst < 4e-6f);
+    REQUIRE(utm.has_camera());
+    const glm::vec3 eye_shift = utm.camera().eye - moved - home.camera().eye;
+    CHECK(glm::length(eye_shift) < 4e-6f);
+
+    const rad::Solution a = rad::solve(utm);
+    const rad::Solution b = rad::solve(home);
+    for (const std::string& g : home.groups()) {
+      CAPTURE(g);
+      const rad::Rgb ba = a.group_radiosity(g), bb = b.group_radiosity(g);
+      for (int c = 0; c < 3; ++c) CHECK(ba[c] == doctest::Approx(bb[c]).epsilon(0.005));
+    }
+    fs::remove(path);
+  }
+
   TEST_CASE("a View3D file in UTM coordinates - local origin - exact view factors as at home - save_view3d writes "
             "the file's coordinates back") {
     const rad::View3DFile utm = rad::load_view3d(kData / "view3d" / "cube_utm.vs3");

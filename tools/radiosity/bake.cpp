@@ -243,6 +243,9 @@ int run_bake(const BakeArgs& a) {
     manifest["units"] = {{"length", "scene unit"},
                          {"lightmap", a.quantity + ", W/m^2 (watts per scene unit^2), linear float RGB"},
                          {"vertex", "irradiance_r/g/b and radiosity_r/g/b, W/m^2"}};
+    // Scene::origin(): the PLYs' positions include it; a host that keeps the model at its
+    // site's coordinates places the meshes by it.
+    manifest["origin"] = {scene.origin().x, scene.origin().y, scene.origin().z};
     manifest["lightmap"] = {{"quantity", a.quantity},
                             {"final_gather", a.final_gather},
                             {"resolution", a.lightmap},

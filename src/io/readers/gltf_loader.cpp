@@ -37,6 +37,7 @@
 #include "io/readers/placed_light.hpp"
 #include "io/readers/placed_mesh.hpp"
 #include "io/readers/reader_files.hpp"
+#include "io/readers/local_origin.hpp"
 #include "io/readers/reader_warnings.hpp"
 #include "io/readers/readers.hpp"
 #include "io/readers/texture_mean.hpp"
@@ -55,10 +56,37 @@ class GltfReader {
       : src_(src), model_(model), accessors_(src, model), ctx_(ctx), options_(options), warnings_(options.strict) {}
 
   Scene read() {
+    const std::vector<std::pair<int, glm::dmat4>> placed = place_nodes();
+    // A model far from the origin for its size (a georeferenced root translation) is placed
+    // relative to a point near it: the world matrices are double, the positions float.
+    glm::dmat4 shift(1.0);
+    if (options_.local_origin) {
+      const glm::dvec3 origin = local_origin(placed);
+      scene_.set_origin(origin);
+      shift[3] = glm::dvec4(-origin, 1.0);
+    }
+    for (const auto& [n, placement] : placed) {
+      const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(n)];
+      const glm::dmat4 world = shift * placement;
+      if (node.mesh >= 0) add_node_mesh(n, node, world);
+      if (node.camera >= 0) add_camera(n, node, world);
+      add_node_light(n, node, world);
+    }
+    if (scene_.polygons().empty())
+      src_.fail(ErrorCode::parse_error, "",
+                skipped_triangles_ ? "has no triangles that are not degenerate"
+                                   : "has no triangles in its scene (no node of it places a mesh of triangles)");
+    warnings_.move_to(scene_);
+    return std::move(scene_);
+  }
+
+ private:
+  /// The nodes of the default scene with their world matrices (section 3.5.3), depth first,
+  /// children in order; checked to form a tree with finite transforms.
+  std::vector<std::pair<int, glm::dmat4>> place_nodes() const {
     const std::vector<int> roots = scene_roots();
-    // Depth first, children in order, each with its parent's world matrix (section 3.5.3).
     std::vector<bool> visited(model_.nodes.size(), false);
-    std::vector<std::pair<int, glm::dmat4>> stack;
+    std::vector<std::pair<int, glm::dmat4>> stack, placed;
     for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
     while (!stack.empty()) {
       const auto [n, parent] = stack.back();
@@ -74,20 +102,49 @@ class GltfReader {
         for (int r = 0; r < 4; ++r)
           if (!std::isfinite(world[c][r]))
             src_.fail(ErrorCode::invalid_scene, place, "its world transform (the product of its ancestors') is not finite");
-      if (node.mesh >= 0) add_node_mesh(n, node, world);
-      if (node.camera >= 0) add_camera(n, node, world);
-      add_node_light(n, node, world);
+      placed.emplace_back(n, world);
       for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) stack.emplace_back(*it, world);
     }
-    if (scene_.polygons().empty())
-      src_.fail(ErrorCode::parse_error, "",
-                skipped_triangles_ ? "has no triangles that are not degenerate"
-                                   : "has no triangles in its scene (no node of it places a mesh of triangles)");
-    warnings_.move_to(scene_);
-    return std::move(scene_);
+    return placed;
   }
 
- private:
+  /// Scene::origin() for the placed meshes' triangles in world space (LocalOriginFinder). A
+  /// first look at the primitives: what it cannot read, the pass that adds them reports.
+  glm::dvec3 local_origin(const std::vector<std::pair<int, glm::dmat4>>& placed) {
+    LocalOriginFinder finder;
+    for (const auto& [n, world] : placed) {
+      const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(n)];
+      if (node.mesh < 0) continue;
+      const auto m = static_cast<std::size_t>(node.mesh);
+      for (std::size_t p = 0; p < model_.meshes[m].primitives.size(); ++p) {
+        const tinygltf::Primitive& primitive = model_.meshes[m].primitives[p];
+        const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
+        const auto position = primitive.attributes.find("POSITION");
+        if (mode < TINYGLTF_MODE_TRIANGLES || mode > TINYGLTF_MODE_TRIANGLE_FAN || position == primitive.attributes.end())
+          continue;
+        const std::string place = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
+        const std::vector<float> f = read_floats(position->second, place, "POSITION", TINYGLTF_TYPE_VEC3);
+        std::vector<std::uint32_t> corners;
+        if (primitive.indices >= 0) {
+          corners = read_indices(primitive.indices, place, f.size() / 3);
+        } else {
+          corners.resize(f.size() / 3);
+          std::iota(corners.begin(), corners.end(), 0u);
+        }
+        const std::vector<std::uint32_t> t = triangles(mode, corners, place, false);
+        for (std::size_t k = 0; k + 2 < t.size(); k += 3) {
+          glm::dvec3 triangle[3];
+          for (int c = 0; c < 3; ++c) {
+            const std::size_t v = 3 * static_cast<std::size_t>(t[k + static_cast<std::size_t>(c)]);
+            triangle[c] = glm::dvec3(world * glm::dvec4(f[v], f[v + 1], f[v + 2], 1.0));
+          }
+          finder.add_polygon(triangle, 3);
+        }
+      }
+    }
+    return finder.origin();
+  }
+
   /// The default scene's root nodes (section 3.5.1): `scene`, else the first scene; without
   /// scenes, every node that is no other node's child.
   std::vector<int> scene_roots() const {
@@ -207,11 +264,13 @@ class GltfReader {
   }
 
   /// The triangles of a primitive's corners (section 3.7.2.1): a list, a strip or a fan.
-  std::vector<std::uint32_t> triangles(int mode, const std::vector<std::uint32_t>& v, const std::string& place) {
+  /// `say`: warn about an incomplete triangle (once per primitive: not in the first look).
+  std::vector<std::uint32_t> triangles(int mode, const std::vector<std::uint32_t>& v, const std::string& place,
+                                       bool say = true) {
     std::vector<std::uint32_t> t;
     if (mode == TINYGLTF_MODE_TRIANGLES) {
       t.assign(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 3 * 3));
-      if (v.size() % 3 != 0)
+      if (v.size() % 3 != 0 && say)
         warnings_.forgive("incomplete triangle", ErrorCode::parse_error, src_.where(place),
                           std::to_string(v.size()) + " indices are not a whole number of triangles",
                           "the last " + std::to_string(v.size() % 3) + " ignored");
