@@ -109,7 +109,7 @@ Doubles rgb_rows(const std::vector<rad::Rgb>& values) {
   return out;
 }
 
-Doubles vec3(const glm::vec3& v) {
+Doubles vec3(const glm::dvec3& v) {
   Doubles out(3);
   double* p = out.mutable_data();
   p[0] = v.x;
@@ -786,15 +786,7 @@ PYBIND11_MODULE(radiosity, m) {
            },
            "(lower, upper) corners of the bounding box.")
       .def_property_readonly("origin",
-                             [](const rad::Scene& s) {
-                               const glm::dvec3 o = s.origin();
-                               Doubles out(3);
-                               double* p = out.mutable_data();
-                               p[0] = o.x;
-                               p[1] = o.y;
-                               p[2] = o.z;
-                               return out;
-                             },
+                             [](const rad::Scene& s) { return vec3(s.origin()); },
                              "(3,): the point of the file's coordinates that the scene's (0, 0, 0) stands for; "
                              "positions are relative to it. (0, 0, 0) unless the reader moved a model that lay far "
                              "from the origin for its size (georeferenced coordinates).")

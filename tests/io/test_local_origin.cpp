@@ -140,6 +140,22 @@ TEST_SUITE("io") {
       CHECK(node["translation"][2].get<double>() == 5700000.0);
     }
 
+    // A JSON scene that includes the file keeps it in the JSON's coordinates (which have no local
+    // origin): the box where the OBJ says, not moved by an origin of its own.
+    {
+      std::ofstream json(dir / "site.json");
+      json << R"({"version": 1, "surfaces": [{"type": "obj", "file": "moved.obj"}]})";
+    }
+    rad::LoadOptions quiet;
+    const rad::Scene site = rad::load_scene(dir / "site.json", quiet);
+    CHECK(site.origin() == glm::dvec3(0.0));
+    // (More polygons than at home: faces bent by single precision are triangulated, as warned.)
+    REQUIRE(site.polygons().size() >= home.polygons().size());
+    CHECK(std::fabs(site.polygons()[0].vertices[0].z - (home.polygons()[0].vertices[0].z + 5700000.0f)) <= 0.5f);
+    bool warned = false;
+    for (const std::string& w : site.warnings()) warned = warned || contains(w, "coordinates reach");
+    CHECK(warned);
+
     // A model near the origin, or a small offset for its size, keeps its coordinates.
     const rad::Scene near = rad::load_scene(moved_mcguire_box(dir, glm::dvec3(100.0, 0.0, -50.0)));
     CHECK(near.origin() == glm::dvec3(0.0));

@@ -562,7 +562,11 @@ void SceneReader::include_obj(const json& j, const std::string& loc, Scene& scen
   const fs::path file = file_path(require(j, loc, "file"), key_path(loc, "file"));
   Scene obj;
   try {
-    obj = load_obj(file, options_);
+    // In the JSON scene's coordinates, which have no local origin (Scene::origin()): an OBJ
+    // moved to one of its own would be placed wrongly.
+    LoadOptions as_written = options_;
+    as_written.local_origin = false;
+    obj = load_obj(file, as_written);
   } catch (const Error& e) {
     fail(e.code(), key_path(loc, "file"), e.what());
   }
