@@ -17,6 +17,8 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "support/loading.hpp"
+
 namespace rad = radiosity;
 namespace fs = std::filesystem;
 
@@ -26,27 +28,19 @@ const fs::path kData = fs::path(RADIOSITY_TEST_DATA);
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-/// McGuire's Cornell box (tests/data/mcguire) with every vertex moved by `offset`, written with
-/// 6 decimals as a GIS or BIM export writes it; returns the OBJ's path (its MTL beside it).
+/// McGuire's Cornell box (tests/data/mcguire) with every vertex moved by `offset`.
 fs::path moved_mcguire_box(const fs::path& dir, const glm::dvec3& offset) {
-  fs::create_directories(dir);
-  fs::copy_file(kData / "mcguire" / "CornellBox-Original.mtl", dir / "CornellBox-Original.mtl",
-                fs::copy_options::overwrite_existing);
-  std::ifstream in(kData / "mcguire" / "CornellBox-Original.obj");
-  std::ofstream out(dir / "moved.obj");
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream words(line);
-    std::string tag;
-    double x = 0, y = 0, z = 0;
-    if ((words >> tag) && tag == "v" && (words >> x >> y >> z)) {
-      char moved[128];
-      std::snprintf(moved, sizeof moved, "v %.6f %.6f %.6f", x + offset.x, y + offset.y, z + offset.z);
-      line = moved;
-    }
-    out << line << "\n";
+  return test::moved_obj(kData / "mcguire" / "CornellBox-Original.obj", dir, "moved.obj", offset);
+}
+
+/// Every group's radiosity of `a` within 0.5 % of `b`'s: the same mesh and seed, only rounding
+/// differs.
+void check_same_groups(const rad::Solution& a, const rad::Solution& b) {
+  for (const std::string& g : b.groups()) {
+    CAPTURE(g);
+    const rad::Rgb ba = a.group_radiosity(g), bb = b.group_radiosity(g);
+    for (int c = 0; c < 3; ++c) CHECK(ba[c] == doctest::Approx(bb[c]).epsilon(0.005));
   }
-  return dir / "moved.obj";
 }
 
 /// The first vertex's x, y, z of a binary little-endian PLY whose vertices start with three
@@ -99,11 +93,7 @@ TEST_SUITE("io") {
     // (test_messy_files.cpp).
     const rad::Solution a = rad::solve(utm);
     const rad::Solution b = rad::solve(home);
-    for (const std::string& g : home.groups()) {
-      CAPTURE(g);
-      const rad::Rgb ba = a.group_radiosity(g), bb = b.group_radiosity(g);
-      for (int c = 0; c < 3; ++c) CHECK(ba[c] == doctest::Approx(bb[c]).epsilon(0.005));
-    }
+    check_same_groups(a, b);
     CHECK(a.origin() == utm.origin());
 
     // write_ply(): positions as doubles with the origin added, in the file's coordinates.
@@ -199,11 +189,7 @@ TEST_SUITE("io") {
 
     const rad::Solution a = rad::solve(utm);
     const rad::Solution b = rad::solve(home);
-    for (const std::string& g : home.groups()) {
-      CAPTURE(g);
-      const rad::Rgb ba = a.group_radiosity(g), bb = b.group_radiosity(g);
-      for (int c = 0; c < 3; ++c) CHECK(ba[c] == doctest::Approx(bb[c]).epsilon(0.005));
-    }
+    check_same_groups(a, b);
     fs::remove(path);
   }
 

@@ -14,6 +14,8 @@
 
 #include <radiosity/radiosity.hpp>
 
+#include "support/loading.hpp"
+
 namespace rad = radiosity;
 namespace fs = std::filesystem;
 
@@ -150,25 +152,7 @@ TEST_SUITE("io") {
     // (0.38 deep) collapses and is dropped.
     const fs::path original = fs::path(RADIOSITY_TEST_DATA) / "mcguire" / "CornellBox-Original.obj";
     const fs::path dir = fs::temp_directory_path() / "radiosity_test_utm";
-    fs::create_directories(dir);
-    fs::copy_file(fs::path(RADIOSITY_TEST_DATA) / "mcguire" / "CornellBox-Original.mtl",
-                  dir / "CornellBox-Original.mtl", fs::copy_options::overwrite_existing);
-    {
-      std::ifstream in(original);
-      std::ofstream out(dir / "utm.obj");
-      std::string line;
-      while (std::getline(in, line)) {
-        std::istringstream words(line);
-        std::string tag;
-        double x = 0, y = 0, z = 0;
-        if ((words >> tag) && tag == "v" && (words >> x >> y >> z)) {
-          char moved[128];
-          std::snprintf(moved, sizeof moved, "v %.6f %.6f %.6f", x + 500000.0, y + 30.0, z + 5700000.0);
-          line = moved;
-        }
-        out << line << "\n";
-      }
-    }
+    test::moved_obj(original, dir, "utm.obj", glm::dvec3(500000.0, 30.0, 5700000.0));
     rad::LoadOptions as_written;
     as_written.local_origin = false;
     const rad::Scene utm = rad::load_scene(dir / "utm.obj", as_written);

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <doctest/doctest.h>
@@ -12,6 +15,33 @@
 #include "radiosity/io.hpp"
 
 namespace test {
+
+/// A copy of the OBJ `source` in `dir` named `name`, every `v` moved by `offset` and written
+/// with 6 decimals (as a GIS or BIM export writes a model at its site's coordinates), with the
+/// MTL of the same stem beside it; returns its path.
+inline std::filesystem::path moved_obj(const std::filesystem::path& source, const std::filesystem::path& dir,
+                                       const std::string& name, const glm::dvec3& offset) {
+  namespace fs = std::filesystem;
+  fs::create_directories(dir);
+  fs::path mtl = source;
+  mtl.replace_extension(".mtl");
+  if (fs::exists(mtl)) fs::copy_file(mtl, dir / mtl.filename(), fs::copy_options::overwrite_existing);
+  std::ifstream in(source);
+  std::ofstream out(dir / name);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string tag;
+    double x = 0, y = 0, z = 0;
+    if ((words >> tag) && tag == "v" && (words >> x >> y >> z)) {
+      char moved[128];
+      std::snprintf(moved, sizeof moved, "v %.6f %.6f %.6f", x + offset.x, y + offset.y, z + offset.z);
+      line = moved;
+    }
+    out << line << "\n";
+  }
+  return dir / name;
+}
 
 inline bool near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
   return std::fabs(a.x - b.x) <= eps && std::fabs(a.y - b.y) <= eps && std::fabs(a.z - b.z) <= eps;
