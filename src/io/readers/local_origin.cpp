@@ -1,6 +1,7 @@
 #include "io/readers/local_origin.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 #include <glm/common.hpp>
@@ -51,7 +52,12 @@ glm::dvec3 LocalOriginFinder::origin() {
   const double extent = std::max({extent3.x, extent3.y, extent3.z});
   const double step = extent > 0.0 ? std::pow(10.0, std::floor(std::log10(extent))) : 1.0;
   const glm::dvec3 centre = 0.5 * (lower_ + upper_);
-  return glm::round(centre / step) * step;
+  const glm::dvec3 origin = glm::round(centre / step) * step;
+  // Positions relative to it must be floats again (coordinates near +-FLT_MAX, which the
+  // readers accept, could round it away from the centre by more than float's range allows).
+  const glm::dvec3 far = glm::max(glm::abs(upper_ - origin), glm::abs(lower_ - origin));
+  if (!(std::max({far.x, far.y, far.z}) <= 0.5 * static_cast<double>(FLT_MAX))) return glm::dvec3(0.0);
+  return origin;
 }
 
 }  // namespace radiosity::detail
