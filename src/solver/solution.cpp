@@ -317,6 +317,7 @@ Solution Solution::relight(const std::vector<Rgb>& weights) const {
   Solution out(PatchHierarchy(hierarchy_), std::move(B), groups_, status_, report_, Rgb(0.0f), {}, std::move(back),
                std::move(H), std::move(direct));
   out.meshes_ = meshes_;
+  out.origin_ = origin_;
   out.exposure_ = exposure_;
   out.light_groups_ = light_groups_;
   out.light_group_weights_ = weights;

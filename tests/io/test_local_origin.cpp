@@ -95,6 +95,11 @@ TEST_SUITE("io") {
     const rad::Solution b = rad::solve(home);
     check_same_groups(a, b);
     CHECK(a.origin() == utm.origin());
+    rad::SolveOptions grouped;
+    grouped.separate_light_groups = true;
+    const rad::Solution lit = rad::solve(utm, grouped);
+    REQUIRE(!lit.light_groups().empty());
+    CHECK(lit.relight(std::vector<rad::Rgb>(lit.light_groups().size(), rad::Rgb(0.5f))).origin() == utm.origin());
 
     // write_ply(): positions as doubles with the origin added, in the file's coordinates.
     rad::write_ply(a, dir / "utm.ply");
