@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -105,14 +106,15 @@ CLI::Validator in_range(T lo, T hi) {
   return number_check<T>(lo, false, hi, "in [" + show_number(lo) + ", " + show_number(hi) + "]");
 }
 
-/// `s` as x,y,z, or nullopt.
-/// Read in double: a place in georeferenced coordinates (Scene::origin()) needs the digits.
+/// `s` as x,y,z within float's range, or nullopt. Read in double: a place in georeferenced
+/// coordinates (Scene::origin()) needs the digits.
 inline std::optional<glm::dvec3> try_parse_vec3(const std::string& s) {
   glm::dvec3 v;
   char c1 = 0, c2 = 0;
   std::istringstream in(s);
   if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !in.eof()) return std::nullopt;
-  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return std::nullopt;
+  for (int k = 0; k < 3; ++k)
+    if (!(std::fabs(v[k]) <= static_cast<double>(FLT_MAX))) return std::nullopt;
   return v;
 }
 
@@ -628,7 +630,11 @@ inline glm::vec3 parse_vec3(const std::string& s, const char* name) {
 inline glm::vec3 parse_point(const std::string& s, const char* name, const rad::Scene& scene) {
   const std::optional<glm::dvec3> v = try_parse_vec3(s);
   if (!v) throw CLI::ValidationError(name, "expected x,y,z (three numbers), got '" + s + "'");
-  return glm::vec3(*v - scene.origin());
+  const glm::dvec3 relative = *v - scene.origin();
+  for (int k = 0; k < 3; ++k)
+    if (!(std::fabs(relative[k]) <= static_cast<double>(FLT_MAX)))
+      throw CLI::ValidationError(name, "'" + s + "' is beyond single precision's range from the scene");
+  return glm::vec3(relative);
 }
 
 /// Runs a command body and turns exceptions into the CLI's exit codes: 1 for a

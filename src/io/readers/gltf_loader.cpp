@@ -33,11 +33,11 @@
 
 #include "core/constants.hpp"
 #include "io/readers/gltf_model.hpp"
+#include "io/readers/local_origin.hpp"
 #include "io/readers/material_mapping.hpp"
 #include "io/readers/placed_light.hpp"
 #include "io/readers/placed_mesh.hpp"
 #include "io/readers/reader_files.hpp"
-#include "io/readers/local_origin.hpp"
 #include "io/readers/reader_warnings.hpp"
 #include "io/readers/readers.hpp"
 #include "io/readers/texture_mean.hpp"
@@ -108,8 +108,9 @@ class GltfReader {
     return placed;
   }
 
-  /// Scene::origin() for the placed meshes' triangles in world space (LocalOriginFinder). A
-  /// first look at the primitives: what it cannot read, the pass that adds them reports.
+  /// Scene::origin() for the placed meshes' triangles in world space (LocalOriginFinder). It
+  /// reads the accessors the main pass reads, with the same checks, so a broken one fails here
+  /// with the message that pass would give; modes without triangles are left to that pass.
   glm::dvec3 local_origin(const std::vector<std::pair<int, glm::dmat4>>& placed) {
     LocalOriginFinder finder;
     for (const auto& [n, world] : placed) {

@@ -140,7 +140,8 @@ void save_view3d(const Scene& scene, const View3DControl& control, const std::st
           std::to_string(surfaces.size() - radiating) + " obstruction surfaces\n";
   text += "!  #  x y z\n";
   // In the file's coordinates: a scene read with a local origin is written where it was. The
-  // sum is exact in double (a float plus a round origin), so it reads back to the same floats.
+  // sum (a float plus a round origin) is exact in double or within its rounding, far below a
+  // float's spacing, so the file reads back to the same floats.
   const glm::dvec3 origin = scene.origin();
   for (std::size_t v = 0; v < vertices.size(); ++v) {
     text += "V " + std::to_string(v + 1);
