@@ -264,7 +264,8 @@ void print_text(const CheckResult& r, const rad::Scene& scene) {
   std::printf("polygons: %zu\nmaterials: %zu\nemitters: %zu\nlights: %zu\ngroups: %zu\narea: %.6g\n", r.polygons,
               r.materials, r.emitters, r.lights, r.groups, r.area);
   const glm::dvec3 origin = scene.origin();
-  if (!origin_note(scene).empty()) std::printf("origin: %s\n", origin_note(scene).c_str());
+  const std::string moved = origin_note(scene);
+  if (!moved.empty()) std::printf("origin: %s\n", moved.c_str());
   std::printf("warnings: %zu\n", r.warnings.size());
   for (const std::string& w : r.warnings) std::printf("  warning: %s\n", w.c_str());
   // Contact (a box on a floor, a prop sunk into it) is lit correctly; only z-fighting is a problem.

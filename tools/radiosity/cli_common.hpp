@@ -619,18 +619,19 @@ inline void print_estimator(const rad::Solution& sol, const rad::SolveOptions& o
               why.c_str());
 }
 
-inline glm::vec3 parse_vec3(const std::string& s, const char* name) {
+/// try_parse_vec3(), or a CLI::ValidationError naming option `name`.
+inline glm::dvec3 parse_dvec3(const std::string& s, const char* name) {
   const std::optional<glm::dvec3> v = try_parse_vec3(s);
   if (!v) throw CLI::ValidationError(name, "expected x,y,z (three numbers), got '" + s + "'");
-  return glm::vec3(*v);
+  return *v;
 }
+
+inline glm::vec3 parse_vec3(const std::string& s, const char* name) { return glm::vec3(parse_dvec3(s, name)); }
 
 /// A place given in the scene file's coordinates (--eye, --look-at), as the scene holds it:
 /// relative to its origin (Scene::origin(), (0, 0, 0) unless the reader moved a far model).
 inline glm::vec3 parse_point(const std::string& s, const char* name, const rad::Scene& scene) {
-  const std::optional<glm::dvec3> v = try_parse_vec3(s);
-  if (!v) throw CLI::ValidationError(name, "expected x,y,z (three numbers), got '" + s + "'");
-  const glm::dvec3 relative = *v - scene.origin();
+  const glm::dvec3 relative = parse_dvec3(s, name) - scene.origin();
   for (int k = 0; k < 3; ++k)
     if (!(std::fabs(relative[k]) <= static_cast<double>(FLT_MAX)))
       throw CLI::ValidationError(name, "'" + s + "' is beyond single precision's range from the scene");
