@@ -8,8 +8,10 @@ module was built for on Debian, see docs/PYTHON.md.)
 
 Loads SCENE (default: tests/data/view3d/cube.vs3, a closed 2 m cube), computes the polygon-to-
 polygon view-factor matrix with ray-cast factors, prints each row's sum and sky view factor
-(1 - row sum: what sees no surface), and writes the matrix to OUT.npz (default view_factors.npz)
-with scipy.sparse.save_npz; scipy.sparse.load_npz reads it back.
+(the part of the hemisphere in which no polygon lies, estimated by rays; not 1 - row sum, which
+also holds what sees back faces or is covered: docs/VIEW_FACTORS.md), and writes the matrix to
+OUT.npz (default view_factors.npz) with scipy.sparse.save_npz; scipy.sparse.load_npz reads it
+back.
 """
 import pathlib
 import sys

@@ -378,7 +378,9 @@ struct ViewFactorMatrix {
   /// view factor, 0 in a closed enclosure. It is not 1 - sum_j F_ij: the rest of that
   /// remainder sees back faces, obstruction-only polygons, polygons left out by `groups`, or
   /// nothing where a surface is covered (the ground under a building sees the building's
-  /// inside: remainder 1, sky 0).
+  /// inside: remainder 1, sky 0). A surface lying on another face to face with nothing on its
+  /// side (a building's bottom on the ground, with the void under a terrain) sees nothing
+  /// either: sky 0 there, though its rays, starting just past the ground, would meet nothing.
   std::vector<double> sky;
   /// Per row: the binomial standard error of `sky`, sqrt(sky (1 - sky) / rays).
   std::vector<double> sky_standard_error;

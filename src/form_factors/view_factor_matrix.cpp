@@ -30,6 +30,7 @@
 #include "core/rng.hpp"
 #include "core/sampling.hpp"
 #include "core/streams.hpp"
+#include "geometry/burial.hpp"
 #include "geometry/ray_scene.hpp"
 #include "form_factors/estimators.hpp"
 #include "form_factors/exact_view_factors.hpp"
@@ -82,6 +83,64 @@ std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vect
   return row_of;
 }
 
+/// Points pressed against the ground: a polygon lying on another face to face (find_overlaps():
+/// coincident, facing apart; a building's bottom on the ground it stands on) at a point with
+/// nothing at all on its side (no ray of the burial test meets a polygon: the void under a
+/// terrain, which the model leaves open). Its rays start just past the other polygon and meet
+/// nothing, so they would count as sky: a bottom on the ground would see the whole sky. Such a
+/// point sees nothing instead, as the ground under it does (its rays meet the building's inside).
+/// Where something does lie on its side, the point keeps its rays: two rooms modelled as separate
+/// boxes share a wall as two coincident polygons facing apart, and each side sees its own room
+/// (and the sky through that room's windows).
+class PressedPoints {
+ public:
+  PressedPoints(const Scene& scene, const detail::RayScene& occluders, float lift)
+      : scene_(scene), occluders_(occluders), lift_(lift), first_(scene.polygons().size() + 1, 0) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (const PolygonOverlap& o : find_overlaps(scene)) {
+      if (!o.lying_against()) continue;
+      pairs.emplace_back(o.first, o.second);
+      pairs.emplace_back(o.second, o.first);
+    }
+    std::sort(pairs.begin(), pairs.end());
+    for (const auto& pair : pairs) ++first_[pair.first + 1];
+    for (std::size_t p = 0; p + 1 < first_.size(); ++p) first_[p + 1] += first_[p];
+    partners_.reserve(pairs.size());
+    for (const auto& pair : pairs) partners_.push_back(pair.second);
+  }
+  /// Whether polygon `polygon` lies against any other.
+  bool lies_against(std::uint32_t polygon) const { return first_[polygon + 1] > first_[polygon]; }
+  /// Whether point `x` of polygon `polygon` (on its surface) is pressed against another.
+  bool pressed(std::uint32_t polygon, const glm::vec3& x) const {
+    const glm::vec3 n = scene_.polygons()[polygon].normal;
+    bool covered = false;
+    for (std::size_t k = first_[polygon]; k < first_[polygon + 1] && !covered; ++k)
+      covered = inside(scene_.polygons()[partners_[k]], x);
+    if (!covered) return false;
+    const glm::vec3 origin = x + lift_ * n;
+    for (const glm::vec3& d : detail::burial_directions(n))
+      if (occluders_.occluded(origin, d, 0.0f, std::numeric_limits<float>::infinity())) return false;
+    return true;
+  }
+
+ private:
+  /// Whether `x`, taken into convex polygon q's plane, lies within it (its edges included, to
+  /// the touching tolerance's share of an edge's length).
+  bool inside(const Polygon& q, const glm::vec3& x) const {
+    const std::size_t n = q.vertices.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::vec3 a = q.vertices[i], edge = q.vertices[(i + 1) % n] - a;
+      if (glm::dot(glm::cross(edge, x - a), q.normal) < -lift_ * glm::length(edge)) return false;
+    }
+    return true;
+  }
+  const Scene& scene_;
+  const detail::RayScene& occluders_;
+  float lift_;
+  std::vector<std::size_t> first_;       ///< per polygon: its partners are partners_[first_[p], first_[p + 1])
+  std::vector<std::uint32_t> partners_;  ///< the polygons each lies against
+};
+
 /// Per row, the sky view factor: the cosine-weighted fraction of the hemisphere above the row's
 /// elements (sources[first[r] .. first[r + 1]), area-weighted) in which no polygon lies, from
 /// `rays` stratified rays per element (points and directions each stratified, paired by a
@@ -98,6 +157,7 @@ bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
   const std::size_t element_begin = first[row_begin], element_end = first[row_end];
   const detail::RayScene occluders = detail::RayScene::from_polygons(scene);
   const float epsilon = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
+  const PressedPoints pressed(scene, occluders, epsilon);
   const std::uint32_t n = ff.hemisphere_rays;
   std::vector<double> escaped(element_end - element_begin, 0.0);  // per source of the rows
   // Elements [begin, end) of `sources`: their fractions of rays that meet nothing.
@@ -120,6 +180,10 @@ bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vec
       }
       occluders.occluded_incoherent(n, origin.data(), direction.data(), 0.0f, std::numeric_limits<float>::infinity(),
                                     blocked.data());
+      const std::uint32_t polygon = hierarchy.patches()[hierarchy.element(e).patch].polygon;
+      if (pressed.lies_against(polygon))
+        for (std::uint32_t i = 0; i < n; ++i)
+          if (!blocked[i] && pressed.pressed(polygon, origin[i] - epsilon * normal)) blocked[i] = 1;
       std::uint32_t open = 0;
       for (const std::uint8_t x : blocked) open += x ? 0 : 1;
       escaped[k - element_begin] = static_cast<double>(open) / static_cast<double>(n);

@@ -343,6 +343,72 @@ TEST_SUITE("form_factors") {
     CHECK_THROWS_AS(rad::view_factor_matrix(s, o), rad::Error);
   }
 
+  TEST_CASE("view_factor_matrix: the sky of a box's bottom lying on the ground is 0 - two rooms sharing a wall as "
+            "coincident polygons keep their sky") {
+    // A building (a box) standing on the ground: its bottom lies on the ground face to face,
+    // with nothing below the ground. Its rays start just under the ground and meet nothing, but
+    // it sees nothing at all: its sky is 0, as the ground's under it is.
+    rad::Scene s;
+    const rad::MaterialId m = s.add_material(rad::Material{});
+    rad::add_quad(s, {-5, -5, 0}, {10, 0, 0}, {0, 10, 0}, m, "ground");  // facing +z
+    const rad::PolygonRange box = rad::add_box(s, {-1, -1, 0}, {1, 1, 2}, m, "box");
+    std::uint32_t bottom = rad::kNone, top = rad::kNone;
+    for (std::uint32_t p = box.first; p < box.first + box.count; ++p) {
+      if (s.polygons()[p].normal.z < -0.5f) bottom = p;
+      if (s.polygons()[p].normal.z > 0.5f) top = p;
+    }
+    REQUIRE(bottom != rad::kNone);
+    REQUIRE(top != rad::kNone);
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    for (const rad::FormFactorMethod method : {rad::FormFactorMethod::ray_cast, rad::FormFactorMethod::monte_carlo}) {
+      o.form_factors.method = method;
+      const rad::ViewFactorMatrix v = rad::view_factor_matrix(s, o);
+      REQUIRE(v.rows() == 7);
+      CHECK(v.sky[bottom] == 0.0);  // 1 before: its rays went down under the ground
+      CHECK(v.row_offsets[bottom + 1] == v.row_offsets[bottom]);
+      CHECK(v.sky[top] == 1.0);  // nothing above the roof
+      // The ground: the box hides 4 of its 100 m^2 and some of the sky of the rest.
+      CHECK(v.sky[0] > 0.8);
+      CHECK(v.sky[0] < 0.96);
+    }
+
+    // Two rooms without ceilings, modelled as separate boxes: the wall between them is two
+    // coincident polygons facing apart, each lying against the other, but each side has its
+    // room in front of it (the burial test's rays meet its floor and walls): its sky through
+    // the open top is the same as without the other room (about 0.2), within 4 standard errors
+    // (the mesh, and with it the rays, differ).
+    auto room = [&](rad::Scene& scene, float x0, const char* group) {
+      rad::add_quad(scene, {x0, 0, 0}, {1, 0, 0}, {0, 1, 0}, m, group);      // floor, +z
+      rad::add_quad(scene, {x0, 0, 0}, {0, 1, 0}, {0, 0, 1}, m, group);      // x = x0, +x
+      rad::add_quad(scene, {x0 + 1, 0, 0}, {0, 0, 1}, {0, 1, 0}, m, group);  // x = x0 + 1, -x
+      rad::add_quad(scene, {x0, 0, 0}, {0, 0, 1}, {1, 0, 0}, m, group);      // y = 0, +y
+      rad::add_quad(scene, {x0, 1, 0}, {1, 0, 0}, {0, 0, 1}, m, group);      // y = 1, -y
+    };
+    rad::Scene alone, both;
+    alone.add_material(rad::Material{});
+    both.add_material(rad::Material{});
+    room(alone, 0.0f, "a");
+    room(both, 0.0f, "a");
+    room(both, 1.0f, "b");
+    REQUIRE(both.polygons()[2].normal.x < -0.5f);
+    REQUIRE(both.polygons()[6].normal.x > 0.5f);
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    const rad::ViewFactorMatrix a = rad::view_factor_matrix(alone, o), ab = rad::view_factor_matrix(both, o);
+    bool lying = false;
+    for (const rad::PolygonOverlap& overlap : rad::find_overlaps(both))
+      lying |= overlap.lying_against() && overlap.first == 2 && overlap.second == 6;
+    REQUIRE(lying);
+    auto agree = [](const rad::ViewFactorMatrix& x, std::size_t i, const rad::ViewFactorMatrix& y, std::size_t j) {
+      INFO("sky ", x.sky[i], " +- ", x.sky_standard_error[i], " against ", y.sky[j], " +- ", y.sky_standard_error[j]);
+      CHECK(x.sky[i] > 0.15);
+      CHECK(std::fabs(x.sky[i] - y.sky[j]) <
+            4.0 * std::hypot(x.sky_standard_error[i], y.sky_standard_error[j]));
+    };
+    agree(ab, 2, a, 2);
+    agree(ab, 6, a, 1);
+  }
+
   TEST_CASE("view_factor_matrix, exact mode, obstructed: a closed room around a block - rows sum to 1 within 5e-5 - what the "
             "block hides is 0 - bit-identical at 1 and 2 threads and in blocks of rows - the hierarchical links' factors near "
             "them") {

@@ -299,31 +299,48 @@ int run_factors(const FactorsArgs& a) {
                    level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), processes_text.c_str(), m.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
       for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: factors: %s\n", w.c_str());
-      // Rows that see nothing: one-sided polygons whose fronts face away from everything, or
-      // (per polygon, told apart) polygons lying against another, in contact: a box's bottom on
-      // a floor, hidden as it should be.
-      std::size_t blind = 0, in_contact = 0;
+      // Rows that see no surface: polygons lying against another, in contact (per polygon,
+      // told apart: a box's bottom on a floor, hidden as it should be); polygons that see only
+      // the sky (a roof above everything else, in an open scene); and the rest, which see
+      // nothing at all. Most of a closed model seeing only the sky is a model wound outward:
+      // find_polygons_facing_outward() judges that, as `check` does.
+      std::size_t blind = 0, in_contact = 0, sky_only = 0;
       std::vector<bool> touching;
+      std::vector<rad::PolygonOverlap> overlaps;
       // The overlap search (0.5 s at 246k polygons) only when some row is empty.
       bool any_empty = false;
       for (std::size_t i = 0; i < m.rows() && !any_empty; ++i) any_empty = m.row_offsets[i + 1] == m.row_offsets[i];
       if (level == "polygon" && any_empty) {
+        overlaps = rad::find_overlaps(scene);
         touching.assign(scene.polygons().size(), false);
-        for (const rad::PolygonOverlap& p : rad::find_overlaps(scene))
+        for (const rad::PolygonOverlap& p : overlaps)
           if (p.lying_against()) touching[p.first] = touching[p.second] = true;
       }
       for (std::size_t i = 0; i < m.rows(); ++i) {
         if (m.row_offsets[i + 1] != m.row_offsets[i]) continue;
         if (!touching.empty() && touching[m.ids[i]])
           ++in_contact;
+        else if (i < m.sky.size() && m.sky[i] > 0.0)
+          ++sky_only;
         else
           ++blind;
       }
-      if (blind > 0)
+      const bool outward = sky_only > 0 && level == "polygon" &&
+                           rad::find_polygons_facing_outward(scene, overlaps).looks_wound_outward();
+      if (outward)
         std::fprintf(stderr,
-                     "warning: factors: %zu of %zu rows see no surface in front of them (polygons send and receive "
-                     "on their fronts only: if the scene is closed, its polygons may face outward: --reverse-winding outward "
-                     "turns them over)\n",
+                     "warning: factors: %zu of %zu rows see no surface in front of them, only the sky, and most of the "
+                     "model looks wound outward (polygons send and receive on their fronts only: --reverse-winding "
+                     "outward turns them over)\n",
+                     sky_only + blind, m.rows());
+      else if (sky_only > 0)
+        std::fprintf(stderr, "factors: %zu rows see only the sky (no surface in front of them: a roof above the rest)\n",
+                     sky_only);
+      if (blind > 0 && !outward)
+        std::fprintf(stderr,
+                     "warning: factors: %zu of %zu rows see nothing, neither a surface nor the sky (polygons send and "
+                     "receive on their fronts only: if the scene is closed, its polygons may face outward: "
+                     "--reverse-winding outward turns them over)\n",
                      blind, m.rows());
       if (in_contact > 0)
         std::fprintf(stderr,
