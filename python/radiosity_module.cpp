@@ -949,6 +949,23 @@ PYBIND11_MODULE(radiosity, m) {
       "The one-sided polygons whose front sees nothing while their back sees the scene all around, as the walls "
       "of a closed room or enclosure wound outwards do (radiosity check's warning): what "
       "scene.reverse_winding(ids) turns over. Deterministic (a fixed seed).");
+  m.def(
+      "find_inconsistent_winding",
+      [](const rad::Scene& scene) {
+        rad::InconsistentWinding found;
+        {
+          py::gil_scoped_release release;
+          found = rad::find_inconsistent_winding(scene);
+        }
+        py::list ids;
+        for (const rad::PolygonId id : found.polygons) ids.append(id);
+        return ids;
+      },
+      py::arg("scene"),
+      "find_inconsistent_winding(scene) -> list of polygon ids\n\n"
+      "The one-sided polygons wound opposite to the polygons they share edges with (a flipped face of a mesh, "
+      "black in a solve; radiosity check's warning): of each surface connected by shared edges, the orientation "
+      "holding less area. What scene.reverse_winding(ids) turns over. No rays; deterministic.");
   m.def("cornell_box", &rad::cornell_box,
         "The Cornell box (geometry in mm, measured reflectances, light E = pi (17, 12, 4)); groups floor, ceiling, "
         "back_wall, red_wall, green_wall, light, short_block, tall_block. Thread safety: may be called "

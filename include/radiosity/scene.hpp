@@ -505,6 +505,26 @@ RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene);
 /// overlap names a polygon the scene does not have.
 RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene, const std::vector<PolygonOverlap>& overlaps);
 
+/// What find_inconsistent_winding() found.
+struct InconsistentWinding {
+  std::vector<PolygonId> polygons;  ///< in polygon order
+  double area = 0.0;                ///< theirs, scene units^2
+  std::size_t surfaces = 0;         ///< connected surfaces that hold some of them
+};
+
+/// One-sided polygons (as find_polygons_facing_outward() takes them) wound opposite to the
+/// polygons they share edges with: an exporter's slip, a face flipped by hand. Such a polygon
+/// faces away from the light its neighbours take and comes out black. Two polygons that share
+/// an edge (both ends at exactly the same positions, as an indexed mesh's faces or a triangulated
+/// polygon's pieces do, and no third polygon on it) are wound alike when they run along it in
+/// opposite directions. Over each surface connected by such edges the polygons fall into two
+/// orientations; those of the one holding less area are reported (on a tie, the one without the
+/// surface's lowest polygon id). No rays: a closed model wound outward throughout is consistent
+/// (find_polygons_facing_outward() finds that). Scene::reverse_winding() turns the polygons
+/// found. Deterministic. Cost: a sort of the polygons' edges and a walk over them, no rays.
+/// Thread safety: concurrent calls are safe.
+RADIOSITY_API InconsistentWinding find_inconsistent_winding(const Scene& scene);
+
 /// Adds the parallelogram origin, origin + edge_u, origin + edge_u + edge_v, origin + edge_v,
 /// facing edge_u x edge_v (counter-clockwise seen from that side). Units are scene units.
 /// Throws Error{invalid_argument} for a non-finite value or parallel (or zero) edges, and what

@@ -146,6 +146,14 @@ def test_cornell_box_has_its_groups():
     assert "polygons" in repr(scene)
 
 
+def test_find_inconsistent_winding_names_a_flipped_triangle_of_a_mesh(data_dir):
+    # A box exported as a triangle mesh with triangle 13 flipped, on a ground.
+    scene = radiosity.load_scene(data_dir / "flipped_face.obj")
+    assert radiosity.find_inconsistent_winding(scene) == [13]
+    scene.reverse_winding([13])
+    assert radiosity.find_inconsistent_winding(scene) == []
+
+
 def test_reverse_winding_turns_the_polygons_found_facing_outward(data_dir):
     # A room as an exporter writes it: walls and floor wound outwards, a box standing on the
     # floor wound as it should be.

@@ -6,6 +6,7 @@
 // Malley's method (a uniform disk point projected up onto the hemisphere).
 #include "scene/emitter_check.hpp"
 #include "scene/emission.hpp"
+#include "scene/winding_check.hpp"
 
 #include <algorithm>
 #include <array>
@@ -266,7 +267,7 @@ OutwardFacing find_polygons_facing_outward(const Scene& scene, const std::vector
   OutwardFacing out;
   if (polygons.empty()) return out;
   // One-sided: no back of its own (detail::pass1_has_back()) and no glass to see through.
-  auto one_sided = [&](const Material& m) { return !detail::pass1_has_back(m) && !(detail::max_channel(m.transmittance) > 0.0f); };
+  const auto one_sided = detail::has_sides;
   std::vector<std::uint8_t> outward(polygons.size(), 0);
   const float lift = 1e-5f * std::max(scene.bounds().diagonal(), std::numeric_limits<float>::min());
   const detail::RayScene rays_scene = detail::RayScene::from_polygons(scene);

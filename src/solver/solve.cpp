@@ -12,6 +12,7 @@
 #include "scene/emission.hpp"
 #include "core/memory_budget.hpp"
 #include "scene/overlap.hpp"
+#include "scene/winding_check.hpp"
 #include "radiosity/render.hpp"
 #include "radiosity/solver.hpp"
 #include "scene/emitter_check.hpp"
@@ -381,6 +382,9 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given, const detail::Com
     // ambiguous.
     const detail::KeepGoing poll = [&] { return gate.report(Progress{Phase::meshing, 0.0}); };
     for (std::string& w : detail::z_fighting_warnings(scene, meshing_progress ? poll : detail::KeepGoing()))
+      warnings.push_back(std::move(w));
+    // A face of a mesh wound against its neighbours comes out black with no other sign.
+    for (std::string& w : detail::inconsistent_winding_warnings(scene, find_inconsistent_winding(scene)))
       warnings.push_back(std::move(w));
   }
   if (!meshing_cancelled)

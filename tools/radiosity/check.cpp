@@ -173,6 +173,21 @@ void coarse_contact_warnings(const rad::Scene& scene, const std::vector<rad::Con
                        " more pairs where one stands on elements larger than itself");
 }
 
+const std::string& group_of(const rad::Scene& scene, rad::PolygonId p) {
+  return scene.groups()[scene.polygons()[p].group];
+}
+
+/// A place in the file's coordinates (Scene::origin() added), with the digits georeferenced
+/// coordinates need when there is an origin.
+std::string place(const glm::vec3& p, const glm::dvec3& origin) {
+  const bool moved = origin != glm::dvec3(0.0);
+  char text[128];
+  std::snprintf(text, sizeof text, moved ? "(%.10g, %.10g, %.10g)" : "(%.6g, %.6g, %.6g)",
+                static_cast<double>(p.x) + origin.x, static_cast<double>(p.y) + origin.y,
+                static_cast<double>(p.z) + origin.z);
+  return text;
+}
+
 CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   CheckResult r;
   r.scene = a.scene.empty() ? "cornell-box" : a.scene;
@@ -217,6 +232,31 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
     }
   }
 
+  {
+    // Polygons wound against their neighbours (a flipped face of a mesh): black with no other sign.
+    const rad::InconsistentWinding inconsistent = rad::find_inconsistent_winding(scene);
+    if (!inconsistent.polygons.empty()) {
+      char area[32];
+      std::snprintf(area, sizeof area, "%.3g", inconsistent.area);
+      const rad::Polygon& p = scene.polygons()[inconsistent.polygons.front()];
+      glm::vec3 centre(0.0f);
+      for (const glm::vec3& v : p.vertices) centre += v;
+      centre /= static_cast<float>(p.vertices.size());
+      const bool one = inconsistent.polygons.size() == 1;
+      r.warnings.push_back(std::to_string(inconsistent.polygons.size()) + (one ? " polygon is" : " polygons are") +
+                           " wound opposite to the polygons " + (one ? "it shares" : "they share") + " edges with (" +
+                           area + " units^2 in " + std::to_string(inconsistent.surfaces) +
+                           (inconsistent.surfaces == 1 ? " surface" : " surfaces") + "; the first: polygon " +
+                           std::to_string(inconsistent.polygons.front()) + " of group '" +
+                           group_of(scene, inconsistent.polygons.front()) + "' at " + place(centre, scene.origin()) +
+                           "): one-sided, " +
+                           (one ? "it faces away from the light its neighbours take and comes"
+                                : "they face away from the light their neighbours take and come") +
+                           " out black; reverse the winding (--reverse-winding inconsistent) or use two-sided "
+                           "materials (--two-sided)");
+    }
+  }
+
   rad::MeshOptions mesh;
   mesh.max_patch_area = a.max_patch_area;
   mesh.max_element_area = a.max_element_area;
@@ -234,10 +274,6 @@ CheckResult check_scene(const CheckArgs& a, const rad::Scene& scene) {
   return r;
 }
 
-const std::string& group_of(const rad::Scene& scene, rad::PolygonId p) {
-  return scene.groups()[scene.polygons()[p].group];
-}
-
 const char* kind_name(rad::OverlapKind k) {
   return k == rad::OverlapKind::coincident ? "coincident" : "interpenetrating";
 }
@@ -246,17 +282,6 @@ std::string mib(std::size_t bytes) {
   char s[32];
   std::snprintf(s, sizeof s, "%.1f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
   return s;
-}
-
-/// A place in the file's coordinates (Scene::origin() added), with the digits georeferenced
-/// coordinates need when there is an origin.
-std::string place(const glm::vec3& p, const glm::dvec3& origin) {
-  const bool moved = origin != glm::dvec3(0.0);
-  char text[128];
-  std::snprintf(text, sizeof text, moved ? "(%.10g, %.10g, %.10g)" : "(%.6g, %.6g, %.6g)",
-                static_cast<double>(p.x) + origin.x, static_cast<double>(p.y) + origin.y,
-                static_cast<double>(p.z) + origin.z);
-  return text;
 }
 
 void print_text(const CheckResult& r, const rad::Scene& scene) {

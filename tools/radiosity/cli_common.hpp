@@ -283,15 +283,16 @@ inline void add_photometric_flag(CLI::App& cmd, bool& photometric) {
                "divide by 683 lm/W; without it they are W/sr and W/m^2 as written (the library is radiometric)");
 }
 
-/// Adds `--reverse-winding all|outward` (every command that loads a scene has it).
+/// Adds `--reverse-winding all|outward|inconsistent` (every command that loads a scene has it).
 inline void add_reverse_winding_option(CLI::App& cmd, std::string& reverse_winding) {
   cmd.add_option("--reverse-winding", reverse_winding,
                  "Turn polygons over (reverse their vertex order) after loading, for one-sided models wound the wrong "
                  "way: 'outward' the polygons whose front sees nothing and whose back sees the scene (the walls of a "
                  "room or enclosure modelled as an outward box, as check lists them; furniture inside keeps its "
-                 "winding), 'all' every polygon. View factors are taken on fronts only, so for them this, not "
-                 "--two-sided, is the fix")
-      ->check(CLI::IsMember({"all", "outward"}));
+                 "winding), 'inconsistent' the polygons wound opposite to the polygons they share edges with (a "
+                 "flipped face of a mesh), 'all' every polygon. View factors are taken on fronts only, so for them "
+                 "this, not --two-sided, is the fix")
+      ->check(CLI::IsMember({"all", "outward", "inconsistent"}));
 }
 
 /// `with_path`: also offer `--method path` (render only: the reference path tracer, no solve).
@@ -448,7 +449,7 @@ inline rad::Scene load(const std::string& path, bool strict = false, bool photom
 /// What the command line changes in a scene once it is loaded.
 struct SceneEdits {
   bool two_sided = false;       ///< `--two-sided`: Scene::make_two_sided()
-  std::string reverse_winding;  ///< `--reverse-winding`: "" (none), "all" or "outward"
+  std::string reverse_winding;  ///< `--reverse-winding`: "" (none), "all", "outward" or "inconsistent"
 };
 
 /// Applies `--reverse-winding` (Scene::reverse_winding()) and says what it turned.
@@ -457,6 +458,15 @@ inline void reverse_winding(rad::Scene& scene, const std::string& which) {
   if (which == "all") {
     scene.reverse_winding();
     std::fprintf(stderr, "reversed the winding of all %zu polygons (--reverse-winding all)\n", scene.polygons().size());
+    return;
+  }
+  if (which == "inconsistent") {
+    const rad::InconsistentWinding found = rad::find_inconsistent_winding(scene);
+    scene.reverse_winding(found.polygons);
+    std::fprintf(stderr,
+                 "reversed the winding of %zu of %zu polygons, those wound opposite to the polygons they share edges "
+                 "with (--reverse-winding inconsistent)\n",
+                 found.polygons.size(), scene.polygons().size());
     return;
   }
   const rad::OutwardFacing outward = rad::find_polygons_facing_outward(scene);
