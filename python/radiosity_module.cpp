@@ -558,6 +558,7 @@ py::object view_factor_matrix(const rad::Scene& scene, const std::string& level,
   info["correction"] = c;
   info["warnings"] = string_list(m.warnings);
   info["method"] = m.method;
+  info["method_reason"] = m.method_reason;
   info["element_count"] = m.element_count;
   info["seconds"] = m.seconds;
   info["cancelled"] = m.cancelled;
@@ -628,10 +629,13 @@ shape (rows, rows), or (csr_matrix, info) with return_info=True: F[i, j] is the 
 energy leaving surface i (diffusely) that arrives at surface j.
 level: 'polygon' (rows are the scene's polygons in order, obstruction-only ones left out),
 'element' (the leaves of the mesh that max_patch_area/max_element_area make) or 'group'.
-method: 'auto' (= 'ray-cast': exact unoccluded factors, occlusion by rays), 'ray-cast',
-'analytic' (no occlusion), 'hemicube', 'monte-carlo' (hemisphere_rays per element; rows x rays
-cost, for large scenes) or 'hierarchical' (the links of hierarchical radiosity, epsilon their
-refinement threshold; reciprocal whatever the correction).
+method: 'auto' (at polygon and element level: 'ray-cast' while its thread time, estimated from
+a sample of pairs, is at most a minute, else 'monte-carlo'; info['method_reason'] says which and
+why), 'ray-cast' (polygon and element level: the exact mode, each pair integrated without rays;
+group level: element rows, occlusion by rays), 'analytic' (no occlusion), 'hemicube',
+'monte-carlo' (hemisphere_rays per element; rows x rays cost, for large scenes) or 'hierarchical'
+(the links of hierarchical radiosity, epsilon their refinement threshold; reciprocal whatever the
+correction).
 correction: 'none', 'reciprocity' (A_i F_ij = A_j F_ji exactly) or 'enclosure' (reciprocity
 and rows summing to 1, for closed enclosures). groups: names of the groups whose surfaces are
 rows and columns (None = all). seed and threads as in solve(); the result does not depend on
@@ -639,10 +643,12 @@ threads. dtype: float64 or float32 values.
 
 return_info=True returns (matrix, info), info a dict with: 'level'; 'ids' (per row: the
 PolygonId, element id or GroupId); 'names' (group level: the group names); 'area' (per row,
-scene units^2); 'sky' (per row: 1 - row sum, the part of the hemisphere that sees no surface);
+scene units^2); 'sky' (per row: the sky view factor, the part of the hemisphere in which no
+polygon lies, estimated by rays; not 1 - row sum);
 'row_standard_error' (per row, Monte Carlo; None for the other methods); 'correction' (dict:
 name, reciprocity_before, row_sum_error_before, row_sum_rms_before, largest_change, rms_change,
-empty_rows, clamped, iterations); 'method' (the estimator that ran); 'element_count';
+empty_rows, clamped, iterations); 'method' (the estimator that ran); 'method_reason' (why, when
+'auto' chose it; else empty); 'element_count';
 'seconds'; 'cancelled' (the progress callback stopped it: rows are incomplete).
 
 Raises radiosity.Error for a scene without polygons, bad options or an unknown group.

@@ -57,6 +57,9 @@ def test_reciprocity_correction_and_float32_values(cube):
     f, info = radiosity.view_factor_matrix(cube, correction="reciprocity", dtype=np.float32, return_info=True,
                                            **COARSE)
     assert f.dtype == np.float32
+    # method 'auto' (the default): the exact mode on a scene this small, and why.
+    assert info["method"] == "ray-cast"
+    assert info["method_reason"].startswith("automatic: the exact mode, about ")
     dense = f.toarray().astype(float)
     area = info["area"]
     np.testing.assert_allclose(area[:, None] * dense, (area[:, None] * dense).T, atol=1e-6)

@@ -39,6 +39,7 @@ enum class Stream : std::uint64_t {
   hierarchical_enclosure = 0xe1000000000ull,  ///< key_a 2 x element + back: a side's enclosure rays
   // View factors (key_a: the element).
   view_factor_sky = 0xf0000000000ull,    ///< an element's rays for its sky view factor
+  view_factor_cost = 0xf1000000000ull,   ///< key_a 0: the pairs the automatic choice integrates to estimate
 };
 
 /// The key of `stream`, `offset` into its range.

@@ -184,7 +184,7 @@ struct ExactPolygonTransport::Impl {
 
   void add_cluster(std::uint32_t begin, std::uint32_t end);
   void candidates(std::uint32_t s, std::uint32_t r, std::vector<std::uint32_t>& out) const;
-  double unobstructed(const Face& S, const Face& R) const;
+  double unobstructed(const Face& S, const Face& R, Workspace& w) const;
   bool hidden_by_one(const Face& S, const Face& R, const std::vector<std::uint32_t>& candidates) const;
   double visible_factor(const glm::vec3& point, const Face& S, const Face& R, Workspace& w) const;
   template <typename PointFactor, typename Forced>
@@ -442,7 +442,7 @@ bool ExactPolygonTransport::Impl::hidden_by_one(const Face& S, const Face& R,
   return false;
 }
 
-double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R) const {
+double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R, Workspace& w) const {
   const float separation = glm::length(R.centroid - S.centroid) / (S.radius + R.radius);
   bool all_in_front = separation > kFarSeparation;
   for (const glm::vec3& v : R.corners) all_in_front = all_in_front && glm::dot(v - S.centroid, S.normal) > epsilon;
@@ -461,6 +461,7 @@ double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R) c
   }
   const int n = static_cast<int>(R.corners.size());
   auto g = [&](const glm::vec3& x) -> double {
+    ++w.work;
     if (glm::dot(x - R.centroid, R.normal) <= 0.0f) return 0.0;  // behind the receiver
     return n <= 8 ? static_cast<double>(point_to_polygon_factor_fast(x, S.normal, R.corners.data(), n))
                   : point_to_polygon_factor(x, S.normal, R.corners.data(), n);
@@ -472,6 +473,7 @@ double ExactPolygonTransport::Impl::unobstructed(const Face& S, const Face& R) c
 // shadow of each candidate occluder (w.candidates).
 double ExactPolygonTransport::Impl::visible_factor(const glm::vec3& point, const Face& S, const Face& R,
                                                    Workspace& w) const {
+  ++w.work;
   const glm::dvec3 x(point);
   const glm::dvec3 nr = R.dnormal;
   const double h = glm::dot(nr, x) - R.offset;  // height of x above the receiver's plane
@@ -508,6 +510,7 @@ double ExactPolygonTransport::Impl::visible_factor(const glm::vec3& point, const
       if (clear) break;
     }
     if (clear) continue;
+    ++w.work;
     // The occluder between x and the receiver's plane: -h <= dot(nr, o) <= -1e-9 h.
     int k = n;
     if (lo < 0.0) {
@@ -645,6 +648,7 @@ std::unique_ptr<ExactPolygonTransport::Workspace> ExactPolygonTransport::workspa
 double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Workspace& w) const {
   const Impl& m = *impl_;
   if (i == j) return 0.0;
+  ++w.work;
   // The source is the smaller polygon (ties: the lower index), so both orders give one number.
   const bool i_source = m.faces[i].area < m.faces[j].area || (m.faces[i].area == m.faces[j].area && i < j);
   const std::uint32_t s = i_source ? i : j, r = i_source ? j : i;
@@ -657,7 +661,7 @@ double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Worksp
   for (const glm::vec3& v : S.corners) s_in_front |= glm::dot(v - R.centroid, R.normal) > m.epsilon;
   if (!s_in_front) return 0.0;
   if (!m.clusters.empty()) m.candidates(s, r, w.candidates);
-  if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R);
+  if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R, w);
   if (m.hidden_by_one(S, R, w.candidates)) return 0.0;
   auto g = [&](const glm::vec3& x) { return m.visible_factor(x, S, R, w); };
   // A source edge in the plane of an occluder (a floor facet along a block's face): the shadow

@@ -32,6 +32,10 @@ class ExactPolygonTransport {
     std::vector<glm::dvec3> corners, next_corners, occluder, scratch, planes, cone;
     /// Convex pieces of the receiver: (first corner, corner count) in `corners`.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pieces, next_pieces;
+    /// Work done, counted for the automatic choice's estimate (view_factor_matrix.cpp): per
+    /// pair 1, plus per point of the adaptive rules 1, plus per occluder clipped at a point 1.
+    /// Deterministic (the same pairs do the same work).
+    std::uint64_t work = 0;
   };
   std::unique_ptr<Workspace> workspace() const;
 

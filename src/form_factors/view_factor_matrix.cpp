@@ -278,6 +278,64 @@ void check_enclosure(const ViewFactorMatrix& m, const Scene& scene) {
                   "winding) see nothing in front of them");
 }
 
+/// The automatic choice at the polygon and element levels (FormFactorMethod::automatic): the
+/// exact mode while its thread time is estimated at most this, Monte Carlo rows beyond. The
+/// exact mode integrates every pair of rows, with a cost per pair from a microsecond (far apart,
+/// nothing between) to a millisecond (partly hidden behind several occluders): the benchmark room
+/// of 3 708 facets takes about 9 s of thread time, a city block of 3 744 triangles (16 buildings)
+/// about 115 s. 60 s is half a minute on two threads.
+constexpr double kAutomaticExactSeconds = 60.0;
+/// Thread time per unit of ExactPolygonTransport::Workspace::work (a pair, a point of the adaptive
+/// rules, an occluder clipped at a point). Measured (session 37, quiet machine, 2 threads): the
+/// room estimated at 11 s, 4.2 s wall for its rows; the city block estimated at 77 s, 58 s wall;
+/// the benchmark city of 5 832 facets estimated at 14 s, 19 s of thread time on a loaded one.
+/// Within about a third either way, enough to tell seconds from minutes.
+constexpr double kExactWorkSeconds = 0.2e-6;
+/// Pairs the estimate integrates (all of them when there are fewer).
+constexpr std::size_t kCostSample = 4096;
+
+/// What the exact mode would cost on the rows `ids`: each unordered pair once, a sample of them
+/// integrated (`seed`'s stream, so the same choice on every run and every MPI process).
+struct ExactCost {
+  double pairs = 0.0;       ///< unordered pairs of rows
+  std::size_t sampled = 0;  ///< pairs integrated to estimate
+  double seconds = 0.0;     ///< thread time, estimated
+};
+ExactCost exact_cost(const Scene& scene, const std::vector<std::uint32_t>& ids, std::uint64_t seed, unsigned threads) {
+  ExactCost cost;
+  const std::size_t n = ids.size();
+  cost.pairs = 0.5 * static_cast<double>(n) * static_cast<double>(n > 0 ? n - 1 : 0);
+  if (n < 2) return cost;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> sample;
+  if (cost.pairs <= static_cast<double>(kCostSample)) {
+    for (std::uint32_t r = 0; r < n; ++r)
+      for (std::uint32_t c = r + 1; c < n; ++c) sample.emplace_back(ids[r], ids[c]);
+  } else {
+    detail::Rng rng(seed, 0, detail::stream_key(detail::Stream::view_factor_cost));
+    for (std::size_t k = 0; k < kCostSample; ++k) {
+      const auto r = static_cast<std::uint32_t>(std::min<double>(rng.uniform() * static_cast<double>(n), n - 1));
+      auto c = static_cast<std::uint32_t>(std::min<double>(rng.uniform() * static_cast<double>(n - 1), n - 2));
+      if (c >= r) ++c;
+      sample.emplace_back(ids[r], ids[c]);
+    }
+  }
+  const detail::ExactPolygonTransport transport(scene);
+  std::vector<std::uint64_t> work(sample.size(), 0);
+  detail::parallel_for(threads, sample.size(), 64, [&](std::size_t begin, std::size_t end) {
+    const auto w = transport.workspace();
+    for (std::size_t k = begin; k < end; ++k) {
+      w->work = 0;
+      transport.transport(sample[k].first, sample[k].second, *w);
+      work[k] = w->work;
+    }
+  });
+  std::uint64_t total = 0;
+  for (const std::uint64_t x : work) total += x;
+  cost.sampled = sample.size();
+  cost.seconds = cost.pairs * static_cast<double>(total) / static_cast<double>(sample.size()) * kExactWorkSeconds;
+  return cost;
+}
+
 /// Rows [begin, end) of the exact mode (exact_view_factors.hpp) between the polygons `ids` of
 /// `scene` (row and column r: polygon ids[r]), into out.row_offsets, columns and values: each
 /// unordered pair once, F(r -> c) = G_rc / A_r. A pair with both rows in the block is
@@ -501,6 +559,7 @@ struct ViewFactorRows::Impl {
   std::vector<std::uint32_t> sources;
   std::vector<std::uint64_t> first;
   bool cancelled = false;  ///< the meshing callback said stop
+  std::string reason;      ///< why FormFactorMethod::automatic chose ff.method (empty when it was given)
 };
 
 ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options, const ProgressFn* meshing)
@@ -519,6 +578,8 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
   m.level = options.level;
   m.memory_budget = detail::resolve_memory_budget(options.memory_budget_bytes);
   m.ff = view_factor_estimator_options(options);
+  const bool automatic = options.method == ViewFactorMethod::estimator &&
+                         options.form_factors.method == FormFactorMethod::automatic;
   m.links = options.method == ViewFactorMethod::hierarchical;
   m.epsilon = options.epsilon;
   std::vector<std::uint32_t> row_of = selected_polygons(scene, options.groups, "view_factor_matrix");
@@ -545,6 +606,28 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
   for (std::size_t p = 0; p < polygons; ++p)
     if (row_of[p] != kNone) m.ids.push_back(static_cast<std::uint32_t>(p));
   const std::size_t rows = m.ids.size();
+  if (automatic) {
+    // The exact mode where it takes seconds, Monte Carlo rows where it would take minutes
+    // (kAutomaticExactSeconds); the reason goes to ViewFactorMatrix::method_reason.
+    const ExactCost cost = exact_cost(*m.scene, m.ids, m.ff.seed, m.ff.threads);
+    char text[320];
+    if (cost.seconds <= kAutomaticExactSeconds) {
+      std::snprintf(text, sizeof text,
+                    "automatic: the exact mode, about %.2g s of thread time for %.3g M pairs of %s (estimated from "
+                    "%zu of them)",
+                    cost.seconds, 1e-6 * cost.pairs, options.level == ViewFactorLevel::element ? "elements" : "polygons",
+                    cost.sampled);
+    } else {
+      m.ff.method = FormFactorMethod::monte_carlo;
+      std::snprintf(text, sizeof text,
+                    "automatic: the exact mode would take about %.2g s of thread time for %.3g M pairs of %s (estimated "
+                    "from %zu of them), over the %.0f s the automatic choice allows; Monte Carlo rows of %u rays per "
+                    "element instead, each row with its standard error",
+                    cost.seconds, 1e-6 * cost.pairs, options.level == ViewFactorLevel::element ? "elements" : "polygons",
+                    cost.sampled, kAutomaticExactSeconds, m.ff.hemisphere_rays);
+    }
+    m.reason = text;
+  }
   m.area.assign(rows, 0.0);
   m.hierarchy = mesh_scene(*m.scene, mesh);
   if (m.cancelled) {
@@ -590,6 +673,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   const std::size_t rows = end - begin;
   out.level = m.level;
   out.method = m.links ? "hierarchical" : to_string(m.ff.method);
+  out.method_reason = m.reason;
   out.ids.assign(m.ids.begin() + static_cast<std::ptrdiff_t>(begin), m.ids.begin() + static_cast<std::ptrdiff_t>(end));
   // Element level: leaf position -> element id.
   if (m.element_mesh)

@@ -14,6 +14,7 @@
 
 #include "../../tools/radiosity/npz_format.hpp"
 #include "form_factors/view_factor_rows.hpp"
+#include "city.hpp"
 #include "support/scenes.hpp"
 #include "support/build.hpp"
 
@@ -341,6 +342,41 @@ TEST_SUITE("form_factors") {
     CHECK(top.non_zeros() == 0);  // it sees no other selected polygon
     o.groups = {"nothing"};
     CHECK_THROWS_AS(rad::view_factor_matrix(s, o), rad::Error);
+  }
+
+  TEST_CASE("view_factor_matrix, automatic: the exact mode where it takes seconds, said why - Monte Carlo rows where "
+            "it would take minutes (a city), said why - a method given is taken as it is") {
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    REQUIRE(o.form_factors.method == rad::FormFactorMethod::automatic);  // the default
+    const rad::ViewFactorMatrix box = rad::view_factor_matrix(faceted_box(1, 2, 3, 0.5f), o);
+    CHECK(box.method == "ray-cast");
+    CHECK(box.method_reason.rfind("automatic: the exact mode, about ", 0) == 0);
+    // 88 facets, 3 828 pairs: fewer than the sample, so all of them were integrated to estimate.
+    CHECK(box.method_reason.find(" s of thread time for 0.00383 M pairs of polygons (estimated from 3828 of them)") !=
+          std::string::npos);
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    CHECK(rad::view_factor_matrix(faceted_box(1, 2, 3, 0.5f), o).method_reason.empty());
+
+    // The benchmark city of 3 x 3 blocks (23 454 facets, 275 M pairs, some partly hidden behind
+    // buildings). Few rays per element keep the test short (the choice does not depend on them).
+    bench::CityOptions city;
+    city.blocks = 3;
+    city.facet_size = 2.25;
+    const bench::City c = bench::city(city);
+    INFO(c.scene.polygons().size(), " facets");
+    o.form_factors.method = rad::FormFactorMethod::automatic;
+    o.form_factors.hemisphere_rays = 16;
+    o.mesh.max_patch_area = o.mesh.max_element_area = 1e30f;
+    const rad::ViewFactorMatrix fast = rad::view_factor_matrix(c.scene, o);
+    INFO(fast.method_reason);
+    CHECK(fast.method == "monte-carlo");
+    CHECK(fast.method_reason.rfind("automatic: the exact mode would take about ", 0) == 0);
+    CHECK(fast.method_reason.find("over the 60 s the automatic choice allows; Monte Carlo rows of 16 rays per element "
+                                  "instead") != std::string::npos);
+    CHECK(fast.row_standard_error.size() == fast.rows());
+    // The same choice from the same seed (the estimate integrates the same pairs).
+    CHECK(rad::view_factor_matrix(c.scene, o).method_reason == fast.method_reason);
   }
 
   TEST_CASE("view_factor_matrix: the sky of a box's bottom lying on the ground is 0 - two rooms sharing a wall as "

@@ -27,7 +27,7 @@ namespace {
 
 struct FactorsArgs {
   std::string scene;
-  std::string method = "ray-cast";
+  std::string method = "auto";
   std::string format = "csv";
   std::string level = "group";
   std::string correction = "none";
@@ -153,6 +153,8 @@ int write_blocks(const rad::Scene& scene, const rad::ViewFactorOptions& o, const
                "%.3f s, wrote %s\n",
                total_rows, level.c_str(), static_cast<unsigned long long>(non_zeros), elements, rows.method.c_str(),
                ranges.size(), ranges.size() == 1 ? "" : "s", rows.seconds, (folder / "manifest.json").c_str());
+  if (!rows.method_reason.empty())
+    std::fprintf(stderr, "factors: %s (%s; --method overrides)\n", rows.method.c_str(), rows.method_reason.c_str());
   return 0;
 }
 
@@ -176,6 +178,7 @@ int run_factors(const FactorsArgs& a) {
       scene = load(a.scene, a.strict, a.photometric, {false, a.reverse_winding});
     }
     print_load_notes(scene);
+    std::string method = a.method;  // "auto" at the group level becomes "ray-cast" (below)
     rad::ViewFactorOptions o;
     if (a.method == "hierarchical") {
       o.method = rad::ViewFactorMethod::hierarchical;
@@ -203,6 +206,12 @@ int run_factors(const FactorsArgs& a) {
       chosen += std::string(chosen.empty() ? "" : ", ") + "correction enclosure (the file's control line says encl=1)";
     }
     if (!chosen.empty()) std::fprintf(stderr, "factors: %s\n", chosen.c_str());
+    // The group level's estimators have no automatic choice of their own: "auto" is ray-cast
+    // there (element rows, occlusion by rays), named so in the summary and the JSON.
+    if (method == "auto" && level == "group") {
+      method = "ray-cast";
+      o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    }
     o.level = level == "polygon" ? rad::ViewFactorLevel::polygon
               : level == "element" ? rad::ViewFactorLevel::element
                                      : rad::ViewFactorLevel::group;
@@ -275,7 +284,7 @@ int run_factors(const FactorsArgs& a) {
       control.enclosure = o.correction == rad::ViewFactorCorrection::enclosure;
       text = view3d_output(m, view3d_emissivities(scene, m), control);
     } else if (o.level == rad::ViewFactorLevel::group)
-      text = a.format == "json" ? factors_json(v, a.sparse, a.method) : factors_csv(v, a.sparse);
+      text = a.format == "json" ? factors_json(v, a.sparse, method) : factors_csv(v, a.sparse);
     else
       text = a.format == "json" ? matrix_json(m, o.correction) : a.format == "mtx" ? matrix_market(m) : matrix_csv(m);
     if (a.format == "view3d" && control.output_format == 1 && (a.output.empty() || a.output == "-"))
@@ -290,7 +299,7 @@ int run_factors(const FactorsArgs& a) {
     const std::string links = v.link_count > 0 ? " (" + std::to_string(v.link_count) + " links)" : "";
     if (o.level == rad::ViewFactorLevel::group && !matrix) {
       std::fprintf(stderr, "factors: %zu groups, %zu patches, %zu source elements, %s%s, %.3f s%s%s\n",
-                   v.groups.size(), v.patch_count, v.element_count, a.method.c_str(), links.c_str(), v.seconds,
+                   v.groups.size(), v.patch_count, v.element_count, method.c_str(), links.c_str(), v.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
     } else {
       const std::string processes_text =
@@ -298,6 +307,8 @@ int run_factors(const FactorsArgs& a) {
       std::fprintf(stderr, "factors: %zu %ss, %zu factors, %zu source elements, %s%s, %.3f s%s%s\n", m.rows(),
                    level.c_str(), m.non_zeros(), m.element_count, m.method.c_str(), processes_text.c_str(), m.seconds,
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
+      if (!m.method_reason.empty())
+        std::fprintf(stderr, "factors: %s (%s; --method overrides)\n", m.method.c_str(), m.method_reason.c_str());
       for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: factors: %s\n", w.c_str());
       // Rows that see no surface: polygons lying against another, in contact (per polygon,
       // told apart: a box's bottom on a floor, hidden as it should be); polygons that see only
