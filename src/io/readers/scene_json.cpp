@@ -668,6 +668,12 @@ void SceneReader::surface(const json& j, const std::string& loc, Scene& scene) c
 
 Scene SceneReader::read(const json& root) {
   object(root, "", {"version", "camera", "materials", "surfaces", "lights"});
+  // Required, so that a file of a later version is never read as this one; the message says
+  // what to write (a first file written by hand lacks it).
+  if (!find(root, "version"))
+    fail(ErrorCode::parse_error, "version",
+         "missing (required: the format version; this library reads " + std::to_string(kFormatVersion) +
+             ", so begin the object with \"version\": " + std::to_string(kFormatVersion) + ")");
   const json& version = require(root, "", "version");
   if (!version.is_number_integer() || version.get<long long>() != kFormatVersion)
     fail(ErrorCode::parse_error, "version",
