@@ -63,7 +63,7 @@ Block compute_block(const Scene& scene, const ViewFactorOptions& options, const 
   Block block;
   detail::collectively(comm, [&] {
     if (scene.polygons().empty()) throw Error(ErrorCode::invalid_scene, "view_factor_matrix: the scene has no polygons");
-    const FormFactorOptions ff = detail::view_factor_estimator_options(options);
+    detail::view_factor_estimator_options(options);  // throws for options out of range, as view_factor_matrix()
     if (options.method == ViewFactorMethod::hierarchical && !(options.epsilon > 0.0f && options.epsilon <= 1.0f))
       throw Error(ErrorCode::invalid_argument,
                   "view_factor_matrix: epsilon must be in (0, 1], got " + std::to_string(options.epsilon));
@@ -76,8 +76,9 @@ Block compute_block(const Scene& scene, const ViewFactorOptions& options, const 
     block.total_rows = rows.rows();
     const std::size_t first = block.offsets[static_cast<std::size_t>(comm.rank())];
     const std::size_t last = cancelled ? first : block.offsets[static_cast<std::size_t>(comm.rank()) + 1];
+    // compute() names the method that ran, and why when FormFactorMethod::automatic chose it
+    // (the same choice on every process: the estimate's pairs come from the seed's stream).
     rows.compute(first, last, gate, block.rows);
-    block.rows.method = options.method == ViewFactorMethod::hierarchical ? "hierarchical" : to_string(ff.method);
     block.rows.cancelled = block.rows.cancelled || cancelled;
   });
   block.rows.cancelled = comm.any(block.rows.cancelled);
@@ -149,6 +150,7 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
   }
   out.level = own.level;
   out.method = own.method;
+  out.method_reason = own.method_reason;
   out.row_offsets.assign(counts.size() + 1, 0);
   for (std::size_t i = 0; i < counts.size(); ++i) out.row_offsets[i + 1] = out.row_offsets[i] + counts[i];
   for (const std::uint64_t e : elements) out.element_count += static_cast<std::size_t>(e);

@@ -13,6 +13,7 @@
 #include <radiosity/mpi.hpp>
 #include <radiosity/radiosity.hpp>
 
+#include "city.hpp"
 #include "support/scenes.hpp"
 
 namespace {
@@ -68,6 +69,7 @@ void check_same_matrix(const rad::ViewFactorMatrix& a, const rad::ViewFactorMatr
   CHECK(same(a.sky_standard_error, b.sky_standard_error));
   CHECK(same(a.row_standard_error, b.row_standard_error));
   CHECK(a.method == b.method);
+  CHECK(a.method_reason == b.method_reason);
   CHECK(a.element_count == b.element_count);
   CHECK(a.cancelled == b.cancelled);
   CHECK(a.correction.reciprocity_before == b.correction.reciprocity_before);
@@ -196,6 +198,26 @@ TEST_SUITE("mpi") {
     check_view_factors(scene, coarse(factor_options(rad::ViewFactorLevel::element, mc)));
     // The group level is not split: rank 0 computes it.
     check_view_factors(scene, coarse(factor_options(rad::ViewFactorLevel::group, rad::FormFactorMethod::monte_carlo)));
+  }
+
+  TEST_CASE("mpi view factors, automatic: every process makes the single process's choice - the exact mode for the "
+            "Cornell box, Monte Carlo rows for a city - and the rows are its bit for bit") {
+    rad::ViewFactorOptions o = factor_options(rad::ViewFactorLevel::polygon, rad::FormFactorMethod::automatic);
+    o.mesh.max_patch_area = o.mesh.max_element_area = 1e30f;
+    check_view_factors(rad::cornell_box(), o);
+    // The benchmark city of 3 x 3 blocks: the exact mode would take minutes (found under MPI:
+    // the merged matrix was named ray-cast and lost its rows' standard errors).
+    bench::CityOptions city;
+    city.blocks = 3;
+    city.facet_size = 2.25;
+    o.form_factors.hemisphere_rays = 16;
+    const rad::Scene scene = bench::city(city).scene;
+    const rad::ViewFactorMatrix split = rad::mpi::view_factor_matrix(scene, o, MPI_COMM_WORLD);
+    CHECK(split.method == "monte-carlo");  // every process's block too
+    CHECK(split.method_reason.rfind("automatic: the exact mode would take about ", 0) == 0);
+    CHECK(split.row_standard_error.size() == split.rows());
+    // Rank 0 holds the merged matrix: the single process's (23 454 rows, so once, not per rank).
+    if (rank() == 0) check_same_matrix(split, rad::view_factor_matrix(scene, o));
   }
 
   TEST_CASE("mpi view factors from the hierarchical links per polygon are the single process's bit for bit") {
