@@ -336,8 +336,10 @@ int run_factors(const FactorsArgs& a) {
         else
           ++blind;
       }
-      const bool outward = sky_only > 0 && level == "polygon" &&
-                           rad::find_polygons_facing_outward(scene, overlaps).looks_wound_outward();
+      // (At the element level the overlaps were not searched: the judgement searches them.)
+      const bool outward = sky_only > 0 && (touching.empty() ? rad::find_polygons_facing_outward(scene)
+                                                             : rad::find_polygons_facing_outward(scene, overlaps))
+                                               .looks_wound_outward();
       if (outward)
         std::fprintf(stderr,
                      "warning: factors: %zu of %zu rows see no surface in front of them, only the sky, and most of the "
