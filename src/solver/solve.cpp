@@ -384,8 +384,12 @@ Problem::Impl::Impl(const Scene& s, const SolveOptions& given, const detail::Com
     for (std::string& w : detail::z_fighting_warnings(scene, meshing_progress ? poll : detail::KeepGoing()))
       warnings.push_back(std::move(w));
     // A face of a mesh wound against its neighbours comes out black with no other sign.
-    for (std::string& w : detail::inconsistent_winding_warnings(scene, find_inconsistent_winding(scene)))
-      warnings.push_back(std::move(w));
+    // (Not after a cancel seen by the overlap search: the callback is called no more then.)
+    if (!meshing_cancelled) {
+      const InconsistentWinding inconsistent =
+          detail::inconsistent_winding(scene, meshing_progress ? poll : detail::KeepGoing());
+      for (std::string& w : detail::inconsistent_winding_warnings(scene, inconsistent)) warnings.push_back(std::move(w));
+    }
   }
   if (!meshing_cancelled)
     hierarchy = meshing_progress ? PatchHierarchy(scene, o.mesh, meshing_progress) : PatchHierarchy(scene, o.mesh);
