@@ -50,7 +50,7 @@ def test_enclosure_correction_closes_rows_and_keeps_reciprocity(cube):
     assert info["correction"]["name"] == "enclosure"
     assert info["correction"]["row_sum_error_before"] < 5e-3
     assert info["seconds"] >= 0 and not info["cancelled"]
-    assert info["warnings"] == []
+    assert info["warnings"] == [] and info["notes"] == []
 
 
 def test_reciprocity_correction_and_float32_values(cube):
@@ -106,3 +106,12 @@ def test_view_factor_errors(cube):
         radiosity.view_factor_matrix(cube, groups=["nowhere"])
     with pytest.raises(radiosity.Error):
         radiosity.view_factor_matrix(cube, method="monte-carlo", hemisphere_rays=1)
+
+
+def test_rows_that_see_no_surface_are_told_apart(data_dir):
+    # A block standing on a ground (an STL, z up): its roof sees only the sky (a note, not a
+    # warning: the model is not wound outward), its bottom lies on the ground (in contact).
+    scene = radiosity.load_scene(str(data_dir / "ground_zup.stl"))
+    _, info = radiosity.view_factor_matrix(scene, return_info=True)
+    assert info["warnings"] == []
+    assert any(n.startswith("2 rows see only the sky") for n in info["notes"])

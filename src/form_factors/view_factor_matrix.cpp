@@ -94,10 +94,12 @@ std::vector<std::uint32_t> selected_polygons(const Scene& scene, const std::vect
 /// (and the sky through that room's windows).
 class PressedPoints {
  public:
-  PressedPoints(const Scene& scene, const detail::RayScene& occluders, float lift)
+  /// `overlaps`: find_overlaps(scene).
+  PressedPoints(const Scene& scene, const std::vector<PolygonOverlap>& overlaps, const detail::RayScene& occluders,
+                float lift)
       : scene_(scene), occluders_(occluders), lift_(lift), first_(scene.polygons().size() + 1, 0) {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
-    for (const PolygonOverlap& o : find_overlaps(scene)) {
+    for (const PolygonOverlap& o : overlaps) {
       if (!o.lying_against()) continue;
       pairs.emplace_back(o.first, o.second);
       pairs.emplace_back(o.second, o.first);
@@ -149,15 +151,17 @@ class PressedPoints {
 /// Reports progress through `gate` between blocks of elements, from `done` (a fraction of
 /// Phase::form_factors already reported) to 1; returns false when cancelled (out.sky is then
 /// left empty).
-/// Rows [row_begin, row_end) of `first` only, into out.sky[r - row_begin].
-bool row_sky(const Scene& scene, const PatchHierarchy& hierarchy, const std::vector<std::uint32_t>& sources,
-             const std::vector<std::uint64_t>& first, std::size_t row_begin, std::size_t row_end,
-             const FormFactorOptions& ff, detail::ProgressGate& gate, double done, ViewFactorMatrix& out) {
+/// Rows [row_begin, row_end) of `first` only, into out.sky[r - row_begin]. `overlaps`:
+/// find_overlaps(scene).
+bool row_sky(const Scene& scene, const std::vector<PolygonOverlap>& overlaps, const PatchHierarchy& hierarchy,
+             const std::vector<std::uint32_t>& sources, const std::vector<std::uint64_t>& first, std::size_t row_begin,
+             std::size_t row_end, const FormFactorOptions& ff, detail::ProgressGate& gate, double done,
+             ViewFactorMatrix& out) {
   const std::size_t rows = row_end - row_begin;
   const std::size_t element_begin = first[row_begin], element_end = first[row_end];
   const detail::RayScene occluders = detail::RayScene::from_polygons(scene);
   const float epsilon = 1e-5f * std::max(scene.bounds().diagonal(), 1e-6f);
-  const PressedPoints pressed(scene, occluders, epsilon);
+  const PressedPoints pressed(scene, overlaps, occluders, epsilon);
   const std::uint32_t n = ff.hemisphere_rays;
   std::vector<double> escaped(element_end - element_begin, 0.0);  // per source of the rows
   // Elements [begin, end) of `sources`: their fractions of rays that meet nothing.
@@ -294,14 +298,16 @@ constexpr double kExactWorkSeconds = 0.2e-6;
 /// Pairs the estimate integrates (all of them when there are fewer).
 constexpr std::size_t kCostSample = 4096;
 
-/// What the exact mode would cost on the rows `ids`: each unordered pair once, a sample of them
-/// integrated (`seed`'s stream, so the same choice on every run and every MPI process).
+/// What the exact mode would cost on the rows `ids` (polygons of `transport`'s scene): each
+/// unordered pair once, a sample of them integrated (`seed`'s stream, so the same choice on every
+/// run and every MPI process).
 struct ExactCost {
   double pairs = 0.0;       ///< unordered pairs of rows
   std::size_t sampled = 0;  ///< pairs integrated to estimate
   double seconds = 0.0;     ///< thread time, estimated
 };
-ExactCost exact_cost(const Scene& scene, const std::vector<std::uint32_t>& ids, std::uint64_t seed, unsigned threads) {
+ExactCost exact_cost(const detail::ExactPolygonTransport& transport, const std::vector<std::uint32_t>& ids,
+                     std::uint64_t seed, unsigned threads) {
   ExactCost cost;
   const std::size_t n = ids.size();
   cost.pairs = 0.5 * static_cast<double>(n) * static_cast<double>(n > 0 ? n - 1 : 0);
@@ -319,7 +325,6 @@ ExactCost exact_cost(const Scene& scene, const std::vector<std::uint32_t>& ids, 
       sample.emplace_back(ids[r], ids[c]);
     }
   }
-  const detail::ExactPolygonTransport transport(scene);
   std::vector<std::uint64_t> work(sample.size(), 0);
   detail::parallel_for(threads, sample.size(), 64, [&](std::size_t begin, std::size_t end) {
     const auto w = transport.workspace();
@@ -337,15 +342,14 @@ ExactCost exact_cost(const Scene& scene, const std::vector<std::uint32_t>& ids, 
 }
 
 /// Rows [begin, end) of the exact mode (exact_view_factors.hpp) between the polygons `ids` of
-/// `scene` (row and column r: polygon ids[r]), into out.row_offsets, columns and values: each
+/// `transport`'s scene (row and column r: polygon ids[r]), into out.row_offsets, columns and values: each
 /// unordered pair once, F(r -> c) = G_rc / A_r. A pair with both rows in the block is
 /// integrated by its lower row; a pair with one outside by this block (and by the other's, to
 /// the same bits). Rows are integrated in parallel, a chunk at a time between progress reports;
 /// returns false when `gate` cancels (every row of the block is then left empty).
-bool exact_rows(const Scene& scene, const std::vector<std::uint32_t>& ids, const std::vector<double>& area,
-                std::size_t begin, std::size_t end, unsigned threads, std::size_t memory_budget,
-                detail::ProgressGate& gate, double share, ViewFactorMatrix& out) {
-  const detail::ExactPolygonTransport transport(scene);
+bool exact_rows(const detail::ExactPolygonTransport& transport, const std::vector<std::uint32_t>& ids,
+                const std::vector<double>& area, std::size_t begin, std::size_t end, unsigned threads,
+                std::size_t memory_budget, detail::ProgressGate& gate, double share, ViewFactorMatrix& out) {
   const std::size_t n = ids.size(), rows = end - begin;
   std::vector<std::vector<std::uint32_t>> columns(rows);
   std::vector<std::vector<float>> transports(rows);
@@ -466,6 +470,9 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
   ViewFactorMatrix out;
   out.level = options.level;
   out.row_offsets.assign(1, 0);
+  // find_overlaps(scene) once (0.5 s at 246k polygons), for the sky, the warnings and the notes;
+  // left empty at the element level, where the rows are a scene of their own.
+  std::vector<PolygonOverlap> overlaps;
   if (options.level == ViewFactorLevel::group) {
     const GroupViewFactors g = view_factors(scene, options);
     const std::size_t n = g.groups.size();
@@ -504,7 +511,8 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
         if (row_of(e) != kNone) sources[at[row_of(e)]++] = e;
       // view_factors() reported its rows; the sky's rays report at the end, and may cancel.
       detail::ProgressGate gate(options.on_progress);
-      out.cancelled = !row_sky(scene, hierarchy, sources, first, 0, n, ff, gate, 1.0, out);
+      overlaps = find_overlaps(scene);
+      out.cancelled = !row_sky(scene, overlaps, hierarchy, sources, first, 0, n, ff, gate, 1.0, out);
     }
   } else {
     detail::ProgressGate gate(options.on_progress);
@@ -516,9 +524,11 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
       const detail::ViewFactorRows rows(scene, options, &options.on_progress);
       out.cancelled = rows.cancelled();
       if (!out.cancelled) rows.compute(0, rows.rows(), gate, out);
+      if (options.level == ViewFactorLevel::polygon) overlaps = rows.overlaps();
     }
   }
-  detail::finish_view_factor_matrix(scene, options, out);
+  detail::finish_view_factor_matrix(scene, options,
+                                    options.level == ViewFactorLevel::element ? nullptr : &overlaps, out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
@@ -560,6 +570,10 @@ struct ViewFactorRows::Impl {
   std::vector<std::uint64_t> first;
   bool cancelled = false;  ///< the meshing callback said stop
   std::string reason;      ///< why FormFactorMethod::automatic chose ff.method (empty when it was given)
+  std::vector<PolygonOverlap> overlaps;  ///< find_overlaps(*scene)
+  /// The exact mode's occluders and pairs, made once for the automatic choice's estimate and the
+  /// rows (null unless the exact mode runs).
+  std::unique_ptr<const ExactPolygonTransport> exact;
 };
 
 ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options, const ProgressFn* meshing)
@@ -606,10 +620,12 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
   for (std::size_t p = 0; p < polygons; ++p)
     if (row_of[p] != kNone) m.ids.push_back(static_cast<std::uint32_t>(p));
   const std::size_t rows = m.ids.size();
+  if (!m.links && m.ff.method == FormFactorMethod::ray_cast)
+    m.exact = std::make_unique<const ExactPolygonTransport>(*m.scene);
   if (automatic) {
     // The exact mode where it takes seconds, Monte Carlo rows where it would take minutes
     // (kAutomaticExactSeconds); the reason goes to ViewFactorMatrix::method_reason.
-    const ExactCost cost = exact_cost(*m.scene, m.ids, m.ff.seed, m.ff.threads);
+    const ExactCost cost = exact_cost(*m.exact, m.ids, m.ff.seed, m.ff.threads);
     char text[320];
     if (cost.seconds <= kAutomaticExactSeconds) {
       std::snprintf(text, sizeof text,
@@ -619,6 +635,7 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
                     cost.sampled);
     } else {
       m.ff.method = FormFactorMethod::monte_carlo;
+      m.exact.reset();
       std::snprintf(text, sizeof text,
                     "automatic: the exact mode would take about %.2g s of thread time for %.3g M pairs of %s (estimated "
                     "from %zu of them), over the %.0f s the automatic choice allows; Monte Carlo rows of %u rays per "
@@ -655,6 +672,7 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
     const std::uint32_t r = row_of[patches[hierarchy.element(e).patch].polygon];
     if (r != kNone) m.sources[at[r]++] = e;
   }
+  m.overlaps = find_overlaps(*m.scene);
 }
 
 ViewFactorRows::~ViewFactorRows() = default;
@@ -663,6 +681,7 @@ std::size_t ViewFactorRows::rows() const { return impl_->ids.size(); }
 bool ViewFactorRows::cancelled() const { return impl_->cancelled; }
 
 const std::vector<std::uint64_t>& ViewFactorRows::source_offsets() const { return impl_->first; }
+const std::vector<PolygonOverlap>& ViewFactorRows::overlaps() const { return impl_->overlaps; }
 
 void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& gate, ViewFactorMatrix& out) const {
   const Impl& m = *impl_;
@@ -699,9 +718,9 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   if (!m.links && m.ff.method == FormFactorMethod::ray_cast) {
     // The exact mode: polygon pairs integrated once, without rays (exact_view_factors.hpp).
     out.cancelled =
-        !exact_rows(*m.scene, m.ids, m.area, begin, end, m.ff.threads, m.memory_budget, gate, rows_share, out);
+        !exact_rows(*m.exact, m.ids, m.area, begin, end, m.ff.threads, m.memory_budget, gate, rows_share, out);
     if (!out.cancelled)
-      out.cancelled = !row_sky(*m.scene, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
+      out.cancelled = !row_sky(*m.scene, m.overlaps, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
     return;
   }
   // The element rows: the estimator's, or the links' (refined over the whole scene, so every
@@ -793,7 +812,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
     }
   }
   if (!out.cancelled)
-    out.cancelled = !row_sky(*m.scene, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
+    out.cancelled = !row_sky(*m.scene, m.overlaps, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
 }
 
 void fill_missing_sky(ViewFactorMatrix& m) {
@@ -802,7 +821,63 @@ void fill_missing_sky(ViewFactorMatrix& m) {
   m.sky_standard_error.assign(m.rows(), 0.0);
 }
 
-void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options, ViewFactorMatrix& out) {
+namespace {
+
+/// The rows of `m` that see no surface, told apart, into m.warnings and m.notes: at the polygon
+/// level, polygons lying against others in contact (a box's bottom on a floor: hidden, as they
+/// should be); rows that see only the sky (a roof above everything else in an open scene, or,
+/// when find_polygons_facing_outward() judges most of the model wound outward as `check` does,
+/// a warning); and rows that see nothing at all. `overlaps`: find_overlaps(scene), or null.
+void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>* overlaps, ViewFactorMatrix& m) {
+  bool any_empty = false;
+  for (std::size_t i = 0; i < m.rows() && !any_empty; ++i) any_empty = m.row_offsets[i + 1] == m.row_offsets[i];
+  if (!any_empty) return;
+  std::vector<PolygonOverlap> searched;
+  if (!overlaps) overlaps = &(searched = find_overlaps(scene));
+  std::vector<bool> touching;
+  if (m.level == ViewFactorLevel::polygon) {
+    touching.assign(scene.polygons().size(), false);
+    for (const PolygonOverlap& p : *overlaps)
+      if (p.lying_against()) touching[p.first] = touching[p.second] = true;
+  }
+  std::size_t blind = 0, in_contact = 0, sky_only = 0;
+  for (std::size_t i = 0; i < m.rows(); ++i) {
+    if (m.row_offsets[i + 1] != m.row_offsets[i]) continue;
+    if (!touching.empty() && touching[m.ids[i]])
+      ++in_contact;
+    else if (i < m.sky.size() && m.sky[i] > 0.0)
+      ++sky_only;
+    else
+      ++blind;
+  }
+  // Judged (32 rays per polygon) only when empty rows are a large part of the matrix: a model
+  // wound outward leaves most rows empty, an open scene a few roofs above the rest.
+  const bool outward = sky_only > 0 && 4 * (sky_only + blind) >= m.rows() &&
+                       find_polygons_facing_outward(scene, *overlaps).looks_wound_outward();
+  const std::string rows = std::to_string(m.rows());
+  if (outward)
+    m.warnings.push_back(std::to_string(sky_only + blind) + " of " + rows +
+                         " rows see no surface in front of them, only the sky, and most of the model looks wound "
+                         "outward (polygons send and receive on their fronts only: --reverse-winding outward turns "
+                         "them over; in code, Scene::reverse_winding() of find_polygons_facing_outward())");
+  else if (sky_only > 0)
+    m.notes.push_back(std::to_string(sky_only) +
+                      " rows see only the sky (no surface in front of them: a roof above the rest)");
+  if (blind > 0 && !outward)
+    m.warnings.push_back(std::to_string(blind) + " of " + rows +
+                         " rows see nothing, neither a surface nor the sky (polygons send and receive on their fronts "
+                         "only: if the scene is closed, its polygons may face outward: --reverse-winding outward turns "
+                         "them over)");
+  if (in_contact > 0)
+    m.notes.push_back(std::to_string(in_contact) +
+                      " rows see nothing because their polygons lie against others, in contact (a box's bottom on a "
+                      "floor): hidden, as they should be");
+}
+
+}  // namespace
+
+void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options,
+                               const std::vector<PolygonOverlap>* overlaps, ViewFactorMatrix& out) {
   if (!out.cancelled && options.correction == ViewFactorCorrection::enclosure) check_enclosure(out, scene);
   if (!out.cancelled) {
     // The links' two directions of a pair were refined and sampled apart: their factors are
@@ -818,14 +893,17 @@ void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& opti
     out.values = std::move(F.values);
   }
   fill_missing_sky(out);
+  if (out.cancelled) return;
+  std::vector<PolygonOverlap> searched;
+  if (!overlaps) overlaps = &(searched = find_overlaps(scene));
   // A polygon modelled twice (McGuire's Cornell box indexes a side of each box again as its
   // "bottom face") is two receivers to the view factors: the exact mode integrates each, so a
   // row that sees them counts that area twice (its sum 1.28 in that box), silently but for this.
-  if (!out.cancelled)
-    out.warnings = z_fighting_warnings(scene, {},
-                                       "each is a surface of its own to the view factors: the exact mode (ray-cast, "
-                                       "the default) counts that area twice in the rows that see it (sums above 1), "
-                                       "the others split it between the two by rounding; remove one of them");
+  out.warnings = z_fighting_warnings(scene, *overlaps,
+                                     "each is a surface of its own to the view factors: the exact mode (ray-cast, what "
+                                     "the automatic choice takes for small scenes) counts that area twice in the rows that see it (sums "
+                                     "above 1), the others split it between the two by rounding; remove one of them");
+  describe_empty_rows(scene, overlaps, out);
 }
 
 }  // namespace radiosity::detail

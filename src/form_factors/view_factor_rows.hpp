@@ -12,6 +12,7 @@
 
 #include "core/progress.hpp"
 #include "radiosity/form_factors.hpp"
+#include "radiosity/scene.hpp"
 
 namespace radiosity::detail {
 
@@ -40,6 +41,9 @@ class ViewFactorRows {
   /// rows() + 1 entries: source_offsets()[r] is the number of source elements of rows [0, r)
   /// (what a block balanced by elements, not rows, splits).
   const std::vector<std::uint64_t>& source_offsets() const;
+  /// find_overlaps() of the scene the rows are computed on: the given scene at the polygon
+  /// level, the scene of its leaf elements at the element level.
+  const std::vector<PolygonOverlap>& overlaps() const;
 
   /// Rows [begin, end) of the matrix into `out`: ids, area, row_offsets (end - begin + 1 of
   /// them, from 0), columns (every row's columns, numbered as the whole matrix's rows), values,
@@ -62,8 +66,11 @@ void fill_missing_sky(ViewFactorMatrix& m);
 
 /// The end of view_factor_matrix() on the whole matrix `m` (of `scene`, made with `options`):
 /// the enclosure check (throws Error{invalid_argument} for a scene that is no enclosure), the
-/// correction options.correction names (with its report). Nothing for a cancelled matrix but
-/// zero skies where they are missing.
-void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options, ViewFactorMatrix& m);
+/// correction options.correction names (with its report), the warnings and notes (z-fighting;
+/// the rows that see no surface, told apart). `overlaps`: find_overlaps(scene) when the caller
+/// has it, else null (then searched here). Nothing for a cancelled matrix but zero skies where
+/// they are missing.
+void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& options,
+                               const std::vector<PolygonOverlap>* overlaps, ViewFactorMatrix& m);
 
 }  // namespace radiosity::detail

@@ -55,6 +55,9 @@ struct Block {
   ViewFactorMatrix rows;
   std::vector<std::size_t> offsets;  ///< rank r's rows are [offsets[r], offsets[r + 1])
   std::size_t total_rows = 0;
+  /// find_overlaps() of the scene at the polygon level (the rows' own), for the end of the
+  /// matrix; empty at the element level, whose rows are a scene of their own.
+  std::vector<PolygonOverlap> overlaps;
 };
 
 /// Checks as view_factor_matrix() does, then computes this process's rows; errors and cancel
@@ -79,10 +82,16 @@ Block compute_block(const Scene& scene, const ViewFactorOptions& options, const 
     // compute() names the method that ran, and why when FormFactorMethod::automatic chose it
     // (the same choice on every process: the estimate's pairs come from the seed's stream).
     rows.compute(first, last, gate, block.rows);
+    if (options.level == ViewFactorLevel::polygon) block.overlaps = rows.overlaps();
     block.rows.cancelled = block.rows.cancelled || cancelled;
   });
   block.rows.cancelled = comm.any(block.rows.cancelled);
   return block;
+}
+
+/// The scene's overlaps when the block has them (the polygon level), else null.
+const std::vector<PolygonOverlap>* polygon_overlaps(const Block& block) {
+  return block.rows.level == ViewFactorLevel::polygon ? &block.overlaps : nullptr;
 }
 
 }  // namespace
@@ -110,7 +119,7 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
     // Nothing gathered: each process keeps what it computed (one process: the whole matrix).
     detail::collectively(comm, [&] {
       if (comm.size() == 1) {
-        detail::finish_view_factor_matrix(scene, options, own);
+        detail::finish_view_factor_matrix(scene, options, polygon_overlaps(block), own);
       } else {
         detail::fill_missing_sky(own);
       }
@@ -154,7 +163,7 @@ ViewFactorMatrix view_factor_matrix(const Scene& scene, const ViewFactorOptions&
   out.row_offsets.assign(counts.size() + 1, 0);
   for (std::size_t i = 0; i < counts.size(); ++i) out.row_offsets[i + 1] = out.row_offsets[i] + counts[i];
   for (const std::uint64_t e : elements) out.element_count += static_cast<std::size_t>(e);
-  detail::collectively(comm, [&] { detail::finish_view_factor_matrix(scene, options, out); });
+  detail::collectively(comm, [&] { detail::finish_view_factor_matrix(scene, options, polygon_overlaps(block), out); });
   out.seconds = seconds();
   return out;
 }

@@ -16,6 +16,7 @@
 #include "render/camera_choice.hpp"
 #include "core/frame.hpp"
 #include "core/text.hpp"
+#include "scene/polygon_math.hpp"
 #include "image/camera.hpp"
 
 namespace radiosity::detail {
@@ -40,9 +41,7 @@ class LightProbe {
                       [](const auto& a, const auto& b) { return a.first > b.first; });
     for (std::size_t k = 0; k < kept; ++k) {
       const Polygon& polygon = polygons[power[k].second];
-      glm::vec3 centroid(0.0f);
-      for (const glm::vec3& v : polygon.vertices) centroid += v;
-      centroid /= static_cast<float>(polygon.vertices.size());
+      const glm::vec3 centroid = vertex_mean(polygon.vertices);
       const bool two_sided = scene.material(polygon.material).two_sided;
       emitters_.push_back(Emitter{centroid, polygon.normal, two_sided});
     }

@@ -478,9 +478,13 @@ std::vector<PolygonOverlap> overlaps(const Scene& scene, const KeepGoing& keep_g
 }  // namespace
 
 std::vector<std::string> z_fighting_warnings(const Scene& scene, const KeepGoing& keep_going, const char* consequence) {
+  return z_fighting_warnings(scene, overlaps(scene, keep_going), consequence);
+}
+
+std::vector<std::string> z_fighting_warnings(const Scene& scene, const std::vector<PolygonOverlap>& found,
+                                             const char* consequence) {
   std::vector<std::string> out;
   std::vector<const PolygonOverlap*> same_facing;
-  const std::vector<PolygonOverlap> found = overlaps(scene, keep_going);
   for (const PolygonOverlap& o : found)
     if (o.z_fighting()) same_facing.push_back(&o);
   if (same_facing.empty()) return out;

@@ -14,6 +14,7 @@
 namespace radiosity {
 inline namespace v1 {
 class Scene;
+struct PolygonOverlap;
 }  // namespace v1
 }  // namespace radiosity
 
@@ -37,6 +38,9 @@ using KeepGoing = std::function<bool()>;
 std::vector<std::string> z_fighting_warnings(
     const Scene& scene, const KeepGoing& keep_going = {},
     const char* consequence = "which of them is in front is decided by rounding; remove one or move them apart");
+/// The same from `overlaps`, find_overlaps(scene)'s result that the caller already has.
+std::vector<std::string> z_fighting_warnings(const Scene& scene, const std::vector<PolygonOverlap>& overlaps,
+                                             const char* consequence);
 
 /// The distance below which two surfaces count as touching in `scene`:
 /// kOverlapRelativeTolerance of its bounding-box diagonal, and at least a few ulps of its

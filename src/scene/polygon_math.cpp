@@ -63,9 +63,7 @@ CleanPolygon clean_polygon(const std::vector<glm::vec3>& input) {
   // "triangulated into 1 triangle" with a warning.
   if (out.vertices.size() == 3) return out;
 
-  glm::vec3 centre(0.0f);
-  for (const glm::vec3& p : out.vertices) centre += p;
-  centre /= static_cast<float>(out.vertices.size());
+  const glm::vec3 centre = vertex_mean(out.vertices);
   for (const glm::vec3& p : out.vertices)
     if (std::fabs(glm::dot(p - centre, out.normal)) > kPlanarityTolerance * out.diameter) out.planar = false;
 

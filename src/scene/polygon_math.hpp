@@ -27,6 +27,14 @@ inline bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfin
 inline bool usable_position(const glm::vec3& v) {
   return std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate && std::fabs(v.z) <= kMaxCoordinate;
 }
+/// The mean of `vertices` (not empty): a point inside a convex polygon, where its warnings place
+/// it and its plane's offset is measured from.
+inline glm::vec3 vertex_mean(const std::vector<glm::vec3>& vertices) {
+  glm::vec3 sum(0.0f);
+  for (const glm::vec3& v : vertices) sum += v;
+  return sum / static_cast<float>(vertices.size());
+}
+
 /// Vertices may leave the best-fit plane by this fraction of the diameter and still be planar.
 inline constexpr float kPlanarityTolerance = 1e-4f;
 

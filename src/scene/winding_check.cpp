@@ -22,6 +22,7 @@
 #include "core/color.hpp"
 #include "core/text.hpp"
 #include "form_factors/pass1_material.hpp"
+#include "scene/polygon_math.hpp"
 
 namespace radiosity::detail {
 
@@ -68,9 +69,7 @@ std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const
   if (found.polygons.empty()) return warnings;
   const PolygonId first = found.polygons.front();
   const Polygon& p = scene.polygons()[first];
-  glm::vec3 centre(0.0f);
-  for (const glm::vec3& v : p.vertices) centre += v;
-  centre /= static_cast<float>(p.vertices.size());
+  const glm::vec3 centre = vertex_mean(p.vertices);
   char area[32];
   std::snprintf(area, sizeof area, "%.3g", found.area);
   warnings.push_back(std::to_string(found.polygons.size()) + " polygon" + (found.polygons.size() == 1 ? " is" : "s are") +
@@ -153,9 +152,7 @@ InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& ke
   // The unit direction from edge (lo, hi) into polygon p, in its plane.
   auto inward = [&](PolygonId id, const glm::vec3& lo, const glm::vec3& hi) {
     const Polygon& p = polygons[id];
-    glm::vec3 centre(0.0f);
-    for (const glm::vec3& v : p.vertices) centre += v;
-    centre /= static_cast<float>(p.vertices.size());
+    const glm::vec3 centre = vertex_mean(p.vertices);
     const glm::vec3 along = glm::normalize(hi - lo), to = centre - lo;
     const glm::vec3 across = to - glm::dot(to, along) * along;
     const float length = glm::length(across);

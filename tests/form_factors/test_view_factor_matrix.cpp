@@ -234,7 +234,7 @@ TEST_SUITE("form_factors") {
     MESSAGE(got.warnings[0]);
     CHECK(got.warnings[0].find("polygon 1 (group 'x1') and polygon 6 (group 'x1 again') are coincident and face the "
                                "same way (z-fighting)") == 0);
-    CHECK(got.warnings[0].find("the exact mode (ray-cast, the default) counts that area twice") != std::string::npos);
+    CHECK(got.warnings[0].find("the exact mode (ray-cast, what the automatic choice takes for small scenes) counts that area twice") != std::string::npos);
     const double opposite = 0.1998249, adjacent = 0.2000438;  // Howell C-11, C-14
     CHECK(row_sum(got, 0) == doctest::Approx(1.0 + opposite).epsilon(1e-4));  // x0 sees x1 twice
     CHECK(row_sum(got, 2) == doctest::Approx(1.0 + adjacent).epsilon(1e-4));  // y0 too
@@ -407,6 +407,24 @@ TEST_SUITE("form_factors") {
       // The ground: the box hides 4 of its 100 m^2 and some of the sky of the rest.
       CHECK(v.sky[0] > 0.8);
       CHECK(v.sky[0] < 0.96);
+      // The two empty rows, told apart: the roof sees only the sky, the bottom lies in contact;
+      // neither is a warning (the model is not wound outward).
+      CHECK(v.warnings.empty());
+      REQUIRE(v.notes.size() == 2);
+      CHECK(v.notes[0] == "1 rows see only the sky (no surface in front of them: a roof above the rest)");
+      CHECK(v.notes[1].rfind("1 rows see nothing because their polygons lie against others, in contact", 0) == 0);
+    }
+    // The same box alone (add_box() winds it outward, as a solid): every row sees only the sky,
+    // and the model looks wound outward (find_polygons_facing_outward()), which is a warning.
+    {
+      rad::Scene outward;
+      rad::add_box(outward, {-1, -1, 0}, {1, 1, 2}, outward.add_material(rad::Material{}), "box");
+      const rad::ViewFactorMatrix v = rad::view_factor_matrix(outward, o);
+      CHECK(v.notes.empty());
+      REQUIRE(v.warnings.size() == 1);
+      CHECK(v.warnings[0].rfind("6 of 6 rows see no surface in front of them, only the sky, and most of the model looks "
+                                "wound outward",
+                                0) == 0);
     }
 
     // Two rooms without ceilings, modelled as separate boxes: the wall between them is two

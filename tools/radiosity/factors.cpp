@@ -309,57 +309,10 @@ int run_factors(const FactorsArgs& a) {
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
       if (!m.method_reason.empty())
         std::fprintf(stderr, "factors: %s (%s; --method overrides)\n", m.method.c_str(), m.method_reason.c_str());
+      // The library's warnings (z-fighting; rows that see no surface where that looks wrong) and
+      // notes (rows in contact, rows that see only the sky).
       for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: factors: %s\n", w.c_str());
-      // Rows that see no surface: polygons lying against another, in contact (per polygon,
-      // told apart: a box's bottom on a floor, hidden as it should be); polygons that see only
-      // the sky (a roof above everything else, in an open scene); and the rest, which see
-      // nothing at all. Most of a closed model seeing only the sky is a model wound outward:
-      // find_polygons_facing_outward() judges that, as `check` does.
-      std::size_t blind = 0, in_contact = 0, sky_only = 0;
-      std::vector<bool> touching;
-      std::vector<rad::PolygonOverlap> overlaps;
-      // The overlap search (0.5 s at 246k polygons) only when some row is empty.
-      bool any_empty = false;
-      for (std::size_t i = 0; i < m.rows() && !any_empty; ++i) any_empty = m.row_offsets[i + 1] == m.row_offsets[i];
-      if (level == "polygon" && any_empty) {
-        overlaps = rad::find_overlaps(scene);
-        touching.assign(scene.polygons().size(), false);
-        for (const rad::PolygonOverlap& p : overlaps)
-          if (p.lying_against()) touching[p.first] = touching[p.second] = true;
-      }
-      for (std::size_t i = 0; i < m.rows(); ++i) {
-        if (m.row_offsets[i + 1] != m.row_offsets[i]) continue;
-        if (!touching.empty() && touching[m.ids[i]])
-          ++in_contact;
-        else if (i < m.sky.size() && m.sky[i] > 0.0)
-          ++sky_only;
-        else
-          ++blind;
-      }
-      // (At the element level the overlaps were not searched: the judgement searches them.)
-      const bool outward = sky_only > 0 && (touching.empty() ? rad::find_polygons_facing_outward(scene)
-                                                             : rad::find_polygons_facing_outward(scene, overlaps))
-                                               .looks_wound_outward();
-      if (outward)
-        std::fprintf(stderr,
-                     "warning: factors: %zu of %zu rows see no surface in front of them, only the sky, and most of the "
-                     "model looks wound outward (polygons send and receive on their fronts only: --reverse-winding "
-                     "outward turns them over)\n",
-                     sky_only + blind, m.rows());
-      else if (sky_only > 0)
-        std::fprintf(stderr, "factors: %zu rows see only the sky (no surface in front of them: a roof above the rest)\n",
-                     sky_only);
-      if (blind > 0 && !outward)
-        std::fprintf(stderr,
-                     "warning: factors: %zu of %zu rows see nothing, neither a surface nor the sky (polygons send and "
-                     "receive on their fronts only: if the scene is closed, its polygons may face outward: "
-                     "--reverse-winding outward turns them over)\n",
-                     blind, m.rows());
-      if (in_contact > 0)
-        std::fprintf(stderr,
-                     "factors: %zu rows see nothing because their polygons lie against others, in contact (a box's "
-                     "bottom on a floor): hidden, as they should be\n",
-                     in_contact);
+      for (const std::string& n : m.notes) std::fprintf(stderr, "factors: %s\n", n.c_str());
       const rad::ViewFactorCorrectionReport& c = m.correction;
       std::fprintf(stderr,
                    "factors: before correction: reciprocity error up to %.3g, row sums off by up to %.3g (rms %.3g)\n",
