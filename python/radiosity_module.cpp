@@ -648,9 +648,9 @@ scene units^2); 'sky' (per row: the sky view factor, the part of the hemisphere 
 polygon lies, estimated by rays; not 1 - row sum);
 'row_standard_error' (per row, Monte Carlo; None for the other methods); 'correction' (dict:
 name, reciprocity_before, row_sum_error_before, row_sum_rms_before, largest_change, rms_change,
-empty_rows, clamped, iterations); 'warnings' (list of str: z-fighting polygons, rows that see
-nothing or only the sky in a model wound outward); 'notes' (list of str: rows in contact, rows
-that see only the sky); 'method' (the estimator that ran); 'method_reason' (why, when 'auto'
+empty_rows, clamped, iterations); 'warnings' (list of str: z-fighting polygons, polygons wound
+against their neighbours, rows that see only the sky in a model wound outward); 'notes' (list of
+str: rows in contact, rows that see only the sky, covered rows that see nothing); 'method' (the estimator that ran); 'method_reason' (why, when 'auto'
 chose it; else empty); 'element_count';
 'seconds'; 'cancelled' (the progress callback stopped it: rows are incomplete).
 

@@ -391,13 +391,15 @@ struct ViewFactorMatrix {
   ViewFactorCorrectionReport correction;
   /// What the caller should know about the result, one line each: polygons that are coincident
   /// and face the same way (z-fighting: a polygon modelled twice), which the exact mode counts
-  /// twice in the rows that see them; rows that see no surface, only the sky, in a model that
-  /// looks wound outward (find_polygons_facing_outward()); rows that see nothing at all, neither
-  /// a surface nor the sky.
+  /// twice in the rows that see them; polygons wound against the surface they belong to
+  /// (find_inconsistent_winding()), whose rows look the wrong way; rows that see no surface, only
+  /// the sky, in a model that looks wound outward (find_polygons_facing_outward()).
   std::vector<std::string> warnings;
-  /// What may surprise the caller but is right, one line each: rows that see no surface because
-  /// their polygons lie against others in contact (polygon level: a box's bottom on a floor), and
-  /// rows that see only the sky (a roof above everything else, in a model not wound outward).
+  /// What may surprise the caller but is most often right, one line each: rows that see no
+  /// surface because their polygons lie against others in contact (polygon level: a box's bottom
+  /// on a floor), rows that see only the sky (a roof above everything else, in a model not wound
+  /// outward), and rows that see nothing at all, neither a surface nor the sky (covered: a floor
+  /// under a block without a bottom face).
   std::vector<std::string> notes;
   std::string method;              ///< the estimator's name as the command line spells it
   /// Why, when FormFactorMethod::automatic chose it (empty otherwise): at the polygon and element

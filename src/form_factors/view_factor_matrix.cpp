@@ -37,6 +37,7 @@
 #include "form_factors/view_factor_correction.hpp"
 #include "form_factors/view_factor_rows.hpp"
 #include "scene/overlap.hpp"
+#include "scene/winding_check.hpp"
 #include "solver/hierarchical/link_view_factors.hpp"
 #include "radiosity/form_factors.hpp"
 
@@ -827,7 +828,7 @@ namespace {
 /// level, polygons lying against others in contact (a box's bottom on a floor: hidden, as they
 /// should be); rows that see only the sky (a roof above everything else in an open scene, or,
 /// when find_polygons_facing_outward() judges most of the model wound outward as `check` does,
-/// a warning); and rows that see nothing at all. `overlaps`: find_overlaps(scene), or null.
+/// a warning); and rows that see nothing at all (covered). `overlaps`: find_overlaps(scene).
 void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>* overlaps, ViewFactorMatrix& m) {
   bool any_empty = false;
   for (std::size_t i = 0; i < m.rows() && !any_empty; ++i) any_empty = m.row_offsets[i + 1] == m.row_offsets[i];
@@ -863,11 +864,13 @@ void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>* 
   else if (sky_only > 0)
     m.notes.push_back(std::to_string(sky_only) +
                       " rows see only the sky (no surface in front of them: a roof above the rest)");
+  // What stands in front of such a row shows it only its back: most often it is covered (a floor
+  // under a block without a bottom face, the ground under a building), hidden as it should be.
   if (blind > 0 && !outward)
-    m.warnings.push_back(std::to_string(blind) + " of " + rows +
-                         " rows see nothing, neither a surface nor the sky (polygons send and receive on their fronts "
-                         "only: if the scene is closed, its polygons may face outward: --reverse-winding outward turns "
-                         "them over)");
+    m.notes.push_back(std::to_string(blind) + " of " + rows +
+                      " rows see nothing, neither a surface nor the sky: what lies in front of them shows them its "
+                      "back (a floor under a block without a bottom face: hidden, as it should be; if not, check the "
+                      "winding)");
   if (in_contact > 0)
     m.notes.push_back(std::to_string(in_contact) +
                       " rows see nothing because their polygons lie against others, in contact (a box's bottom on a "
@@ -903,6 +906,10 @@ void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& opti
                                      "each is a surface of its own to the view factors: the exact mode (ray-cast, what "
                                      "the automatic choice takes for small scenes) counts that area twice in the rows that see it (sums "
                                      "above 1), the others split it between the two by rounding; remove one of them");
+  // A polygon wound against the surface it belongs to looks the wrong way: its row is wrong,
+  // silently but for this (solve() says the same of its light).
+  for (std::string& w : inconsistent_winding_warnings(scene, inconsistent_winding(scene, {}), true))
+    out.warnings.push_back(std::move(w));
   describe_empty_rows(scene, overlaps, out);
 }
 

@@ -64,7 +64,8 @@ struct EdgeRecord {
 
 bool has_sides(const Material& m) { return !pass1_has_back(m) && !(max_channel(m.transmittance) > 0.0f); }
 
-std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const InconsistentWinding& found) {
+std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const InconsistentWinding& found,
+                                                       bool for_view_factors) {
   std::vector<std::string> warnings;
   if (found.polygons.empty()) return warnings;
   const PolygonId first = found.polygons.front();
@@ -72,17 +73,26 @@ std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const
   const glm::vec3 centre = vertex_mean(p.vertices);
   char area[32];
   std::snprintf(area, sizeof area, "%.3g", found.area);
-  warnings.push_back(std::to_string(found.polygons.size()) + " polygon" + (found.polygons.size() == 1 ? " is" : "s are") +
-                     " wound opposite to the polygons " + (found.polygons.size() == 1 ? "it shares" : "they share") +
-                     " edges with (" + area + " units^2 in " + std::to_string(found.surfaces) + " surface" +
-                     (found.surfaces == 1 ? "" : "s") + "; the first: polygon " + std::to_string(first) + " of group '" +
-                     scene.groups()[p.group] + "' at " + point_text(centre, scene.origin()) +
-                     "): one-sided, " +
-                     (found.polygons.size() == 1 ? "it faces away from the light its neighbours take and comes"
-                                                 : "they face away from the light their neighbours take and come") +
-                     " out black; reverse the winding "
-                     "(--reverse-winding inconsistent; in code, Scene::reverse_winding() of "
-                     "find_inconsistent_winding()) or use two-sided materials (--two-sided)");
+  const bool one = found.polygons.size() == 1;
+  // What it does: a solve's light arrives on the surface's side the polygon turns away from; a
+  // view factor's row looks to the other side. (Two-sided materials mend the first only: the
+  // view factors take fronts alone.)
+  const std::string consequence =
+      for_view_factors ? std::string(one ? "its row sees what lies behind the surface it belongs to"
+                                         : "their rows see what lies behind the surfaces they belong to") +
+                             ", and the rows of what lies in front do not see " + (one ? "it" : "them") +
+                             "; reverse the winding (--reverse-winding inconsistent; in code, "
+                             "Scene::reverse_winding() of find_inconsistent_winding())"
+                       : std::string(one ? "it faces away from the light its neighbours take and comes"
+                                         : "they face away from the light their neighbours take and come") +
+                             " out black; reverse the winding (--reverse-winding inconsistent; in code, "
+                             "Scene::reverse_winding() of find_inconsistent_winding()) or use two-sided materials "
+                             "(--two-sided)";
+  warnings.push_back(std::to_string(found.polygons.size()) + " polygon" + (one ? " is" : "s are") +
+                     " wound opposite to the polygons " + (one ? "it shares" : "they share") + " edges with (" + area +
+                     " units^2 in " + std::to_string(found.surfaces) + " surface" + (found.surfaces == 1 ? "" : "s") +
+                     "; the first: polygon " + std::to_string(first) + " of group '" + scene.groups()[p.group] +
+                     "' at " + point_text(centre, scene.origin()) + "): one-sided, " + consequence);
   return warnings;
 }
 

@@ -19,7 +19,9 @@ bool has_sides(const Material& m);
 InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& keep_going);
 
 /// One warning (or none, when `found` is empty) naming how many polygons of `scene` are wound
-/// against their neighbours, the first of them and where, and the two ways to fix it.
-std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const InconsistentWinding& found);
+/// against their neighbours, the first of them and where, what that does to the caller's result
+/// (`for_view_factors`: to the rows; otherwise to a solve), and the two ways to fix it.
+std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const InconsistentWinding& found,
+                                                       bool for_view_factors = false);
 
 }  // namespace radiosity::detail

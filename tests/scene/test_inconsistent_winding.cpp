@@ -171,3 +171,46 @@ TEST_SUITE("scene") {
     CHECK(mean_after == doctest::Approx(1.5 * mean_before).epsilon(0.15));
   }
 }
+
+TEST_SUITE("scene") {
+  TEST_CASE("a flipped triangle in a closed room: its view-factor row looks out of the room, said by "
+            "view_factor_matrix() - turned, its row sums to 1") {
+    // The closed room of the case above (4 x 4 x 2 triangles a face, wound inward), triangle 37
+    // turned: its row sees what lies behind the wall (nothing: only the sky), so it sums to 0
+    // where every other row of the closed room sums to 1 (the exact mode, to 1e-3).
+    rad::Scene room = triangle_box(4, true, grey(), {36, 37, 38});
+    room.reverse_winding({37});
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    auto row_sum = [](const rad::ViewFactorMatrix& m, std::size_t r) {
+      double sum = 0.0;
+      for (std::uint64_t k = m.row_offsets[r]; k < m.row_offsets[r + 1]; ++k) sum += m.values[k];
+      return sum;
+    };
+    const rad::ViewFactorMatrix before = rad::view_factor_matrix(room, o);
+    REQUIRE(before.rows() == room.polygons().size());
+    CHECK(row_sum(before, 37) == 0.0);
+    CHECK(before.sky[37] == 1.0);
+    bool said = false;
+    for (const std::string& w : before.warnings)
+      said |= w.find("1 polygon is wound opposite to the polygons it shares edges with") != std::string::npos &&
+              w.find("polygon 37 of group 'odd'") != std::string::npos &&
+              w.find("its row sees what lies behind the surface it belongs to") != std::string::npos;
+    CHECK(said);
+
+    room.reverse_winding(rad::find_inconsistent_winding(room).polygons);
+    const rad::ViewFactorMatrix after = rad::view_factor_matrix(room, o);
+    for (const std::string& w : after.warnings) CHECK(w.find("wound opposite") == std::string::npos);
+    for (std::size_t r = 0; r < after.rows(); ++r) {
+      INFO("row ", r);
+      CHECK(row_sum(after, r) == doctest::Approx(1.0).epsilon(1e-3));
+    }
+    // Before, the other rows missed what they now see of triangle 37 (its back blocked them).
+    for (const std::size_t r : {std::size_t{0}, std::size_t{100}}) {
+      INFO("row ", r, ": F(r -> 37) ", after.at(r, 37));
+      CHECK(after.at(r, 37) > 0.0);
+      CHECK(row_sum(before, r) == doctest::Approx(1.0 - after.at(r, 37)).epsilon(1e-3));
+    }
+  }
+}
