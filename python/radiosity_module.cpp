@@ -482,8 +482,8 @@ PySolution solve(const rad::Scene& scene, const std::string& method, double tole
 py::object view_factor_matrix(const rad::Scene& scene, const std::string& level, const std::string& method,
                               const std::string& correction, std::uint32_t hemisphere_rays, std::uint64_t seed,
                               unsigned threads, const py::object& groups, double max_patch_area,
-                              double max_element_area, double epsilon, const py::object& dtype, bool return_info,
-                              const py::object& progress) {
+                              double max_element_area, double epsilon, std::size_t memory_budget_bytes,
+                              const py::object& dtype, bool return_info, const py::object& progress) {
   rad::ViewFactorOptions o;
   o.level = parse("level", level, kLevels);
   if (normalised(method) == "hierarchical") {
@@ -499,6 +499,7 @@ py::object view_factor_matrix(const rad::Scene& scene, const std::string& level,
   o.mesh.max_patch_area = static_cast<float>(max_patch_area);
   o.mesh.max_element_area = static_cast<float>(max_element_area);
   o.epsilon = static_cast<float>(epsilon);
+  o.memory_budget_bytes = memory_budget_bytes;
   if (!groups.is_none()) {
     if (py::isinstance<py::str>(groups)) throw py::type_error("groups: expected a sequence of names, not one str");
     for (const py::handle g : groups.cast<py::sequence>()) o.groups.push_back(py::str(g).cast<std::string>());
@@ -640,7 +641,9 @@ correction).
 correction: 'none', 'reciprocity' (A_i F_ij = A_j F_ji exactly) or 'enclosure' (reciprocity
 and rows summing to 1, for closed enclosures). groups: names of the groups whose surfaces are
 rows and columns (None = all). seed and threads as in solve(); the result does not depend on
-threads. dtype: float64 or float32 values.
+threads. memory_budget_bytes: the most the matrix may take (8 bytes a factor; 0 = 4 GiB): one
+estimated over it from a sample of its rows raises radiosity.Error (code 'memory_budget') before
+the rest are made. dtype: float64 or float32 values.
 
 return_info=True returns (matrix, info), info a dict with: 'level'; 'ids' (per row: the
 PolygonId, element id or GroupId); 'names' (group level: the group names); 'area' (per row,
@@ -988,6 +991,6 @@ PYBIND11_MODULE(radiosity, m) {
         py::kw_only(), py::arg("method") = "auto", py::arg("correction") = "none",
         py::arg("hemisphere_rays") = 1024u, py::arg("seed") = 1u, py::arg("threads") = 0u,
         py::arg("groups") = py::none(), py::arg("max_patch_area") = 0.0, py::arg("max_element_area") = 0.0,
-        py::arg("epsilon") = 0.02, py::arg("dtype") = "float64", py::arg("return_info") = false,
-        py::arg("progress") = py::none());
+        py::arg("epsilon") = 0.02, py::arg("memory_budget_bytes") = 0u, py::arg("dtype") = "float64",
+        py::arg("return_info") = false, py::arg("progress") = py::none());
 }

@@ -115,3 +115,12 @@ def test_rows_that_see_no_surface_are_told_apart(data_dir):
     _, info = radiosity.view_factor_matrix(scene, return_info=True)
     assert info["warnings"] == []
     assert any(n.startswith("2 rows see only the sky") for n in info["notes"])
+
+
+def test_memory_budget_refuses_up_front():
+    # The Cornell box's element rows by Monte Carlo take about 7.8 MiB; under 1 MiB the size
+    # estimated from a sample of rows is refused before the rest are made.
+    box = radiosity.cornell_box()
+    with pytest.raises(radiosity.Error, match="estimated from 256 of its") as e:
+        radiosity.view_factor_matrix(box, "element", method="monte-carlo", memory_budget_bytes=1 << 20)
+    assert e.value.code == "memory_budget"

@@ -61,6 +61,13 @@ void check_matrix_memory(double bytes, std::size_t done, std::size_t rows, std::
                         "; choose fewer rows (ViewFactorOptions::groups), a coarser level or mesh, or raise the budget");
 }
 
+/// Rows whose entries are counted before the element rows are computed (evenly spread over a
+/// block of at least four times as many): the matrix's size is estimated from them, and a matrix
+/// estimated over the budget is refused then, not after most of its rows (minutes at a million
+/// rows). A row's entry count varies with what it sees (a roof few, a street many), so the
+/// estimate is a mean, within about a tenth at these counts; the check as the rows are made stays.
+constexpr std::size_t kSizeSampleRows = 256;
+
 /// The enclosure correction refuses a scene with a row farther than this from 1 (check_enclosure()).
 constexpr double kMaxClosureGap = 0.25;
 
@@ -752,6 +759,55 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   std::vector<std::uint32_t> touched;
   std::vector<std::uint32_t> batch;
   std::vector<SparseFactors> element_rows;
+  // Row r's columns (its elements' rows, element_rows[k - first[from]] for its sources k, where
+  // rows from `from` on were computed) summed into sum[] by column, the columns in `touched`.
+  auto accumulate = [&](std::size_t r, std::uint64_t element_base) {
+    touched.clear();
+    for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
+      const std::uint32_t e = sources[k];
+      const double a = hierarchy.element(e).area;
+      const SparseFactors& f = element_rows[k - element_base];
+      for (std::size_t n = 0; n < f.index.size(); ++n) {
+        // Backs of two-sided patches (indices past the patches) are not surfaces here.
+        if (f.index[n] >= patches.size()) continue;
+        const std::uint32_t c = m.column_of_patch[f.index[n]];
+        if (c == kNone) continue;
+        if (sum[c] == 0.0) touched.push_back(c);
+        sum[c] += a * static_cast<double>(f.value[n]);
+      }
+    }
+  };
+  if (rows >= 4 * kSizeSampleRows) {
+    // The matrix's size, estimated from a sample of its rows before they are all made.
+    double entries = 0.0;
+    for (std::size_t k = 0; k < kSizeSampleRows; ++k) {
+      const std::size_t r = begin + (2 * k + 1) * rows / (2 * kSizeSampleRows);
+      batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[r]),
+                   sources.begin() + static_cast<std::ptrdiff_t>(first[r + 1]));
+      if (links)
+        links->view_factor_rows(*linked_mesh, batch, element_rows);
+      else
+        estimator->sparse_element_rows(batch, element_rows);
+      accumulate(r, first[r]);
+      for (const std::uint32_t c : touched) {
+        if (m.area[r] > 0.0 && static_cast<float>(sum[c] / m.area[r]) > 0.0f) entries += 1.0;
+        sum[c] = 0.0;
+      }
+    }
+    entries *= static_cast<double>(rows) / static_cast<double>(kSizeSampleRows);
+    const double estimate = entries * kEntryBytes;
+    if (estimate > static_cast<double>(m.memory_budget))
+      detail::refuse_memory("the view-factor matrix (estimated from " + std::to_string(kSizeSampleRows) + " of its " +
+                                std::to_string(rows) + " rows, before computing them)",
+                            estimate, m.memory_budget, "ViewFactorOptions::memory_budget_bytes",
+                            "; choose fewer rows (ViewFactorOptions::groups), a coarser level or mesh, or raise the "
+                            "budget");
+    // Room for the estimate and a tenth more, so that the arrays' doubling does not take them
+    // past the budget on the way (the check below counts their capacity).
+    const auto reserved = static_cast<std::size_t>(1.1 * entries);
+    out.columns.reserve(reserved);
+    out.values.reserve(reserved);
+  }
   std::size_t row = begin;
   detail::BlockSizer chunk(kFirstChunk, kSmallestChunk, kLargestChunk);
   while (row < end) {
@@ -766,20 +822,7 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
       estimator->sparse_element_rows(batch, element_rows);
     chunk.done(batch.size());
     for (std::size_t r = row; r < last; ++r) {
-      touched.clear();
-      for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
-        const std::uint32_t e = sources[k];
-        const double a = hierarchy.element(e).area;
-        const SparseFactors& f = element_rows[k - first[row]];
-        for (std::size_t n = 0; n < f.index.size(); ++n) {
-          // Backs of two-sided patches (indices past the patches) are not surfaces here.
-          if (f.index[n] >= patches.size()) continue;
-          const std::uint32_t c = m.column_of_patch[f.index[n]];
-          if (c == kNone) continue;
-          if (sum[c] == 0.0) touched.push_back(c);
-          sum[c] += a * static_cast<double>(f.value[n]);
-        }
-      }
+      accumulate(r, first[row]);
       std::sort(touched.begin(), touched.end());
       const double inverse_area = m.area[r] > 0.0 ? 1.0 / m.area[r] : 0.0;
       double row_sum = 0.0;
@@ -868,9 +911,9 @@ void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>* 
   // under a block without a bottom face, the ground under a building), hidden as it should be.
   if (blind > 0 && !outward)
     m.notes.push_back(std::to_string(blind) + " of " + rows +
-                      " rows see nothing, neither a surface nor the sky: what lies in front of them shows them its "
-                      "back (a floor under a block without a bottom face: hidden, as it should be; if not, check the "
-                      "winding)");
+                      " rows see nothing, neither a surface nor the sky: they are covered, what lies in front of "
+                      "them shows them its back (the ground under a building, a floor under a block: hidden, as it "
+                      "should be; if not, check the winding)");
   if (in_contact > 0)
     m.notes.push_back(std::to_string(in_contact) +
                       " rows see nothing because their polygons lie against others, in contact (a box's bottom on a "

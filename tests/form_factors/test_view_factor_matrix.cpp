@@ -682,4 +682,43 @@ TEST_SUITE("form_factors") {
     zip_close(archive);
     CHECK_THROWS_AS(cli::write_npz(m, std::string(RADIOSITY_TEST_TMP) + "/no/such/dir/box.npz"), rad::Error);
   }
+
+  TEST_CASE("view_factor_matrix: a matrix estimated over the memory budget is refused before its rows are made - "
+            "the estimate is within a fifth of what is made") {
+    // The Cornell box's element rows by Monte Carlo (2 384 rows, about a million factors): the
+    // size is estimated from 256 rows before the others are computed.
+    const rad::Scene box = rad::cornell_box();
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::element;
+    o.form_factors.method = rad::FormFactorMethod::monte_carlo;
+    const rad::ViewFactorMatrix whole = rad::view_factor_matrix(box, o);
+    REQUIRE(whole.rows() >= 1024);  // the estimate samples a quarter of the rows at most
+    const double bytes = 8.0 * static_cast<double>(whole.non_zeros());
+    o.memory_budget_bytes = static_cast<std::size_t>(0.8 * bytes);
+    double reached = 0.0;  // the largest fraction of the rows reported before the refusal
+    o.on_progress = [&](const rad::Progress& p) {
+      if (p.phase == rad::Phase::form_factors) reached = std::max(reached, p.fraction);
+      return true;
+    };
+    bool refused = false;
+    try {
+      rad::view_factor_matrix(box, o);
+    } catch (const rad::Error& e) {
+      refused = e.code() == rad::ErrorCode::memory_budget &&
+                std::string(e.what()).find("estimated from 256 of its " + std::to_string(whole.rows()) +
+                                           " rows, before computing them") != std::string::npos;
+      INFO(e.what());
+      CHECK(refused);
+    }
+    CHECK(refused);
+    // Refused up front, before any chunk of rows (the check as they are made would have seen
+    // 0.8 of them first).
+    CHECK(reached == 0.0);
+    o.on_progress = nullptr;
+    // Within a fifth above: made, and the same matrix.
+    o.memory_budget_bytes = static_cast<std::size_t>(1.2 * bytes);
+    const rad::ViewFactorMatrix within = rad::view_factor_matrix(box, o);
+    CHECK(within.values == whole.values);
+    CHECK(within.columns == whole.columns);
+  }
 }

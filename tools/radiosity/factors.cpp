@@ -43,6 +43,7 @@ struct FactorsArgs {
            hemisphere_rays = rad::FormFactorOptions{}.hemisphere_rays;
   std::uint64_t seed = 1;
   unsigned threads = 0;
+  unsigned memory_budget_mib = 0;  ///< --memory-budget, MiB; 0 = the library's default
   float max_patch_area = 0.0f, max_element_area = 0.0f;
   bool strict = false;
   bool photometric = false;
@@ -192,6 +193,7 @@ int run_factors(const FactorsArgs& a) {
     o.form_factors.hemicube_resolution = a.resolution;
     o.form_factors.seed = a.seed;
     o.form_factors.threads = a.threads;
+    o.memory_budget_bytes = std::size_t{a.memory_budget_mib} << 20;
     o.mesh.max_patch_area = a.max_patch_area;
     o.mesh.max_element_area = a.max_element_area;
     o.groups = split_list(a.groups);
@@ -394,6 +396,10 @@ Command add_factors_command(CLI::App& app) {
       ->check(any_number<std::uint64_t>())
       ->capture_default_str();
   cmd->add_option("--threads", a.threads, "Worker threads (0 = all cores)")->check(any_number<unsigned>());
+  cmd->add_option("--memory-budget", a.memory_budget_mib,
+                  "The most memory the factors may take, MiB (0 = 4096): a matrix estimated over it (from a sample "
+                  "of its rows) is refused with the figure before its rows are computed")
+      ->check(in_range<unsigned>(0u, 1u << 24));
   cmd->add_option("--max-patch-area", a.max_patch_area, "Largest patch, scene units^2 (0 = derive)")
       ->check(non_negative<float>());
   cmd->add_option("--max-element-area", a.max_element_area, "Largest element, scene units^2 (0 = derive)")
