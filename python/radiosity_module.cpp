@@ -653,8 +653,8 @@ polygon lies, estimated by rays; not 1 - row sum);
 name, reciprocity_before, row_sum_error_before, row_sum_rms_before, largest_change, rms_change,
 empty_rows, clamped, iterations); 'warnings' (list of str: z-fighting polygons, polygons wound
 against their neighbours, rows that see only the sky in a model wound outward); 'notes' (list of
-str: rows in contact, rows that see only the sky, covered rows that see nothing); 'method' (the estimator that ran); 'method_reason' (why, when 'auto'
-chose it; else empty); 'element_count';
+str: rows in contact, rows that see only the sky, covered rows that see nothing); 'method' (the
+estimator that ran); 'method_reason' (why, when 'auto' chose it; else empty); 'element_count';
 'seconds'; 'cancelled' (the progress callback stopped it: rows are incomplete).
 
 Raises radiosity.Error for a scene without polygons, bad options or an unknown group.

@@ -350,8 +350,8 @@ ExactCost exact_cost(const detail::ExactPolygonTransport& transport, const std::
 }
 
 /// Rows [begin, end) of the exact mode (exact_view_factors.hpp) between the polygons `ids` of
-/// `transport`'s scene (row and column r: polygon ids[r]), into out.row_offsets, columns and values: each
-/// unordered pair once, F(r -> c) = G_rc / A_r. A pair with both rows in the block is
+/// `transport`'s scene (row and column r: polygon ids[r]), into out.row_offsets, columns and
+/// values: each unordered pair once, F(r -> c) = G_rc / A_r. A pair with both rows in the block is
 /// integrated by its lower row; a pair with one outside by this block (and by the other's, to
 /// the same bits). Rows are integrated in parallel, a chunk at a time between progress reports;
 /// returns false when `gate` cancels (every row of the block is then left empty).
@@ -728,7 +728,8 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
     out.cancelled =
         !exact_rows(*m.exact, m.ids, m.area, begin, end, m.ff.threads, m.memory_budget, gate, rows_share, out);
     if (!out.cancelled)
-      out.cancelled = !row_sky(*m.scene, m.overlaps, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
+      out.cancelled =
+          !row_sky(*m.scene, m.overlaps, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
     return;
   }
   // The element rows: the estimator's, or the links' (refined over the whole scene, so every
@@ -856,7 +857,8 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
     }
   }
   if (!out.cancelled)
-    out.cancelled = !row_sky(*m.scene, m.overlaps, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
+    out.cancelled =
+        !row_sky(*m.scene, m.overlaps, hierarchy, sources, first, begin, end, m.ff, gate, rows_share, out);
 }
 
 void fill_missing_sky(ViewFactorMatrix& m) {
@@ -872,16 +874,14 @@ namespace {
 /// should be); rows that see only the sky (a roof above everything else in an open scene, or,
 /// when find_polygons_facing_outward() judges most of the model wound outward as `check` does,
 /// a warning); and rows that see nothing at all (covered). `overlaps`: find_overlaps(scene).
-void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>* overlaps, ViewFactorMatrix& m) {
+void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>& overlaps, ViewFactorMatrix& m) {
   bool any_empty = false;
   for (std::size_t i = 0; i < m.rows() && !any_empty; ++i) any_empty = m.row_offsets[i + 1] == m.row_offsets[i];
   if (!any_empty) return;
-  std::vector<PolygonOverlap> searched;
-  if (!overlaps) overlaps = &(searched = find_overlaps(scene));
   std::vector<bool> touching;
   if (m.level == ViewFactorLevel::polygon) {
     touching.assign(scene.polygons().size(), false);
-    for (const PolygonOverlap& p : *overlaps)
+    for (const PolygonOverlap& p : overlaps)
       if (p.lying_against()) touching[p.first] = touching[p.second] = true;
   }
   std::size_t blind = 0, in_contact = 0, sky_only = 0;
@@ -897,7 +897,7 @@ void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>* 
   // Judged (32 rays per polygon) only when empty rows are a large part of the matrix: a model
   // wound outward leaves most rows empty, an open scene a few roofs above the rest.
   const bool outward = sky_only > 0 && 4 * (sky_only + blind) >= m.rows() &&
-                       find_polygons_facing_outward(scene, *overlaps).looks_wound_outward();
+                       find_polygons_facing_outward(scene, overlaps).looks_wound_outward();
   const std::string rows = std::to_string(m.rows());
   if (outward)
     m.warnings.push_back(std::to_string(sky_only + blind) + " of " + rows +
@@ -946,14 +946,15 @@ void finish_view_factor_matrix(const Scene& scene, const ViewFactorOptions& opti
   // "bottom face") is two receivers to the view factors: the exact mode integrates each, so a
   // row that sees them counts that area twice (its sum 1.28 in that box), silently but for this.
   out.warnings = z_fighting_warnings(scene, *overlaps,
-                                     "each is a surface of its own to the view factors: the exact mode (ray-cast, what "
-                                     "the automatic choice takes for small scenes) counts that area twice in the rows that see it (sums "
-                                     "above 1), the others split it between the two by rounding; remove one of them");
+                                     "each is a surface of its own to the view factors: the exact mode (ray-cast, "
+                                     "what the automatic choice takes for small scenes) counts that area twice in the "
+                                     "rows that see it (sums above 1), the others split it between the two by "
+                                     "rounding; remove one of them");
   // A polygon wound against the surface it belongs to looks the wrong way: its row is wrong,
   // silently but for this (solve() says the same of its light).
   for (std::string& w : inconsistent_winding_warnings(scene, inconsistent_winding(scene, {}), true))
     out.warnings.push_back(std::move(w));
-  describe_empty_rows(scene, overlaps, out);
+  describe_empty_rows(scene, *overlaps, out);
 }
 
 }  // namespace radiosity::detail

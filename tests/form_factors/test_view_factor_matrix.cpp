@@ -234,7 +234,8 @@ TEST_SUITE("form_factors") {
     MESSAGE(got.warnings[0]);
     CHECK(got.warnings[0].find("polygon 1 (group 'x1') and polygon 6 (group 'x1 again') are coincident and face the "
                                "same way (z-fighting)") == 0);
-    CHECK(got.warnings[0].find("the exact mode (ray-cast, what the automatic choice takes for small scenes) counts that area twice") != std::string::npos);
+    CHECK(got.warnings[0].find("the exact mode (ray-cast, what the automatic choice takes for small scenes) counts "
+                               "that area twice") != std::string::npos);
     const double opposite = 0.1998249, adjacent = 0.2000438;  // Howell C-11, C-14
     CHECK(row_sum(got, 0) == doctest::Approx(1.0 + opposite).epsilon(1e-4));  // x0 sees x1 twice
     CHECK(row_sum(got, 2) == doctest::Approx(1.0 + adjacent).epsilon(1e-4));  // y0 too
