@@ -885,18 +885,24 @@ void describe_empty_rows(const Scene& scene, const std::vector<PolygonOverlap>& 
       if (p.lying_against()) touching[p.first] = touching[p.second] = true;
   }
   std::size_t blind = 0, in_contact = 0, sky_only = 0;
+  double empty_area = 0.0, total_area = 0.0;  // of the rows that see no surface, and of all
   for (std::size_t i = 0; i < m.rows(); ++i) {
+    total_area += m.area[i];
     if (m.row_offsets[i + 1] != m.row_offsets[i]) continue;
-    if (!touching.empty() && touching[m.ids[i]])
+    if (!touching.empty() && touching[m.ids[i]]) {
       ++in_contact;
-    else if (i < m.sky.size() && m.sky[i] > 0.0)
+      continue;
+    }
+    empty_area += m.area[i];
+    if (i < m.sky.size() && m.sky[i] > 0.0)
       ++sky_only;
     else
       ++blind;
   }
-  // Judged (32 rays per polygon) only when empty rows are a large part of the matrix: a model
-  // wound outward leaves most rows empty, an open scene a few roofs above the rest.
-  const bool outward = sky_only > 0 && 4 * (sky_only + blind) >= m.rows() &&
+  // Judged (32 rays per polygon) only when the rows that see no surface are a large part of the
+  // area: a model wound outward leaves most of it so (a room's walls, however many facets its
+  // furniture has), an open scene a few roofs above the rest.
+  const bool outward = sky_only > 0 && 4.0 * empty_area >= total_area &&
                        find_polygons_facing_outward(scene, overlaps).looks_wound_outward();
   const std::string rows = std::to_string(m.rows());
   if (outward)

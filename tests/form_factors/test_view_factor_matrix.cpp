@@ -427,6 +427,30 @@ TEST_SUITE("form_factors") {
                                 "wound outward",
                                 0) == 0);
     }
+    // A room wound outward around furniture of many facets that see each other (two plates of
+    // 10 x 10 facets facing each other): most rows see a surface, but the walls, most of the
+    // area, see only the sky: still judged wound outward (by area, not by count of rows).
+    {
+      rad::Scene room;
+      const rad::MaterialId grey = room.add_material(rad::Material{});
+      rad::add_box(room, {0, 0, 0}, {10, 10, 3}, grey, "room");  // outward: wrong for a room
+      for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j) {
+          const float x = 4.0f + 0.1f * static_cast<float>(i), z = 1.0f + 0.1f * static_cast<float>(j);
+          rad::add_quad(room, {x, 4.0f, z}, {0, 0, 0.1f}, {0.1f, 0, 0}, grey, "plates");  // z x x = +y
+          rad::add_quad(room, {x, 4.2f, z}, {0.1f, 0, 0}, {0, 0, 0.1f}, grey, "plates");  // x x z = -y
+        }
+      // The two plates face each other: the one at y = 4 toward +y, the one at y = 4.2 toward -y.
+      REQUIRE(room.polygons()[6].normal.y > 0.5f);
+      REQUIRE(room.polygons()[7].normal.y < -0.5f);
+      const rad::ViewFactorMatrix v = rad::view_factor_matrix(room, o);
+      std::size_t empty = 0;
+      for (std::size_t r = 0; r < v.rows(); ++r) empty += v.row_offsets[r + 1] == v.row_offsets[r] ? 1 : 0;
+      CHECK(4 * empty < v.rows());  // few rows by count
+      bool said = false;
+      for (const std::string& w : v.warnings) said |= w.find("most of the model looks wound outward") != std::string::npos;
+      CHECK(said);
+    }
 
     // Two rooms without ceilings, modelled as separate boxes: the wall between them is two
     // coincident polygons facing apart, each lying against the other, but each side has its
