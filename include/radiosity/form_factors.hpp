@@ -298,8 +298,8 @@ struct ViewFactorOptions {
   /// (view_factor_matrix(): 8 bytes each while a block is made, 8 more in the result), or
   /// ViewFactorMethod::hierarchical's links. A computation about to pass it stops with
   /// Error{memory_budget}, naming the figure, before the allocation; at the polygon and element
-  /// levels the element rows' matrix is first estimated from 256 of its rows (of 1 024 or more)
-  /// and refused then, before the rest are made.
+  /// levels the matrix is first estimated (element rows: from 256 of its rows, of 1 024 or more;
+  /// the exact mode: from a sample of 4 096 pairs) and refused then, before the rest are made.
   std::size_t memory_budget_bytes = 0;
   /// Called on the calling thread with Phase::form_factors at the start, at the end and at most
   /// every ~50 ms in between; return false to cancel (the result then has `cancelled` set).

@@ -313,6 +313,7 @@ struct ExactCost {
   double pairs = 0.0;       ///< unordered pairs of rows
   std::size_t sampled = 0;  ///< pairs integrated to estimate
   double seconds = 0.0;     ///< thread time, estimated
+  double seen = 0.0;        ///< the share of the sampled pairs that see each other (a factor > 0)
 };
 ExactCost exact_cost(const detail::ExactPolygonTransport& transport, const std::vector<std::uint32_t>& ids,
                      std::uint64_t seed, unsigned threads) {
@@ -334,17 +335,20 @@ ExactCost exact_cost(const detail::ExactPolygonTransport& transport, const std::
     }
   }
   std::vector<std::uint64_t> work(sample.size(), 0);
+  std::vector<std::uint8_t> seen(sample.size(), 0);
   detail::parallel_for(threads, sample.size(), 64, [&](std::size_t begin, std::size_t end) {
     const auto w = transport.workspace();
     for (std::size_t k = begin; k < end; ++k) {
       w->work = 0;
-      transport.transport(sample[k].first, sample[k].second, *w);
+      seen[k] = transport.transport(sample[k].first, sample[k].second, *w) > 0.0 ? 1 : 0;
       work[k] = w->work;
     }
   });
-  std::uint64_t total = 0;
+  std::uint64_t total = 0, seeing = 0;
   for (const std::uint64_t x : work) total += x;
+  for (const std::uint8_t x : seen) seeing += x;
   cost.sampled = sample.size();
+  cost.seen = static_cast<double>(seeing) / static_cast<double>(sample.size());
   cost.seconds = cost.pairs * static_cast<double>(total) / static_cast<double>(sample.size()) * kExactWorkSeconds;
   return cost;
 }
@@ -582,6 +586,9 @@ struct ViewFactorRows::Impl {
   /// The exact mode's occluders and pairs, made once for the automatic choice's estimate and the
   /// rows (null unless the exact mode runs).
   std::unique_ptr<const ExactPolygonTransport> exact;
+  /// The exact mode: the share of pairs that see each other, from exact_cost()'s sample (for the
+  /// matrix's size before the pairs are integrated); negative when not sampled (few pairs).
+  double exact_seen = -1.0;
 };
 
 ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& options, const ProgressFn* meshing)
@@ -630,10 +637,15 @@ ViewFactorRows::ViewFactorRows(const Scene& scene, const ViewFactorOptions& opti
   const std::size_t rows = m.ids.size();
   if (!m.links && m.ff.method == FormFactorMethod::ray_cast)
     m.exact = std::make_unique<const ExactPolygonTransport>(*m.scene);
+  if (m.exact && !automatic && 0.5 * static_cast<double>(rows) * static_cast<double>(rows) > kCostSample) {
+    // The exact mode asked for: its sample too, for the matrix's size (compute()).
+    m.exact_seen = exact_cost(*m.exact, m.ids, m.ff.seed, m.ff.threads).seen;
+  }
   if (automatic) {
     // The exact mode where it takes seconds, Monte Carlo rows where it would take minutes
     // (kAutomaticExactSeconds); the reason goes to ViewFactorMatrix::method_reason.
     const ExactCost cost = exact_cost(*m.exact, m.ids, m.ff.seed, m.ff.threads);
+    if (cost.pairs > static_cast<double>(kCostSample)) m.exact_seen = cost.seen;
     char text[320];
     if (cost.seconds <= kAutomaticExactSeconds) {
       std::snprintf(text, sizeof text,
@@ -724,7 +736,21 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   if (rows == 0) return;
 
   if (!m.links && m.ff.method == FormFactorMethod::ray_cast) {
-    // The exact mode: polygon pairs integrated once, without rays (exact_view_factors.hpp).
+    // The exact mode: polygon pairs integrated once, without rays (exact_view_factors.hpp). Its
+    // size first, from the sample's share of pairs that see each other, counted as exact_rows()
+    // counts it (each pair held once, then twice in the result).
+    if (m.exact_seen >= 0.0) {
+      const double n = static_cast<double>(m.ids.size()), block = static_cast<double>(rows);
+      const double pairs = block * (n - 1.0) - 0.5 * block * (block - 1.0);
+      const double estimate = 3.0 * pairs * m.exact_seen * kEntryBytes;
+      if (estimate > static_cast<double>(m.memory_budget))
+        detail::refuse_memory("the view-factor matrix (the exact mode, estimated from " +
+                                  std::to_string(kCostSample) + " sampled pairs of its " +
+                                  std::to_string(static_cast<std::uint64_t>(pairs)) + ", before integrating them)",
+                              estimate, m.memory_budget, "ViewFactorOptions::memory_budget_bytes",
+                              "; choose fewer rows (ViewFactorOptions::groups), a coarser level, Monte Carlo rows "
+                              "(FormFactorMethod::monte_carlo), or raise the budget");
+    }
     out.cancelled =
         !exact_rows(*m.exact, m.ids, m.area, begin, end, m.ff.threads, m.memory_budget, gate, rows_share, out);
     if (!out.cancelled)

@@ -746,4 +746,40 @@ TEST_SUITE("form_factors") {
     CHECK(within.values == whole.values);
     CHECK(within.columns == whole.columns);
   }
+
+  TEST_CASE("view_factor_matrix: the exact mode over the memory budget is refused before it integrates its pairs - "
+            "the estimate from its sample of pairs is within a fifth") {
+    // The closed 1 x 2 x 3 box in facets of 0.25 (352 polygons, 61 776 pairs): the share of
+    // pairs that see each other is taken from a sample of 4 096 (the automatic choice's), and the
+    // matrix is counted as the exact mode holds it (each pair once, then twice in the result).
+    const rad::Scene box = faceted_box(1, 2, 3, 0.25f);
+    rad::ViewFactorOptions o;
+    o.level = rad::ViewFactorLevel::polygon;
+    o.form_factors.method = rad::FormFactorMethod::ray_cast;
+    const rad::ViewFactorMatrix whole = rad::view_factor_matrix(box, o);
+    REQUIRE(whole.rows() == 352);
+    const double bytes = 3.0 * 0.5 * static_cast<double>(whole.non_zeros()) * 8.0;
+    o.memory_budget_bytes = static_cast<std::size_t>(0.8 * bytes);
+    double reached = 0.0;
+    o.on_progress = [&](const rad::Progress& p) {
+      if (p.phase == rad::Phase::form_factors) reached = std::max(reached, p.fraction);
+      return true;
+    };
+    bool refused = false;
+    try {
+      rad::view_factor_matrix(box, o);
+    } catch (const rad::Error& e) {
+      INFO(e.what());
+      refused = e.code() == rad::ErrorCode::memory_budget &&
+                std::string(e.what()).find("the exact mode, estimated from 4096 sampled pairs of its 61776, before "
+                                           "integrating them") != std::string::npos;
+      CHECK(refused);
+    }
+    CHECK(refused);
+    CHECK(reached == 0.0);
+    o.on_progress = nullptr;
+    o.memory_budget_bytes = static_cast<std::size_t>(1.2 * bytes);
+    const rad::ViewFactorMatrix within = rad::view_factor_matrix(box, o);
+    CHECK(within.values == whole.values);
+  }
 }
