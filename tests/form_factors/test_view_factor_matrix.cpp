@@ -139,6 +139,37 @@ std::pair<std::string, std::string> parse_npy(const std::string& npy) {
   return {npy.substr(10, length), npy.substr(10 + length)};
 }
 
+/// The memory budget's estimate up front: `scene` at `options` made whole, its bytes taken as
+/// `bytes_per_factor` times its factors; at 0.8 of that, refused with Error{memory_budget}
+/// saying `how` before any progress into the rows (the check as they are made would have seen
+/// most of them first); at 1.2, made, and the same matrix.
+void check_refused_up_front(const rad::Scene& scene, rad::ViewFactorOptions options, double bytes_per_factor,
+                            const std::string& how) {
+  const rad::ViewFactorMatrix whole = rad::view_factor_matrix(scene, options);
+  const double bytes = bytes_per_factor * static_cast<double>(whole.non_zeros());
+  options.memory_budget_bytes = static_cast<std::size_t>(0.8 * bytes);
+  double reached = 0.0;  // the largest fraction of the rows reported before the refusal
+  options.on_progress = [&](const rad::Progress& p) {
+    if (p.phase == rad::Phase::form_factors) reached = std::max(reached, p.fraction);
+    return true;
+  };
+  bool refused = false;
+  try {
+    rad::view_factor_matrix(scene, options);
+  } catch (const rad::Error& e) {
+    INFO(e.what());
+    refused = e.code() == rad::ErrorCode::memory_budget && std::string(e.what()).find(how) != std::string::npos;
+    CHECK(refused);
+  }
+  CHECK(refused);
+  CHECK(reached == 0.0);
+  options.on_progress = nullptr;
+  options.memory_budget_bytes = static_cast<std::size_t>(1.2 * bytes);
+  const rad::ViewFactorMatrix within = rad::view_factor_matrix(scene, options);
+  CHECK(within.values == whole.values);
+  CHECK(within.columns == whole.columns);
+}
+
 }  // namespace
 
 TEST_SUITE("form_factors") {
@@ -712,39 +743,10 @@ TEST_SUITE("form_factors") {
             "the estimate is within a fifth of what is made") {
     // The Cornell box's element rows by Monte Carlo (2 384 rows, about a million factors): the
     // size is estimated from 256 rows before the others are computed.
-    const rad::Scene box = rad::cornell_box();
     rad::ViewFactorOptions o;
     o.level = rad::ViewFactorLevel::element;
     o.form_factors.method = rad::FormFactorMethod::monte_carlo;
-    const rad::ViewFactorMatrix whole = rad::view_factor_matrix(box, o);
-    REQUIRE(whole.rows() >= 1024);  // the estimate samples a quarter of the rows at most
-    const double bytes = 8.0 * static_cast<double>(whole.non_zeros());
-    o.memory_budget_bytes = static_cast<std::size_t>(0.8 * bytes);
-    double reached = 0.0;  // the largest fraction of the rows reported before the refusal
-    o.on_progress = [&](const rad::Progress& p) {
-      if (p.phase == rad::Phase::form_factors) reached = std::max(reached, p.fraction);
-      return true;
-    };
-    bool refused = false;
-    try {
-      rad::view_factor_matrix(box, o);
-    } catch (const rad::Error& e) {
-      refused = e.code() == rad::ErrorCode::memory_budget &&
-                std::string(e.what()).find("estimated from 256 of its " + std::to_string(whole.rows()) +
-                                           " rows, before computing them") != std::string::npos;
-      INFO(e.what());
-      CHECK(refused);
-    }
-    CHECK(refused);
-    // Refused up front, before any chunk of rows (the check as they are made would have seen
-    // 0.8 of them first).
-    CHECK(reached == 0.0);
-    o.on_progress = nullptr;
-    // Within a fifth above: made, and the same matrix.
-    o.memory_budget_bytes = static_cast<std::size_t>(1.2 * bytes);
-    const rad::ViewFactorMatrix within = rad::view_factor_matrix(box, o);
-    CHECK(within.values == whole.values);
-    CHECK(within.columns == whole.columns);
+    check_refused_up_front(rad::cornell_box(), o, 8.0, "estimated from 256 of its 2384 rows, before computing them");
   }
 
   TEST_CASE("view_factor_matrix: the exact mode over the memory budget is refused before it integrates its pairs - "
@@ -752,34 +754,10 @@ TEST_SUITE("form_factors") {
     // The closed 1 x 2 x 3 box in facets of 0.25 (352 polygons, 61 776 pairs): the share of
     // pairs that see each other is taken from a sample of 4 096 (the automatic choice's), and the
     // matrix is counted as the exact mode holds it (each pair once, then twice in the result).
-    const rad::Scene box = faceted_box(1, 2, 3, 0.25f);
     rad::ViewFactorOptions o;
     o.level = rad::ViewFactorLevel::polygon;
     o.form_factors.method = rad::FormFactorMethod::ray_cast;
-    const rad::ViewFactorMatrix whole = rad::view_factor_matrix(box, o);
-    REQUIRE(whole.rows() == 352);
-    const double bytes = 3.0 * 0.5 * static_cast<double>(whole.non_zeros()) * 8.0;
-    o.memory_budget_bytes = static_cast<std::size_t>(0.8 * bytes);
-    double reached = 0.0;
-    o.on_progress = [&](const rad::Progress& p) {
-      if (p.phase == rad::Phase::form_factors) reached = std::max(reached, p.fraction);
-      return true;
-    };
-    bool refused = false;
-    try {
-      rad::view_factor_matrix(box, o);
-    } catch (const rad::Error& e) {
-      INFO(e.what());
-      refused = e.code() == rad::ErrorCode::memory_budget &&
-                std::string(e.what()).find("the exact mode, estimated from 4096 sampled pairs of its 61776, before "
-                                           "integrating them") != std::string::npos;
-      CHECK(refused);
-    }
-    CHECK(refused);
-    CHECK(reached == 0.0);
-    o.on_progress = nullptr;
-    o.memory_budget_bytes = static_cast<std::size_t>(1.2 * bytes);
-    const rad::ViewFactorMatrix within = rad::view_factor_matrix(box, o);
-    CHECK(within.values == whole.values);
+    check_refused_up_front(faceted_box(1, 2, 3, 0.25f), o, 3.0 * 0.5 * 8.0,
+                           "the exact mode, estimated from 4096 sampled pairs of its 61776, before integrating them");
   }
 }
