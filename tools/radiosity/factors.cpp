@@ -311,8 +311,8 @@ int run_factors(const FactorsArgs& a) {
                    a.output.empty() ? "" : ", wrote ", a.output.c_str());
       if (!m.method_reason.empty())
         std::fprintf(stderr, "factors: %s (%s; --method overrides)\n", m.method.c_str(), m.method_reason.c_str());
-      // The library's warnings (z-fighting; rows that see no surface where that looks wrong) and
-      // notes (rows in contact, rows that see only the sky).
+      // The library's warnings (z-fighting, polygons wound against their neighbours, a model
+      // wound outward) and notes (rows in contact, rows that see only the sky, covered rows).
       for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: factors: %s\n", w.c_str());
       for (const std::string& n : m.notes) std::fprintf(stderr, "factors: %s\n", n.c_str());
       const rad::ViewFactorCorrectionReport& c = m.correction;
