@@ -786,14 +786,14 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
   std::vector<std::uint32_t> touched;
   std::vector<std::uint32_t> batch;
   std::vector<SparseFactors> element_rows;
-  // Row r's columns (its elements' rows, element_rows[k - first[from]] for its sources k, where
-  // rows from `from` on were computed) summed into sum[] by column, the columns in `touched`.
-  auto accumulate = [&](std::size_t r, std::uint64_t element_base) {
+  // Row r's columns (its elements' rows, element_rows[base + (k - first[r])] for its sources k)
+  // summed into sum[] by column, the columns in `touched`.
+  auto accumulate = [&](std::size_t r, std::size_t base) {
     touched.clear();
     for (std::uint64_t k = first[r]; k < first[r + 1]; ++k) {
       const std::uint32_t e = sources[k];
       const double a = hierarchy.element(e).area;
-      const SparseFactors& f = element_rows[k - element_base];
+      const SparseFactors& f = element_rows[base + static_cast<std::size_t>(k - first[r])];
       for (std::size_t n = 0; n < f.index.size(); ++n) {
         // Backs of two-sided patches (indices past the patches) are not surfaces here.
         if (f.index[n] >= patches.size()) continue;
@@ -804,9 +804,15 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
       }
     }
   };
+  // The rows the size estimate made (in increasing order), kept as their column sums so that the
+  // loop below does not make them again.
+  std::vector<std::size_t> sampled;
+  std::vector<std::vector<std::pair<std::uint32_t, double>>> sampled_sums;
   if (rows >= 4 * kSizeSampleRows) {
     // The matrix's size, estimated from a sample of its rows before they are all made.
     double entries = 0.0;
+    sampled.reserve(kSizeSampleRows);
+    sampled_sums.reserve(kSizeSampleRows);
     for (std::size_t k = 0; k < kSizeSampleRows; ++k) {
       const std::size_t r = begin + (2 * k + 1) * rows / (2 * kSizeSampleRows);
       batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[r]),
@@ -815,9 +821,13 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
         links->view_factor_rows(*linked_mesh, batch, element_rows);
       else
         estimator->sparse_element_rows(batch, element_rows);
-      accumulate(r, first[r]);
+      accumulate(r, 0);
+      sampled.push_back(r);
+      std::vector<std::pair<std::uint32_t, double>>& kept = sampled_sums.emplace_back();
+      kept.reserve(touched.size());
       for (const std::uint32_t c : touched) {
         if (m.area[r] > 0.0 && static_cast<float>(sum[c] / m.area[r]) > 0.0f) entries += 1.0;
+        kept.emplace_back(c, sum[c]);
         sum[c] = 0.0;
       }
     }
@@ -836,20 +846,43 @@ void ViewFactorRows::compute(std::size_t begin, std::size_t end, ProgressGate& g
     out.values.reserve(reserved);
   }
   std::size_t row = begin;
+  std::size_t next_sampled = 0;  // the first of `sampled` not yet written
+  std::vector<std::size_t> base;  // a chunk's rows' first element row in element_rows
   detail::BlockSizer chunk(kFirstChunk, kSmallestChunk, kLargestChunk);
   while (row < end) {
-    // The chunk: whole rows until it holds the elements BlockSizer asks for.
+    // The chunk: whole rows until it holds the elements BlockSizer asks for; its sampled rows'
+    // elements are left out of the batch.
     std::size_t last = row;
     while (last < end && (last == row || first[last] - first[row] < chunk.size())) ++last;
-    batch.assign(sources.begin() + static_cast<std::ptrdiff_t>(first[row]),
-                 sources.begin() + static_cast<std::ptrdiff_t>(first[last]));
-    if (links)
+    batch.clear();
+    base.clear();
+    for (std::size_t r = row, s = next_sampled; r < last; ++r) {
+      base.push_back(batch.size());
+      if (s < sampled.size() && sampled[s] == r) {
+        ++s;
+        continue;
+      }
+      batch.insert(batch.end(), sources.begin() + static_cast<std::ptrdiff_t>(first[r]),
+                   sources.begin() + static_cast<std::ptrdiff_t>(first[r + 1]));
+    }
+    if (batch.empty())
+      element_rows.clear();
+    else if (links)
       links->view_factor_rows(*linked_mesh, batch, element_rows);
     else
       estimator->sparse_element_rows(batch, element_rows);
     chunk.done(batch.size());
     for (std::size_t r = row; r < last; ++r) {
-      accumulate(r, first[row]);
+      if (next_sampled < sampled.size() && sampled[next_sampled] == r) {
+        touched.clear();
+        for (const auto& [c, value] : sampled_sums[next_sampled]) {
+          touched.push_back(c);
+          sum[c] = value;
+        }
+        ++next_sampled;
+      } else {
+        accumulate(r, base[r - row]);
+      }
       std::sort(touched.begin(), touched.end());
       const double inverse_area = m.area[r] > 0.0 ? 1.0 / m.area[r] : 0.0;
       double row_sum = 0.0;

@@ -80,19 +80,19 @@ std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const
   const std::string consequence =
       for_view_factors ? std::string(one ? "its row sees what lies behind the surface it belongs to"
                                          : "their rows see what lies behind the surfaces they belong to") +
-                             ", and the rows of what lies in front do not see " + (one ? "it" : "them") +
-                             "; reverse the winding (--reverse-winding inconsistent; in code, "
-                             "Scene::reverse_winding() of find_inconsistent_winding())"
+                             ", and the rows of what lies in front do not see " + (one ? "it" : "them")
                        : std::string(one ? "it faces away from the light its neighbours take and comes"
                                          : "they face away from the light their neighbours take and come") +
-                             " out black; reverse the winding (--reverse-winding inconsistent; in code, "
-                             "Scene::reverse_winding() of find_inconsistent_winding()) or use two-sided materials "
-                             "(--two-sided)";
+                             " out black";
+  const std::string fix =
+      std::string("; reverse the winding (--reverse-winding inconsistent; in code, Scene::reverse_winding() of "
+                  "find_inconsistent_winding())") +
+      (for_view_factors ? "" : " or use two-sided materials (--two-sided)");
   warnings.push_back(std::to_string(found.polygons.size()) + " polygon" + (one ? " is" : "s are") +
                      " wound opposite to the polygons " + (one ? "it shares" : "they share") + " edges with (" + area +
                      " units^2 in " + std::to_string(found.surfaces) + " surface" + (found.surfaces == 1 ? "" : "s") +
                      "; the first: polygon " + std::to_string(first) + " of group '" + scene.groups()[p.group] +
-                     "' at " + point_text(centre, scene.origin()) + "): one-sided, " + consequence);
+                     "' at " + point_text(centre, scene.origin()) + "): one-sided, " + consequence + fix);
   return warnings;
 }
 

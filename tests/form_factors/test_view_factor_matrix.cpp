@@ -747,6 +747,22 @@ TEST_SUITE("form_factors") {
     o.level = rad::ViewFactorLevel::element;
     o.form_factors.method = rad::FormFactorMethod::monte_carlo;
     check_refused_up_front(rad::cornell_box(), o, 8.0, "estimated from 256 of its 2384 rows, before computing them");
+    // The 256 rows the estimate made are kept, not made again: the whole matrix's rows are those
+    // of blocks too small to be sampled (under 1 024 rows), bit for bit.
+    const rad::Scene s = rad::cornell_box();
+    const radiosity::detail::ViewFactorRows rows(s, o);
+    const rad::ProgressFn no_progress;
+    radiosity::detail::ProgressGate gate(no_progress);
+    rad::ViewFactorMatrix whole;
+    rows.compute(0, rows.rows(), gate, whole);
+    REQUIRE(whole.rows() == 2384);
+    for (std::size_t first = 0; first < whole.rows(); first += 800) {
+      rad::ViewFactorMatrix block;
+      rows.compute(first, std::min<std::size_t>(first + 800, whole.rows()), gate, block);
+      check_block_rows(whole, first, block);
+      for (std::size_t r = 0; r < block.rows(); ++r)
+        CHECK(block.row_standard_error[r] == whole.row_standard_error[first + r]);
+    }
   }
 
   TEST_CASE("view_factor_matrix: the exact mode over the memory budget is refused before it integrates its pairs - "
