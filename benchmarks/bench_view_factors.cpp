@@ -4,7 +4,8 @@
 //    the reciprocity correction: time, peak memory, stored factors, the estimates' reciprocity
 //    error and row standard errors before the correction, the sky view factors per group; with
 //    --city-links the hierarchical links' factors as well;
-//  - a closed, obstructed enclosure of facets (a faceted room around a faceted block) in exact
+//  - a closed, obstructed enclosure of facets (a faceted room around a faceted block, or with
+//    --cornell the Cornell box closed by a front wall, its two turned blocks) in exact
 //    mode (ray_cast: contour integrals, occlusion by shaft-culled rays) and fast mode, both
 //    enclosure-corrected, and the hierarchical links' rows (ViewFactorMethod::hierarchical): their
 //    agreement per row sum and per large factor, and the speed ratios;
@@ -43,6 +44,10 @@ struct Args {
   /// most below 4 000 whose floor facets end at the block's footprint (at 0.16 some lie partly
   /// under it, see nothing there, and the enclosure correction refuses the room).
   float room_facet = 0.25f;
+  /// --cornell MM: instead of the room, the Cornell box closed by a front wall, its two blocks as
+  /// published (one turned each way), every face cut into facets of about MM millimetres, the
+  /// floor cut around the blocks (23 gives 4 246 facets).
+  float cornell_facet = 0.0f;
   std::string write_vs3;      ///< write the room as a View3D input file here (before computing)
   std::string view3d_output;  ///< View3D's text output file (out=0) for that room, to compare with
   double view3d_seconds = 0.0;  ///< View3D's wall time for it, measured outside (0: not given)
@@ -52,7 +57,7 @@ int usage(const char* bad) {
   if (bad) std::fprintf(stderr, "bench_view_factors: bad argument '%s'\n", bad);
   std::fprintf(stderr,
                "usage: bench_view_factors [22k|246k] [--blocks N] [--facet METRES] [--rays N] [--threads T]\n"
-               "                          [--room-facet METRES] [--only city|enclosure] [--city-links]\n"
+               "                          [--room-facet METRES | --cornell MM] [--only city|enclosure] [--city-links]\n"
                "                          [--write-vs3 FILE] [--view3d-output FILE [--view3d-seconds S]]\n");
   return bad ? 2 : 0;
 }
@@ -132,6 +137,134 @@ rad::Scene faceted_room(float facet) {
     if (axis != 1) rectangle(axis, lo[axis], a, b, -1, "block");
     rectangle(axis, hi[axis], a, b, +1, "block");
   }
+  return scene;
+}
+
+/// The Cornell box (the published geometry in mm, its room made rectangular) closed by a front
+/// wall, the blocks without bottoms standing on the floor, every face cut into facets of about
+/// `facet` mm: a closed enclosure obstructed by two blocks turned each way, the "Cornell-style"
+/// scene of issue #16's target.
+rad::Scene faceted_cornell(float facet) {
+  rad::Scene scene;
+  const rad::MaterialId m = scene.add_material(rad::Material{});
+  using Quad = std::vector<glm::vec3>;
+  // A planar quad cut bilinearly, its facets wound as the quad is (its normal towards `inside`
+  // when `toward`, else away from it).
+  auto facets = [&](Quad q, const glm::vec3& inside, bool toward, const char* group) {
+    const glm::vec3 n = glm::cross(q[1] - q[0], q[2] - q[0]);
+    if ((glm::dot(n, inside - q[0]) < 0.0f) == toward) std::reverse(q.begin(), q.end());
+    const float du = std::max(glm::length(q[1] - q[0]), glm::length(q[2] - q[3]));
+    const float dv = std::max(glm::length(q[3] - q[0]), glm::length(q[2] - q[1]));
+    const int nu = std::max(1, static_cast<int>(std::lround(du / facet)));
+    const int nv = std::max(1, static_cast<int>(std::lround(dv / facet)));
+    // In double, rounded once: a face's facets then share its plane exactly where it lies along
+    // an axis (View3D warns of vertices out of plane otherwise).
+    auto at = [&](int i, int j) {
+      const double s = static_cast<double>(i) / nu, t = static_cast<double>(j) / nv;
+      const glm::dvec3 p = (1.0 - t) * ((1.0 - s) * glm::dvec3(q[0]) + s * glm::dvec3(q[1])) +
+                           t * ((1.0 - s) * glm::dvec3(q[3]) + s * glm::dvec3(q[2]));
+      return glm::vec3(p);
+    };
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j) scene.add_polygon({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)}, m, group);
+  };
+  const float X = 556.0f, Y = 548.8f, Z = 559.2f;
+  const glm::vec3 inside(278.0f, 274.0f, 280.0f);
+  // The floor: facets of the grid less the blocks' footprints (each grid cell split by the
+  // footprints' edge lines into convex pieces, those inside a footprint dropped, pieces of more
+  // than 4 corners fanned into triangles, as View3D takes 3 or 4), so that no facet lies partly
+  // under a block, seeing nothing there (its row would not sum to 1 and the two programs would
+  // disagree about the hidden part: View3D counts it).
+  const std::vector<std::vector<glm::vec2>> footprints = {{{130, 65}, {82, 225}, {240, 272}, {290, 114}},
+                                                          {{423, 247}, {265, 296}, {314, 456}, {472, 406}}};
+  using Piece = std::vector<glm::vec2>;
+  auto cross2 = [](glm::vec2 u, glm::vec2 v) { return u.x * v.y - u.y * v.x; };
+  auto area2 = [&](const Piece& q) {
+    float a = 0.0f;
+    for (std::size_t k = 0; k < q.size(); ++k) a += cross2(q[k], q[(k + 1) % q.size()]);
+    return 0.5f * std::fabs(a);
+  };
+  // The part of convex q where side * cross(b - a, p - a) >= 0.
+  auto half = [&](const Piece& q, glm::vec2 a, glm::vec2 b, float side) {
+    Piece out;
+    for (std::size_t k = 0; k < q.size(); ++k) {
+      const glm::vec2 p = q[k], r = q[(k + 1) % q.size()];
+      const float dp = side * cross2(b - a, p - a), dr = side * cross2(b - a, r - a);
+      if (dp >= 0.0f) out.push_back(p);
+      if ((dp > 0.0f && dr < 0.0f) || (dp < 0.0f && dr > 0.0f)) out.push_back(p + (dp / (dp - dr)) * (r - p));
+    }
+    return out;
+  };
+  const int nx = std::max(1, static_cast<int>(std::lround(X / facet)));
+  const int nz = std::max(1, static_cast<int>(std::lround(Z / facet)));
+  const float cell_area = (X / static_cast<float>(nx)) * (Z / static_cast<float>(nz));
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < nz; ++j) {
+      const float x0 = X * static_cast<float>(i) / static_cast<float>(nx), x1 = X * static_cast<float>(i + 1) / static_cast<float>(nx);
+      const float z0 = Z * static_cast<float>(j) / static_cast<float>(nz), z1 = Z * static_cast<float>(j + 1) / static_cast<float>(nz);
+      std::vector<Piece> pieces = {{{x0, z0}, {x1, z0}, {x1, z1}, {x0, z1}}};
+      for (const Piece& f : footprints) {
+        const float orientation = cross2(f[1] - f[0], f[2] - f[0]) > 0.0f ? 1.0f : -1.0f;  // inside: >= 0
+        std::vector<Piece> outside;
+        for (Piece rest : pieces) {
+          // A piece that does not reach into the footprint stays whole (cut by the edges' lines
+          // it would leave slivers far from the block).
+          Piece within = rest;
+          for (std::size_t e = 0; e < f.size() && within.size() >= 3; ++e)
+            within = half(within, f[e], f[(e + 1) % f.size()], orientation);
+          if (within.size() < 3 || area2(within) <= 1e-6f * cell_area) {
+            outside.push_back(rest);
+            continue;
+          }
+          for (std::size_t e = 0; e < f.size() && !rest.empty(); ++e) {
+            const Piece out = half(rest, f[e], f[(e + 1) % f.size()], -orientation);
+            if (out.size() >= 3 && area2(out) > 1e-6f * cell_area) outside.push_back(out);
+            rest = half(rest, f[e], f[(e + 1) % f.size()], orientation);
+            if (rest.size() < 3 || area2(rest) <= 1e-6f * cell_area) rest.clear();
+          }
+          // What is left of `rest` lies inside the footprint: dropped.
+        }
+        pieces = std::move(outside);
+      }
+      for (const Piece& q : pieces) {
+        auto lift = [](glm::vec2 p) { return glm::vec3(p.x, 0.0f, p.y); };
+        auto add = [&](Quad poly) {
+          const glm::vec3 n = glm::cross(poly[1] - poly[0], poly[2] - poly[0]);
+          if (n.y < 0.0f) std::reverse(poly.begin(), poly.end());
+          scene.add_polygon(poly, m, "floor");
+        };
+        if (q.size() <= 4) {
+          Quad poly;
+          for (const glm::vec2& p : q) poly.push_back(lift(p));
+          add(poly);
+        } else {
+          for (std::size_t k = 1; k + 1 < q.size(); ++k) add({lift(q[0]), lift(q[k]), lift(q[k + 1])});
+        }
+      }
+    }
+  facets({{0, Y, 0}, {X, Y, 0}, {X, Y, Z}, {0, Y, Z}}, inside, true, "ceiling");
+  facets({{0, 0, Z}, {X, 0, Z}, {X, Y, Z}, {0, Y, Z}}, inside, true, "back_wall");
+  facets({{0, 0, 0}, {X, 0, 0}, {X, Y, 0}, {0, Y, 0}}, inside, true, "front_wall");
+  facets({{0, 0, 0}, {0, 0, Z}, {0, Y, Z}, {0, Y, 0}}, inside, true, "green_wall");
+  facets({{X, 0, 0}, {X, 0, Z}, {X, Y, Z}, {X, Y, 0}}, inside, true, "red_wall");
+  auto block = [&](const std::vector<Quad>& faces, const char* group) {
+    glm::vec3 centre(0.0f);
+    for (const Quad& q : faces)
+      for (const glm::vec3& p : q) centre += p / 20.0f;
+    for (const Quad& q : faces) facets(q, centre, false, group);
+  };
+  block({{{130, 165, 65}, {82, 165, 225}, {240, 165, 272}, {290, 165, 114}},
+         {{290, 0, 114}, {290, 165, 114}, {240, 165, 272}, {240, 0, 272}},
+         {{130, 0, 65}, {130, 165, 65}, {290, 165, 114}, {290, 0, 114}},
+         {{82, 0, 225}, {82, 165, 225}, {130, 165, 65}, {130, 0, 65}},
+         {{240, 0, 272}, {240, 165, 272}, {82, 165, 225}, {82, 0, 225}}},
+        "short_block");
+  block({{{423, 330, 247}, {265, 330, 296}, {314, 330, 456}, {472, 330, 406}},
+         {{423, 0, 247}, {423, 330, 247}, {472, 330, 406}, {472, 0, 406}},
+         {{472, 0, 406}, {472, 330, 406}, {314, 330, 456}, {314, 0, 456}},
+         {{314, 0, 456}, {314, 330, 456}, {265, 330, 296}, {265, 0, 296}},
+         {{265, 0, 296}, {265, 330, 296}, {423, 330, 247}, {423, 0, 247}}},
+        "tall_block");
   return scene;
 }
 
@@ -342,9 +475,15 @@ void city_part(const Args& a) {
 }
 
 bool enclosure_part(const Args& a) {
-  const rad::Scene scene = faceted_room(a.room_facet);
-  std::printf("enclosure: a 4 m room around a block on its floor, facet %.4g m: %zu facets (closed)\n", a.room_facet,
-              scene.polygons().size());
+  const bool cornell = a.cornell_facet > 0.0f;
+  const rad::Scene scene = cornell ? faceted_cornell(a.cornell_facet) : faceted_room(a.room_facet);
+  if (cornell)
+    std::printf("enclosure: the Cornell box closed by a front wall, its two blocks standing on the floor, facet %.4g mm:"
+                " %zu facets (closed: the floor cut around the blocks' footprints)\n",
+                a.cornell_facet, scene.polygons().size());
+  else
+    std::printf("enclosure: a 4 m room around a block on its floor, facet %.4g m: %zu facets (closed)\n", a.room_facet,
+                scene.polygons().size());
   if (!a.write_vs3.empty()) {
     // encl=0: View3D then writes its factors as integrated, without its own row normalisation
     // (NormAF), so its row sums' distance from 1 is its own error and one file serves as the
@@ -354,7 +493,10 @@ bool enclosure_part(const Args& a) {
     control.enclosure = false;
     control.output_format = 0;
     char title[96];
-    std::snprintf(title, sizeof title, "bench_view_factors room around a block, facet %.4g m", a.room_facet);
+    if (cornell)
+      std::snprintf(title, sizeof title, "bench_view_factors closed Cornell box, facet %.4g mm", a.cornell_facet);
+    else
+      std::snprintf(title, sizeof title, "bench_view_factors room around a block, facet %.4g m", a.room_facet);
     rad::save_view3d(scene, control, title, a.write_vs3);
     std::printf("  wrote %s: View3D input, %zu surfaces (surface i + 1 = polygon i), encl=0, eps=%g, out=0\n",
                 a.write_vs3.c_str(), scene.polygons().size(), static_cast<double>(control.epsilon));
@@ -475,6 +617,10 @@ int main(int argc, char** argv) {
       const double v = std::strtod(argv[++i], &end);
       if (*end != '\0' || !(v > 0.01) || v > 4.0) return usage(argv[i]);
       a.room_facet = static_cast<float>(v);
+    } else if (arg == "--cornell" && has_value) {
+      const double v = std::strtod(argv[++i], &end);
+      if (*end != '\0' || !(v >= 5.0) || v > 600.0) return usage(argv[i]);
+      a.cornell_facet = static_cast<float>(v);
     } else if (arg == "--write-vs3" && has_value) {
       a.write_vs3 = argv[++i];
     } else if (arg == "--view3d-output" && has_value) {

@@ -42,6 +42,10 @@ class ExactPolygonTransport {
   /// G_ij, bit for bit the same for (i, j) and (j, i). 0 for i == j.
   double transport(std::uint32_t i, std::uint32_t j, Workspace& w) const;
 
+  /// The occluders, coplanar facets whose union is convex counted once (a block's face cut
+  /// into facets is one).
+  std::size_t occluder_count() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
