@@ -34,9 +34,10 @@ rad::PatchHierarchy grid(float size, float patch_area) {
   return rad::PatchHierarchy(scene, rad::MeshOptions{patch_area, patch_area});
 }
 
-/// The box [0,1]^3 as six outward-facing quads, one patch each, turned by `degrees` about
-/// the vertical line through its centre.
-rad::PatchHierarchy outward_box(float degrees = 0.0f) {
+/// The box [0,1]^3 as six outward-facing quads, turned by `degrees` about the vertical line
+/// through its centre, each face cut bilinearly into cuts x cuts facets (as an exporter writes
+/// them: their normals differ in the last bits when the box is turned), one patch each.
+rad::PatchHierarchy outward_box(float degrees = 0.0f, int cuts = 1) {
   rad::Scene scene;
   const rad::MaterialId m = scene.add_material(rad::Material{});
   const glm::vec3 centre(0.5f);
@@ -48,7 +49,12 @@ rad::PatchHierarchy outward_box(float degrees = 0.0f) {
       const glm::vec3 d = x - centre;
       x = centre + glm::vec3(std::cos(t) * d.x + std::sin(t) * d.z, d.y, -std::sin(t) * d.x + std::cos(t) * d.z);
     }
-    scene.add_polygon(q, m);
+    auto at = [&](int i, int j) {
+      const float u = static_cast<float>(i) / static_cast<float>(cuts), v = static_cast<float>(j) / static_cast<float>(cuts);
+      return (1.0f - v) * ((1.0f - u) * q[0] + u * q[1]) + v * ((1.0f - u) * q[3] + u * q[2]);
+    };
+    for (int i = 0; i < cuts; ++i)
+      for (int j = 0; j < cuts; ++j) scene.add_polygon({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)}, m);
   };
   add({{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}});
   add({{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}});
@@ -330,6 +336,26 @@ TEST_CASE("moment bases: one moment per direction for a turned box, the axes for
   const hr::MomentBases two_sided(tree, turned, std::vector<std::uint8_t>(6, 1));
   CHECK(!two_sided.of(hr::ClusterTree::root()).axes);
   CHECK(two_sided.of(hr::ClusterTree::root()).count == 6);
+
+  // The same box with each face cut into 6 x 6 facets: their normals differ in the last bits
+  // (more than six distinct ones), yet they are six directions, one per face.
+  const rad::PatchHierarchy faceted = outward_box(30.0f, 6);
+  REQUIRE(faceted.patches().size() == 6 * 36);
+  std::vector<std::array<float, 3>> normals;
+  for (const rad::Patch& patch : faceted.patches()) normals.push_back({patch.normal.x, patch.normal.y, patch.normal.z});
+  std::sort(normals.begin(), normals.end());
+  CHECK(std::unique(normals.begin(), normals.end()) - normals.begin() > 6);
+  const hr::ClusterTree faceted_tree(faceted);
+  const hr::MomentBases faceted_bases(faceted_tree, faceted, std::vector<std::uint8_t>(faceted.patches().size(), 0));
+  const hr::MomentBasis& faceted_root = faceted_bases.of(hr::ClusterTree::root());
+  CHECK(!faceted_root.axes);
+  CHECK(faceted_root.count == 6);
+  for (std::uint32_t p = 0; p < faceted.patches().size(); ++p) {
+    const glm::vec3& n = faceted.patches()[p].normal;
+    const int k = faceted_root.slot(faceted_bases.front(p, n).id);
+    REQUIRE(k >= 0);
+    CHECK(glm::length(faceted_root.directions[static_cast<std::size_t>(k)] - n) < 1e-5f);
+  }
 
   // The Cornell box faces more than six directions (its blocks are turned): its root keeps the
   // axes, the clusters of one block do not.

@@ -148,8 +148,9 @@ struct MomentBasis {
 /// Every cluster's MomentBasis and every patch side's direction, made bottom-up over a
 /// ClusterTree (the union of the children's directions while it has at most six). Patch
 /// normals along an axis (exactly +-1 in one component) take the axis ids; other normals are
-/// told apart by their components quantised to 2^-20, so the patches of one polygon share an
-/// id. Memory: 8 bytes per patch and 4 per cluster, plus one 104-byte basis per distinct
+/// told apart by their components quantised to 2^-12, so the patches of one polygon, and the
+/// facets of one face whose normals differ by rounding, share an id (a quantised axis is the
+/// axis' id). Memory: 8 bytes per patch and 4 per cluster, plus one 104-byte basis per distinct
 /// direction set, at most kMaxBases (clusters beyond fall back to the axes).
 /// Thread safety: immutable after construction.
 class MomentBases {
