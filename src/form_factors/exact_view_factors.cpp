@@ -47,6 +47,7 @@
 #include "form_factors/estimators.hpp"
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
+#include "scene/polygon_math.hpp"
 
 namespace radiosity::detail {
 
@@ -252,23 +253,22 @@ void ExactPolygonTransport::Impl::add_cluster(std::uint32_t begin, std::uint32_t
 // groups stay facet by facet. Fewer, larger occluders make fewer shadows to clip.
 void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hiding) {
   // The plane's normal made canonical (its first component beyond rounding noise positive), its
-  // offset, and the normal quantised to 2^-12: the facets of one turned face (a Cornell block's
-  // side cut into facets) have normals that differ in their last bits, so planes are told apart
-  // by the quantised normal (about 2.4e-4 rad) and then by offsets within epsilon. (Grouped by
-  // the exact normal, the closed Cornell box's 686 block facets made 627 occluders instead of
-  // 10, and its exact rows took longer than View3D's.) A face whose facets straddle a
-  // quantisation step merely stays in two parts, each merged or facet by facet.
+  // offset, and direction_key() of the normal (quantised to 2^-12): the facets of one turned
+  // face (a Cornell block's side cut into facets) have normals that differ in their last bits,
+  // so planes are told apart by that key and then by offsets within epsilon. (Grouped by the
+  // exact normal, the closed Cornell box's 686 block facets made 627 occluders instead of 10,
+  // and its exact rows took longer than View3D's.) A face whose facets straddle a quantisation
+  // step merely stays in two parts, each merged or facet by facet.
   struct Plane {
     glm::vec3 normal;
     float offset;
-    std::array<long, 3> key;
+    std::array<std::int64_t, 3> key;
   };
   auto plane_of = [&](std::uint32_t p) {
     glm::vec3 n = faces[p].normal;
     const float lead = std::fabs(n.x) > 1e-3f ? n.x : (std::fabs(n.y) > 1e-3f ? n.y : n.z);
     if (lead < 0.0f) n = -n;
-    return Plane{n, glm::dot(n, faces[p].corners[0]),
-                 {std::lround(4096.0f * n.x), std::lround(4096.0f * n.y), std::lround(4096.0f * n.z)}};
+    return Plane{n, glm::dot(n, faces[p].corners[0]), direction_key(n)};
   };
   std::sort(hiding.begin(), hiding.end(), [&](std::uint32_t x, std::uint32_t y) {
     const Plane px = plane_of(x), py = plane_of(y);

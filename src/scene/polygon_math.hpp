@@ -2,7 +2,9 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -34,6 +36,17 @@ inline glm::vec3 vertex_mean(const std::vector<glm::vec3>& vertices) {
   for (const glm::vec3& v : vertices) sum += v;
   return sum / static_cast<float>(vertices.size());
 }
+
+/// A unit normal's components quantised to 2^-12 (about 2.4e-4 rad): equal for the facets of
+/// one face, whose normals (each computed from its own float corners) differ in their last
+/// bits when the face is turned off the axes, and different for faces at any visible angle.
+/// A face whose facets straddle a step gets two keys; callers treat that as two faces.
+inline std::array<std::int64_t, 3> direction_key(const glm::vec3& n) {
+  constexpr double kSteps = 4096.0;
+  return {std::llround(double{n.x} * kSteps), std::llround(double{n.y} * kSteps), std::llround(double{n.z} * kSteps)};
+}
+/// direction_key() of the axis direction +-1 on one axis: the component that is not 0.
+inline constexpr std::int64_t kDirectionKeyUnit = 4096;
 
 /// Vertices may leave the best-fit plane by this fraction of the diameter and still be planar.
 inline constexpr float kPlanarityTolerance = 1e-4f;

@@ -18,6 +18,7 @@
 #include "core/assert.hpp"
 #include "core/constants.hpp"
 #include "core/parallel.hpp"
+#include "scene/polygon_math.hpp"
 
 namespace radiosity::detail {
 namespace {
@@ -132,7 +133,7 @@ MomentBases::MomentBases(const ClusterTree& tree, const PatchHierarchy& hierarch
   const std::vector<Patch>& patches = hierarchy.patches();
   RADIOSITY_ASSERT(has_back.size() == patches.size());
   // Direction ids, in patch order (so the same on every run): the axes' own, else one per
-  // normal quantised to 2^-12 (about 2.4e-4 rad), a quantised axis taking the axis' id. The
+  // direction_key() (the normal quantised to 2^-12), a quantised axis taking the axis' id. The
   // facets of one turned face (a block's side cut into facets as an exporter writes them) have
   // normals that differ in their last bits: quantised to 2^-20, the tall Cornell block's four
   // turned sides in 6 x 6 facets made 18 ids, its clusters passed six and fell back to the
@@ -142,15 +143,11 @@ MomentBases::MomentBases(const ClusterTree& tree, const PatchHierarchy& hierarch
   auto id_of = [&](const glm::vec3& n) {
     const std::uint32_t axis = axis_id(n);
     if (axis != kNone) return axis;
-    constexpr double kSteps = 4096.0;
-    const std::array<std::int64_t, 3> key{std::llround(double{n.x} * kSteps), std::llround(double{n.y} * kSteps),
-                                          std::llround(double{n.z} * kSteps)};
-    for (int a = 0; a < 3; ++a) {
-      const int b = (a + 1) % 3, c = (a + 2) % 3;
-      if (key[static_cast<std::size_t>(b)] != 0 || key[static_cast<std::size_t>(c)] != 0) continue;
-      if (key[static_cast<std::size_t>(a)] == static_cast<std::int64_t>(kSteps)) return static_cast<std::uint32_t>(2 * a);
-      if (key[static_cast<std::size_t>(a)] == -static_cast<std::int64_t>(kSteps))
-        return static_cast<std::uint32_t>(2 * a + 1);
+    const std::array<std::int64_t, 3> key = direction_key(n);
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (key[(a + 1) % 3] != 0 || key[(a + 2) % 3] != 0) continue;
+      if (key[a] == kDirectionKeyUnit) return static_cast<std::uint32_t>(2 * a);
+      if (key[a] == -kDirectionKeyUnit) return static_cast<std::uint32_t>(2 * a + 1);
     }
     const auto [at, inserted] = ids.emplace(key, next);
     if (inserted) ++next;
