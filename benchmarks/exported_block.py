@@ -9,6 +9,10 @@ triangle is wound the other way (a flipped face, as exports have). The JSON puts
 of radiance 100 over it (z up).
 
     python3 benchmarks/exported_block.py OUTDIR    # OUTDIR/block.obj, block.mtl, daylight.json
+    python3 benchmarks/exported_block.py --turn OUTDIR   # each building turned about its centre
+
+With --turn, building b is turned by 11 b degrees (mod 90) about its vertical axis, as the
+buildings of a real city stand (the ground is cut as before, so its facets lie partly under them).
 
 3 744 triangles. Session 37 found three defects with it as a user (docs/VIEW_FACTORS.md, "The
 sky view factor"; find_inconsistent_winding()); session 38 measured the automatic method choice
@@ -16,6 +20,7 @@ on it meshed finely (docs/HIERARCHICAL.md, "The automatic method choice";
 benchmarks/element_accuracy.py).
 """
 import json
+import math
 import os
 import sys
 
@@ -25,9 +30,12 @@ CELL = 5.0
 
 
 def main():
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    turn = "--turn" in args
+    args = [a for a in args if a != "--turn"]
+    if len(args) != 1:
         raise SystemExit(__doc__)
-    out = sys.argv[1]
+    out = args[0]
     os.makedirs(out, exist_ok=True)
     vertices, faces = [], []  # faces: (group, material, [vertex numbers])
 
@@ -54,10 +62,20 @@ def main():
         x0, y0 = LOWER[b // 4], LOWER[b % 4]
         x1, y1 = x0 + 20, y0 + 20
         name = f"b{b}"
+        angle = math.radians((11 * b) % 90) if turn else 0.0
+        cx, cy = x0 + 10, y0 + 10
+
+        def turned(a, b_, c, d, flip_second=False, group=None, material="concrete"):
+            """quad() with each corner turned about the building's centre."""
+            def t(p):
+                dx, dy = p[0] - cx, p[1] - cy
+                return (cx + math.cos(angle) * dx - math.sin(angle) * dy,
+                        cy + math.sin(angle) * dx + math.cos(angle) * dy, p[2])
+            quad(group, material, t(a), t(b_), t(c), t(d), flip_second)
         for i in range(4):
             for j in range(4):
                 x, y = x0 + CELL * i, y0 + CELL * j
-                quad(name + "_roof", "concrete", (x, y, h), (x + CELL, y, h), (x + CELL, y + CELL, h), (x, y + CELL, h))
+                turned((x, y, h), (x + CELL, y, h), (x + CELL, y + CELL, h), (x, y + CELL, h), group=name + "_roof")
         dz = h / 4
         # Each side from its start corner along its direction, outward normal by the right hand.
         sides = [((x0, y0), (1, 0)), ((x1, y0), (0, 1)), ((x1, y1), (-1, 0)), ((x0, y1), (0, -1))]
@@ -72,8 +90,8 @@ def main():
                     bx, by = ax + ux * CELL, ay + uy * CELL
                     z = dz * k
                     flip = b == len(HEIGHTS) - 1 and s == 3 and i == 3 and k == 3
-                    quad(name + "_wall", "concrete", (ax, ay, z), (bx, by, z), (bx, by, z + dz), (ax, ay, z + dz), flip)
-        quad(name + "_bottom", "concrete", (x0, y0, 0), (x0, y1, 0), (x1, y1, 0), (x1, y0, 0))
+                    turned((ax, ay, z), (bx, by, z), (bx, by, z + dz), (ax, ay, z + dz), flip, group=name + "_wall")
+        turned((x0, y0, 0), (x0, y1, 0), (x1, y1, 0), (x1, y0, 0), group=name + "_bottom")
 
     with open(os.path.join(out, "block.mtl"), "w") as f:
         f.write("newmtl concrete\nKd 1 1 1\nnewmtl asphalt\nKd 0.1 0.1 0.1\n")
