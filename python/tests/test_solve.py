@@ -143,3 +143,27 @@ def test_concurrent_solves_from_python_threads_agree():
     for k in range(2):
         assert calls[k] > 0
         np.testing.assert_array_equal(results[k], reference)
+
+
+def test_turned_buildings_sliver_stays_within_the_sky_and_hierarchical_agrees_with_gauss_seidel(tmp_path):
+    """An exported block with its buildings turned (benchmarks/exported_block.py --turn): the
+    contact lines leave slivers of ground open beside the buildings' feet. Until session 39 the
+    hierarchical solver gave one of them 402 W/m^2 under a sky of 100 (Gauss-Seidel: 62), what a
+    link into its mostly buried cluster brought, pushed by 1 / exposure; its element RMS against
+    Gauss-Seidel was 10 %. Measured now: at most 101 W/m^2 either way, 1.4 % element RMS (power
+    over area) against this Gauss-Seidel solve."""
+    import subprocess
+    import sys
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "exported_block.py"
+    subprocess.run([sys.executable, str(script), "--turn", str(tmp_path)], check=True, capture_output=True)
+    scene = radiosity.load_scene(tmp_path / "daylight.json")
+    values = {}
+    for method, options in (("gauss-seidel", {"form_factors": "monte-carlo"}), ("hierarchical", {"epsilon": 0.05})):
+        solution = radiosity.solve(scene, method, **options)
+        irradiance = solution.element_values("irradiance").mean(axis=1)
+        assert irradiance.max() < 1.2 * 100.0, method  # the sky's horizontal irradiance is 100 W/m^2
+        values[method] = solution.element_radiosity().mean(axis=1) * solution.element_exposure()
+    reference = values["gauss-seidel"]
+    kept = reference > 0.1 * reference.mean()
+    relative = (values["hierarchical"][kept] - reference[kept]) / reference[kept]
+    assert np.sqrt(np.mean(relative ** 2)) < 0.04
