@@ -14,7 +14,6 @@
 // detail::ViewFactorRows (view_factor_rows.hpp), which the MPI module (src/mpi/) calls for each
 // process's block; the correction is the end, on the whole matrix.
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -369,7 +368,7 @@ bool exact_rows(const detail::ExactPolygonTransport& transport, const std::vecto
   // Chunks of rows of about equal work (row r integrates n - r pairs in a whole matrix), each
   // of about as many pairs as BlockSizer asks for.
   detail::BlockSizer chunk_pairs(std::max<std::size_t>(n, 1) * 4, 64, std::max<std::size_t>(n, 1) * 64);
-  const std::size_t kPieceColumns = std::getenv("RAD_WHOLE_ROWS") ? std::max<std::size_t>(n, 1) : 256;
+  constexpr std::size_t kPieceColumns = 256;
   struct Piece {
     std::size_t row, first, last;  // row `row`, columns [first, last)
   };

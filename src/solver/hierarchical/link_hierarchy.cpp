@@ -1016,14 +1016,15 @@ struct LinkHierarchy::Impl {
   /// How far the rule for receivers with a buried part lowers its floor for receiver `r`
   /// (kBuriedClusterFloor x the threshold, times this): infinite for a receiver with nothing
   /// buried (the rule does not apply) or everything (it receives nothing), 1 for a cluster
-  /// whose exposure is kMinExposure or more (its least per direction), and below that the
-  /// exposure over kMinExposure, for clusters and inner elements. What a link brings to a receiver with exposure x is pushed to
-  /// its open parts times 1 / x, and its estimate, from rays at points over the whole receiver,
-  /// is noisy by about the light of one ray's point in a share x of them: a link into a cluster
-  /// of ground mostly under a building, beside a sliver left open, gave the sliver 4 times the
-  /// irradiance of the open sky (an exported block with its buildings turned,
-  /// benchmarks/exported_block.py --turn: 402 W/m^2 under a sky of 100, Gauss-Seidel 62). Down
-  /// to receivers mostly open or wholly buried, the push cannot amplify the noise much.
+  /// whose exposure is kMinExposure or more (its least per direction), and below that, for
+  /// clusters and inner elements, the exposure over kMinExposure. What a link brings to a
+  /// receiver with exposure x is pushed to its open parts times 1 / x, and its estimate, from
+  /// rays at points over the whole receiver, is noisy by about the light of one ray's point in
+  /// a share x of them: a link into a cluster of ground mostly under a building, beside a
+  /// sliver left open, gave the sliver 4 times the irradiance of the open sky (an exported
+  /// block with its buildings turned, benchmarks/exported_block.py --turn: 402 W/m^2 under a
+  /// sky of 100, Gauss-Seidel 62). Down to receivers mostly open or wholly buried, the push
+  /// cannot amplify the noise much (docs/HIERARCHICAL.md, "Buried parts").
   float buried_scale(const PatchHierarchy& h, NodeHandle r) const {
     constexpr float kNotBuried = std::numeric_limits<float>::infinity();
     float x = 1.0f;
