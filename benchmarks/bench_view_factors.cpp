@@ -46,7 +46,7 @@ struct Args {
   float room_facet = 0.25f;
   /// --cornell MM: instead of the room, the Cornell box closed by a front wall, its two blocks as
   /// published (one turned each way), every face cut into facets of about MM millimetres, the
-  /// floor cut around the blocks (23 gives 4 246 facets).
+  /// floor cut around the blocks (23 gives 4 111 facets).
   float cornell_facet = 0.0f;
   std::string write_vs3;      ///< write the room as a View3D input file here (before computing)
   std::string view3d_output;  ///< View3D's text output file (out=0) for that room, to compare with
