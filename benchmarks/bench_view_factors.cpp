@@ -175,8 +175,20 @@ rad::Scene faceted_cornell(float facet) {
   // than 4 corners fanned into triangles, as View3D takes 3 or 4), so that no facet lies partly
   // under a block, seeing nothing there (its row would not sum to 1 and the two programs would
   // disagree about the hidden part: View3D counts it).
-  const std::vector<std::vector<glm::vec2>> footprints = {{{130, 65}, {82, 225}, {240, 272}, {290, 114}},
-                                                          {{423, 247}, {265, 296}, {314, 456}, {472, 406}}};
+  // The blocks as rad::cornell_box() has them (the published corners); a block's footprint is
+  // its top face seen from above (its sides are vertical).
+  const rad::Scene published = rad::cornell_box();
+  const char* const block_groups[2] = {"short_block", "tall_block"};
+  std::vector<std::vector<glm::vec2>> footprints;
+  for (const char* name : block_groups) {
+    const rad::GroupId g = *published.find_group(name);
+    for (const rad::Polygon& p : published.polygons()) {
+      if (p.group != g || !(p.normal.y > 0.99f)) continue;
+      std::vector<glm::vec2> corners;
+      for (const glm::vec3& v : p.vertices) corners.emplace_back(v.x, v.z);
+      footprints.push_back(corners);
+    }
+  }
   using Piece = std::vector<glm::vec2>;
   auto cross2 = [](glm::vec2 u, glm::vec2 v) { return u.x * v.y - u.y * v.x; };
   auto area2 = [&](const Piece& q) {
@@ -247,24 +259,12 @@ rad::Scene faceted_cornell(float facet) {
   facets({{0, 0, 0}, {X, 0, 0}, {X, Y, 0}, {0, Y, 0}}, inside, true, "front_wall");
   facets({{0, 0, 0}, {0, 0, Z}, {0, Y, Z}, {0, Y, 0}}, inside, true, "green_wall");
   facets({{X, 0, 0}, {X, 0, Z}, {X, Y, Z}, {X, Y, 0}}, inside, true, "red_wall");
-  auto block = [&](const std::vector<Quad>& faces, const char* group) {
-    glm::vec3 centre(0.0f);
-    for (const Quad& q : faces)
-      for (const glm::vec3& p : q) centre += p / 20.0f;
-    for (const Quad& q : faces) facets(q, centre, false, group);
-  };
-  block({{{130, 165, 65}, {82, 165, 225}, {240, 165, 272}, {290, 165, 114}},
-         {{290, 0, 114}, {290, 165, 114}, {240, 165, 272}, {240, 0, 272}},
-         {{130, 0, 65}, {130, 165, 65}, {290, 165, 114}, {290, 0, 114}},
-         {{82, 0, 225}, {82, 165, 225}, {130, 165, 65}, {130, 0, 65}},
-         {{240, 0, 272}, {240, 165, 272}, {82, 165, 225}, {82, 0, 225}}},
-        "short_block");
-  block({{{423, 330, 247}, {265, 330, 296}, {314, 330, 456}, {472, 330, 406}},
-         {{423, 0, 247}, {423, 330, 247}, {472, 330, 406}, {472, 0, 406}},
-         {{472, 0, 406}, {472, 330, 406}, {314, 330, 456}, {314, 0, 456}},
-         {{314, 0, 456}, {314, 330, 456}, {265, 330, 296}, {265, 0, 296}},
-         {{265, 0, 296}, {265, 330, 296}, {423, 330, 247}, {423, 0, 247}}},
-        "tall_block");
+  // The blocks' faces, outward as cornell_box() makes them.
+  for (const char* name : block_groups) {
+    const rad::GroupId g = *published.find_group(name);
+    for (const rad::Polygon& p : published.polygons())
+      if (p.group == g) facets(Quad(p.vertices.begin(), p.vertices.end()), p.vertices[0] + p.normal, true, name);
+  }
   return scene;
 }
 

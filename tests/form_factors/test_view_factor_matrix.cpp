@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "../../tools/radiosity/npz_format.hpp"
+#include "core/constants.hpp"
 #include "form_factors/exact_view_factors.hpp"
 #include "form_factors/view_factor_rows.hpp"
 #include "city.hpp"
@@ -632,7 +633,7 @@ TEST_SUITE("form_factors") {
     // facets' normals then differ in their last bits, and until session 39 each such facet was
     // an occluder of its own (the closed Cornell box of 4 111 facets: 627 occluders instead of
     // 10, and 4 times the time).
-    const float turn = 27.0f * 3.14159265f / 180.0f, c = std::cos(turn), s = std::sin(turn);
+    const float turn = 27.0f * radiosity::detail::kPi / 180.0f, c = std::cos(turn), s = std::sin(turn);
     auto corner = [&](float x, float y, float z) {  // (x, z) in [-0.5, 0.5] about the room's centre
       return glm::vec3(1.5f + c * x - s * z, y, 1.5f + s * x + c * z);
     };
