@@ -270,12 +270,16 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
     if (lead < 0.0f) n = -n;
     return Plane{n, glm::dot(n, faces[p].corners[0]), direction_key(n)};
   };
-  std::sort(hiding.begin(), hiding.end(), [&](std::uint32_t x, std::uint32_t y) {
-    const Plane px = plane_of(x), py = plane_of(y);
-    if (px.key != py.key) return px.key < py.key;
-    if (px.offset != py.offset) return px.offset < py.offset;
-    return x < y;
+  // Each polygon's plane once, then sorted with it (by key, offset and id).
+  std::vector<std::pair<Plane, std::uint32_t>> planes;
+  planes.reserve(hiding.size());
+  for (const std::uint32_t p : hiding) planes.emplace_back(plane_of(p), p);
+  std::sort(planes.begin(), planes.end(), [](const auto& x, const auto& y) {
+    if (x.first.key != y.first.key) return x.first.key < y.first.key;
+    if (x.first.offset != y.first.offset) return x.first.offset < y.first.offset;
+    return x.second < y.second;
   });
+  for (std::size_t k = 0; k < planes.size(); ++k) hiding[k] = planes[k].second;
   auto add = [&](const std::vector<glm::vec3>& corners, glm::vec3 normal, const std::uint32_t* members,
                  std::size_t count) {
     Occluder o;
@@ -300,10 +304,10 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
   std::vector<std::size_t> hull;
   std::size_t begin = 0;
   while (begin < hiding.size()) {
-    const Plane plane = plane_of(hiding[begin]);
+    const Plane& plane = planes[begin].first;
     std::size_t end = begin + 1;
     while (end < hiding.size()) {
-      const Plane next = plane_of(hiding[end]);
+      const Plane& next = planes[end].first;
       if (next.key != plane.key || std::fabs(next.offset - plane.offset) > epsilon) break;
       ++end;
     }
