@@ -163,7 +163,17 @@ class RADIOSITY_API PatchHierarchy {
   /// neighbours cut their edge into different numbers of patches (so its inner points are not
   /// shared), the points both sides have are averaged over both and the others interpolated
   /// between them, which keeps the field continuous there too.
-  std::vector<Rgb> vertex_values(const std::vector<Rgb>& element_values) const;
+  ///
+  /// `exposure` (empty, or one value in [0, 1] per element id: Solution::exposure()) is the
+  /// share of each leaf that is not buried under a solid standing on it; each leaf then weighs
+  /// its area x exposure, since its value is its open part's: a wholly buried leaf (the floor
+  /// under a block) does not darken the vertices it shares with open ones, which would
+  /// otherwise show as dark wedges along every contact. A vertex with no open leaf around it
+  /// takes the mean of its leaves' corners that have one, ring by ring inward (as lightmap
+  /// bakers dilate texels under geometry), so the corner of a host triangle that lies under a
+  /// block carries its open part's light rather than 0.
+  std::vector<Rgb> vertex_values(const std::vector<Rgb>& element_values,
+                                 const std::vector<float>& exposure = {}) const;
 
   /// Fills inner nodes with the area-weighted mean of their children (leaves are read).
   void aggregate(std::vector<Rgb>& element_values) const;

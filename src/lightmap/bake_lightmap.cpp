@@ -268,7 +268,7 @@ class FinalGather {
       back_ = solution.vertex_back_radiosity();
     } else {
       const auto k = static_cast<std::size_t>(options.light_group);
-      front_ = h_.vertex_values(solution.light_group_values(k, Quantity::radiosity));
+      front_ = h_.vertex_values(solution.light_group_values(k, Quantity::radiosity), solution.exposure());
       std::vector<Rgb> back = solution.light_groups()[k].back_radiosity;
       for (Rgb& b : back) b *= solution.light_group_weights()[k];
       if (!back.empty()) back_ = h_.vertex_values(back);
@@ -504,7 +504,8 @@ Lightmap bake_lightmap(const Scene& scene, const Solution& solution, const std::
   const std::vector<Rgb> field = h.vertex_values(
       options.light_group < 0 ? solution.element_values(options.quantity)
                               : solution.light_group_values(static_cast<std::size_t>(options.light_group),
-                                                            options.quantity));
+                                                            options.quantity),
+      solution.exposure());
 
   const int W = options.width, H = options.height;
   Lightmap map;

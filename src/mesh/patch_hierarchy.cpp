@@ -82,6 +82,66 @@ double distance_to_segment(const glm::dvec3& p, const glm::dvec3& a, const glm::
   return glm::length(p - (a + t * ab));
 }
 
+// PatchHierarchy::vertex_values()'s fill of the vertices whose `weight` (the open area of the
+// leaves around them) is 0: under a block, inside a prop sunk into the floor.
+void dilate_into_buried(const std::vector<Element>& elements, const std::vector<std::uint32_t>& leaves,
+                        const std::vector<double>& weight, std::vector<Rgb>& out) {
+  // Ring by ring: each pass gives every corner still without a value the mean, over the
+  // leaves it belongs to, of those leaves' corners that had one before the pass (so the result
+  // does not depend on the order of the leaves). A buried region is as many passes wide as it
+  // is leaves across; what no pass reaches (a polygon wholly buried) keeps 0.
+  std::vector<std::uint8_t> known(out.size());
+  for (std::size_t v = 0; v < known.size(); ++v) known[v] = weight[v] > 0.0;
+  std::vector<std::uint32_t> pending;
+  for (const std::uint32_t id : leaves) {
+    const Element& e = elements[id];
+    for (int k = 0; k < e.corner_count(); ++k)
+      if (!known[e.corners[k]]) {
+        pending.push_back(id);
+        break;
+      }
+  }
+  std::vector<glm::dvec3> sum(out.size(), glm::dvec3(0.0));
+  std::vector<std::uint32_t> count(out.size(), 0);
+  std::vector<std::uint32_t> reached;
+  while (!pending.empty()) {
+    for (const std::uint32_t id : pending) {
+      const Element& e = elements[id];
+      glm::dvec3 mean(0.0);
+      int n = 0;
+      for (int k = 0; k < e.corner_count(); ++k)
+        if (known[e.corners[k]]) {
+          mean += glm::dvec3(out[e.corners[k]]);
+          ++n;
+        }
+      if (n == 0) continue;
+      mean /= n;
+      for (int k = 0; k < e.corner_count(); ++k) {
+        const std::uint32_t v = e.corners[k];
+        if (known[v]) continue;
+        if (count[v]++ == 0) reached.push_back(v);
+        sum[v] += mean;
+      }
+    }
+    if (reached.empty()) break;  // the rest lie where nothing open is connected
+    for (const std::uint32_t v : reached) {
+      out[v] = Rgb(sum[v] / static_cast<double>(count[v]));
+      known[v] = 1;
+      sum[v] = glm::dvec3(0.0);
+      count[v] = 0;
+    }
+    reached.clear();
+    std::size_t kept = 0;
+    for (const std::uint32_t id : pending) {
+      const Element& e = elements[id];
+      bool unknown_corner_left = false;
+      for (int k = 0; k < e.corner_count(); ++k) unknown_corner_left = unknown_corner_left || !known[e.corners[k]];
+      if (unknown_corner_left) pending[kept++] = id;
+    }
+    pending.resize(kept);
+  }
+}
+
 bool fits(double area, float limit) { return area <= static_cast<double>(limit) * (1.0 + kAreaSlack); }
 
 struct AreaCentroid {
@@ -1181,21 +1241,27 @@ glm::vec3 PatchHierarchy::sample_point(std::uint32_t element, glm::vec2 uv) cons
   return detail::CellSampler(corners.data(), e.corner_count())(uv);
 }
 
-std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_values) const {
+std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_values,
+                                               const std::vector<float>& exposure) const {
   if (element_values.size() != elements_.size())
     throw Error(ErrorCode::invalid_argument, "PatchHierarchy::vertex_values: element_values has " +
                                                  std::to_string(element_values.size()) + " entries, expected " +
                                                  std::to_string(elements_.size()) + " (one per element)");
-  // Area-weighted mean of the leaves around each vertex. Accumulating in double makes a constant
-  // field come back exactly after rounding to float.
+  if (!exposure.empty() && exposure.size() != elements_.size())
+    throw Error(ErrorCode::invalid_argument, "PatchHierarchy::vertex_values: exposure has " +
+                                                 std::to_string(exposure.size()) + " entries, expected " +
+                                                 std::to_string(elements_.size()) + " (one per element, or none)");
+  // Mean of the leaves around each vertex weighted by their open area. Accumulating in double
+  // makes a constant field come back exactly after rounding to float.
   std::vector<glm::dvec3> sum(vertices_.size(), glm::dvec3(0.0));
   std::vector<double> weight(vertices_.size(), 0.0);
   for (const std::uint32_t id : leaves_) {
     const Element& e = elements_[id];
     const glm::dvec3 value(element_values[id]);
+    const double w = static_cast<double>(e.area) * (exposure.empty() ? 1.0 : static_cast<double>(exposure[id]));
     for (int k = 0; k < e.corner_count(); ++k) {
-      sum[e.corners[k]] += static_cast<double>(e.area) * value;
-      weight[e.corners[k]] += static_cast<double>(e.area);
+      sum[e.corners[k]] += w * value;
+      weight[e.corners[k]] += w;
     }
   }
   // Seams (smooth neighbours whose edge points are not shared): with side counts n_s and g
@@ -1228,6 +1294,7 @@ std::vector<Rgb> PatchHierarchy::vertex_values(const std::vector<Rgb>& element_v
   std::vector<Rgb> out(vertices_.size(), Rgb(0.0f));
   for (std::size_t v = 0; v < vertices_.size(); ++v)
     if (weight[v] > 0.0) out[v] = Rgb(sum[v] / weight[v]);
+  if (!exposure.empty()) dilate_into_buried(elements_, leaves_, weight, out);
 
   // Every other point of a seam side, its lattice points and the midpoints subdivision made
   // along it, gets the linear interpolation between the common knots around it: then each side

@@ -47,7 +47,7 @@ std::vector<Rgb> Solution::radiosity_with_ambient() const {
 }
 
 std::vector<Rgb> Solution::vertex_radiosity(bool with_ambient) const {
-  return hierarchy_.vertex_values(with_ambient ? radiosity_with_ambient() : radiosity_);
+  return hierarchy_.vertex_values(with_ambient ? radiosity_with_ambient() : radiosity_, exposure_);
 }
 
 std::vector<Rgb> Solution::vertex_back_radiosity() const {
@@ -216,7 +216,7 @@ std::vector<Rgb> Solution::mesh_triangle_values(MeshId mesh, Quantity quantity) 
 
 std::vector<Rgb> Solution::mesh_vertex_values(MeshId mesh, Quantity quantity) const {
   const SolvedMesh& m = solved_mesh(mesh);
-  const std::vector<Rgb> at_vertex = hierarchy_.vertex_values(element_values(quantity));
+  const std::vector<Rgb> at_vertex = hierarchy_.vertex_values(element_values(quantity), exposure_);
   const auto ranges = patches_by_polygon(hierarchy_, m);
   std::vector<glm::dvec3> sum(m.positions.size(), glm::dvec3(0.0));
   std::vector<double> weight(m.positions.size(), 0.0);

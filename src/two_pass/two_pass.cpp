@@ -90,7 +90,7 @@ class TwoPassRenderer {
     auto start = std::chrono::steady_clock::now();
     vertex_B_ = pass1.vertex_radiosity(options.ambient);
     vertex_back_ = pass1.vertex_back_radiosity();
-    vertex_direct_ = direct_part_of_pass1();
+    vertex_direct_ = direct_part_of_pass1(pass1.exposure());
     caustics_ = options.content == TwoPassContent::full && options.caustics.photons > 0;
     specular_ = options.content == TwoPassContent::full && options.max_specular_depth > 0 && scene_.has_specular();
     max_radius_ = options.caustics.max_radius > 0.0f ? options.caustics.max_radius : 0.02f * scene.bounds().diagonal();
@@ -131,8 +131,10 @@ class TwoPassRenderer {
   /// the lights, by stratified shadow rays; the sky's directions stratified too and paired with
   /// the points by a random permutation), interpolated to the vertices like the radiosity, and
   /// capped at the radiosity so the indirect remainder is never negative (the two estimates
-  /// differ by the solver's error).
-  std::vector<Rgb> direct_part_of_pass1() const {
+  /// differ by the solver's error). Where pass 1 found a leaf partly buried (`exposure`,
+  /// Solution::exposure()), its points under the solid see nothing: the mean is over its
+  /// open part, as pass 1's values are.
+  std::vector<Rgb> direct_part_of_pass1(const std::vector<float>& exposure) const {
     const PatchHierarchy& h = scene_.hierarchy();
     std::vector<Rgb> element_direct(h.elements().size(), Rgb(0.0f));
     const auto& leaves = h.leaves();
@@ -165,11 +167,12 @@ class TwoPassRenderer {
               }
             }
           H /= static_cast<float>(n * n);
+          if (!exposure.empty() && exposure[e] > 0.0f) H /= exposure[e];
         }
         element_direct[e] = s.emission + s.diffuse * H;
       }
     });
-    std::vector<Rgb> direct = h.vertex_values(element_direct);
+    std::vector<Rgb> direct = h.vertex_values(element_direct, exposure);
     for (std::size_t v = 0; v < direct.size(); ++v) direct[v] = glm::min(direct[v], vertex_B_[v]);
     return direct;
   }

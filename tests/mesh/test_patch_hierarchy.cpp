@@ -44,6 +44,13 @@ Scene mixed_scene() {
   return scene;
 }
 
+float centroid_x(const PatchHierarchy& h, std::uint32_t id) {
+  const Element& e = h.element(id);
+  float x = 0.0f;
+  for (int c = 0; c < e.corner_count(); ++c) x += h.vertices()[e.corners[static_cast<std::size_t>(c)]].x;
+  return x / static_cast<float>(e.corner_count());
+}
+
 double signed_area_along(const PatchHierarchy& h, std::uint32_t id) {
   const Element& e = h.element(id);
   const auto& v = h.vertices();
@@ -239,6 +246,40 @@ TEST_CASE("a constant field is reproduced exactly at every vertex") {
   const Rgb c(0.1f, 0.7f, 3.3f);
   const std::vector<Rgb> values(h.elements().size(), c);
   for (const Rgb& v : h.vertex_values(values)) CHECK(v == c);
+}
+
+TEST_CASE("vertex values weigh leaves by their open area: buried leaves neither darken their open neighbours' corners nor "
+          "stay black at their own") {
+  // A 4 x 1 floor quad meshed into 4 x 1 unit leaves (welded along x), the two at x < 2 under a
+  // block (exposure 0, value 0 as a solver leaves them), the others open with value 1 and 3.
+  Scene scene;
+  const MaterialId m = scene.add_material(Material{});
+  add_quad(scene, {0, 0, 0}, {4, 0, 0}, {0, 0, -1}, m, "floor");
+  PatchHierarchy h(scene, MeshOptions{1.0f, 1.0f});
+  REQUIRE(h.leaves().size() == 4);
+  std::vector<Rgb> values(h.elements().size(), Rgb(0.0f));
+  std::vector<float> exposure(h.elements().size(), 1.0f);
+  for (const std::uint32_t leaf : h.leaves()) {
+    const float x = centroid_x(h, leaf);
+    values[leaf] = Rgb(x < 2.0f ? 0.0f : x < 3.0f ? 1.0f : 3.0f);
+    exposure[leaf] = x < 2.0f ? 0.0f : 1.0f;
+  }
+  const std::vector<Rgb> area_weighted = h.vertex_values(values);
+  const std::vector<Rgb> open_weighted = h.vertex_values(values, exposure);
+  for (std::size_t v = 0; v < h.vertices().size(); ++v) {
+    const float x = h.vertices()[v].x;
+    CAPTURE(x);
+    // Without exposure, the corners at x = 2 take the mean with the buried leaf: 0.5.
+    if (x == 2.0f) CHECK(area_weighted[v].x == doctest::Approx(0.5));
+    // With it, the open leaf's value there and beyond; under the block, the corners one ring
+    // in take the mean of their leaf's known corners (1), and the next ring takes theirs.
+    const float expected = x >= 4.0f ? 3.0f : x >= 3.0f ? 2.0f : 1.0f;
+    CHECK(open_weighted[v].x == doctest::Approx(expected));
+  }
+  // Wholly buried: nothing to take a value from, every vertex 0.
+  const std::vector<float> buried(h.elements().size(), 0.0f);
+  for (const Rgb& v : h.vertex_values(std::vector<Rgb>(h.elements().size(), Rgb(5.0f)), buried)) CHECK(v.x == 0.0f);
+  CHECK_THROWS_AS(h.vertex_values(values, std::vector<float>(3, 1.0f)), Error);
 }
 
 TEST_CASE("vertex values are continuous across T-vertices - nested ones included (abs 1e-5)") {
