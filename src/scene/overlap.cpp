@@ -284,6 +284,89 @@ bool contact_of(const Search& s, PolygonId ia, PolygonId ib, ContactLine& out, b
   return true;
 }
 
+// Polygon `id`'s distance inside its border from `x` (a point in its plane): the least over its
+// edges of the distance to the edge's line, negative outside.
+double depth_inside(const Search& s, PolygonId id, const glm::dvec3& x) {
+  const Polygon& a = (*s.polygons)[id];
+  const glm::dvec3& normal = s.planes[id].normal;
+  double depth = 1e300;
+  for (std::size_t i = 0, n = a.vertices.size(); i < n; ++i) {
+    const glm::dvec3 u(a.vertices[i]), v(a.vertices[(i + 1) % n]);
+    const double edge_length = glm::length(v - u);
+    if (!(edge_length > 0.0)) continue;
+    depth = std::min(depth, glm::dot(x - u, glm::cross(normal, v - u) / edge_length));
+  }
+  return depth;
+}
+
+// Contact segments that divide their polygon together: a chain of them, joined end to end,
+// whose loose ends all lie on the polygon's border. A wall cut into facets stands on a ground
+// triangle with each facet's foot ending inside it, and a building's corner stands in one
+// with two feet meeting there; either way the triangle is partly under the building, and an
+// element across the feet would be partly buried: its light the mean of its open part and of
+// the dark under the building (session 40 found dark wedges along every turned building's feet).
+// Cutting along each such segment's whole line leaves every piece wholly on one side of every
+// foot, so wholly under the building or wholly open (the footprint is an intersection of the
+// half-planes of its edges, or a union of such). A closed chain (a block whose four feet all lie
+// inside a floor) or one with an end inside the polygon (a wall that stops in the middle of a
+// room) stays segments: cutting it along whole lines would spread slivers over the floor.
+// `segments` sorted by polygon; the lines are appended to `lines`, the segments kept (the mesh
+// is graded toward them as well).
+void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>& segments,
+                              std::vector<ContactLine>& lines) {
+  const double join = 4.0 * s.tolerance;    // ends this close are one point (shared facet corners)
+  const double border = 3.0 * s.tolerance;  // segments end `tolerance` inside a's border
+  std::vector<std::uint32_t> parent, ends, matched;
+  for (std::size_t first = 0; first < segments.size();) {
+    const PolygonId id = segments[first].polygon;
+    std::size_t last = first;
+    while (last < segments.size() && segments[last].polygon == id) ++last;
+    const auto n = static_cast<std::uint32_t>(last - first);
+    auto end_point = [&](std::uint32_t e) -> const glm::dvec3& {
+      const ContactSegment& c = segments[first + e / 2];
+      return e % 2 == 0 ? c.from : c.to;
+    };
+    // Union-find over the segments; ends are matched by a sweep along x.
+    parent.resize(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto root = [&](std::uint32_t k) {
+      while (parent[k] != k) k = parent[k] = parent[parent[k]];
+      return k;
+    };
+    ends.resize(2 * std::size_t{n});
+    std::iota(ends.begin(), ends.end(), 0u);
+    std::sort(ends.begin(), ends.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return std::make_pair(end_point(x).x, x) < std::make_pair(end_point(y).x, y);
+    });
+    matched.assign(2 * std::size_t{n}, 0);
+    for (std::size_t i = 0; i < ends.size(); ++i)
+      for (std::size_t j = i + 1; j < ends.size() && end_point(ends[j]).x - end_point(ends[i]).x <= join; ++j) {
+        if (ends[i] / 2 == ends[j] / 2 || glm::length(end_point(ends[i]) - end_point(ends[j])) > join) continue;
+        matched[ends[i]] = matched[ends[j]] = 1;
+        parent[root(ends[i] / 2)] = root(ends[j] / 2);
+      }
+    // A chain divides the polygon when it has loose ends and every one lies on the border.
+    std::vector<std::uint8_t> loose(n, 0), inner(n, 0);
+    for (std::uint32_t e = 0; e < 2 * n; ++e) {
+      if (matched[e]) continue;
+      const std::uint32_t r = root(e / 2);
+      loose[r] = 1;
+      if (depth_inside(s, id, end_point(e)) > border) inner[r] = 1;
+    }
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t r = root(k);
+      if (!loose[r] || inner[r]) continue;
+      const ContactSegment& c = segments[first + k];
+      ContactLine l;
+      l.polygon = id;
+      l.point = 0.5 * (c.from + c.to);
+      l.direction = glm::normalize(c.to - c.from);
+      lines.push_back(l);
+    }
+    first = last;
+  }
+}
+
 /// One piece of the broad phase: a BVH over some of the polygons (`ids`), for rtcCollide().
 struct Chunk {
   const Search* search = nullptr;
@@ -506,10 +589,23 @@ Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going) {
   Search s;
   s.contacts = true;
   search_pairs(scene, s, "find_contacts", keep_going);
-  // Sorted by polygon, then by line, and one line per polygon where several polygons meet it
-  // along the same line (a wall modelled as two coincident faces, collinear walls): the order
-  // of Embree's callbacks must not show.
+  // The query may report a pair twice and in any order.
+  std::vector<ContactSegment> segments = std::move(s.segments);
+  auto segment_key = [](const ContactSegment& c) {
+    return std::make_tuple(c.polygon, c.other, c.from.x, c.from.y, c.from.z, c.to.x, c.to.y, c.to.z);
+  };
+  std::sort(segments.begin(), segments.end(),
+            [&](const ContactSegment& x, const ContactSegment& y) { return segment_key(x) < segment_key(y); });
+  segments.erase(std::unique(segments.begin(), segments.end(),
+                             [&](const ContactSegment& x, const ContactSegment& y) {
+                               return segment_key(x) == segment_key(y);
+                             }),
+                 segments.end());
   std::vector<ContactLine> lines = std::move(s.lines);
+  lines_of_dividing_chains(s, segments, lines);
+  // Sorted by polygon, then by line, and one line per polygon where several polygons meet it
+  // along the same line (a wall modelled as two coincident faces, collinear walls, the facets
+  // of one wall): the order of Embree's callbacks must not show.
   auto key = [](const ContactLine& l) {
     return std::make_tuple(l.polygon, l.direction.x, l.direction.y, l.direction.z, l.point.x, l.point.y, l.point.z);
   };
@@ -528,18 +624,6 @@ Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going) {
     }
     if (!same) out.push_back(l);
   }
-  // The query may report a pair twice and in any order.
-  std::vector<ContactSegment> segments = std::move(s.segments);
-  auto segment_key = [](const ContactSegment& c) {
-    return std::make_tuple(c.polygon, c.other, c.from.x, c.from.y, c.from.z, c.to.x, c.to.y, c.to.z);
-  };
-  std::sort(segments.begin(), segments.end(),
-            [&](const ContactSegment& x, const ContactSegment& y) { return segment_key(x) < segment_key(y); });
-  segments.erase(std::unique(segments.begin(), segments.end(),
-                             [&](const ContactSegment& x, const ContactSegment& y) {
-                               return segment_key(x) == segment_key(y);
-                             }),
-                 segments.end());
   return Contacts{std::move(out), std::move(segments)};
 }
 

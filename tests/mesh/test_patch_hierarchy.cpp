@@ -1,6 +1,7 @@
 // Tests for PatchHierarchy: area bookkeeping, option handling, shared vertices, crack-free vertex
 // values, aggregation, area-uniform sampling and progress and cancel while meshing.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -520,6 +521,41 @@ TEST_CASE("a ground's elements are graded toward a house standing on it when the
 }
 
 }  // TEST_SUITE("mesh")
+
+TEST_CASE("a floor is cut along feet that cross it as a chain of facets, not along a block standing inside it nor a "
+          "wall ending inside it") {
+  // The floor [0, 10] x [0, 10] at y = 0 facing up; walls of height 2 cut into 3 x 3 facets as
+  // exporters write a subdivided face (each facet's foot a contact segment ending inside it).
+  auto floor_pieces = [](const std::vector<std::array<glm::vec3, 2>>& feet) {
+    Scene scene;
+    const MaterialId m = scene.add_material(Material{});
+    add_quad(scene, {0, 0, 10}, {10, 0, 0}, {0, 0, -10}, m, "floor");
+    for (const auto& [a, b] : feet) {
+      const glm::vec3 u = (b - a) / 3.0f, v(0.0f, 2.0f / 3.0f, 0.0f);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          add_quad(scene, a + static_cast<float>(i) * u + static_cast<float>(j) * v, u, v, m, "wall");
+    }
+    const PatchHierarchy h(scene, MeshOptions{1000.0f, 1000.0f});
+    std::size_t pieces = 0;
+    for (const Patch& p : h.patches()) pieces += p.polygon == 0 ? 1 : 0;
+    return pieces;
+  };
+  CHECK(floor_pieces({}) == 1);
+  // A partition across the floor at 17 degrees, in three facets: two pieces, as one quad
+  // from border to border gives.
+  const glm::vec3 w0(0.0f, 0.0f, 3.0f), w1(10.0f, 0.0f, 6.0573f);
+  CHECK(floor_pieces({{w0, w1}}) == 2);
+  // An L of two such walls from border to border (a building's corner standing on the floor):
+  // the floor is cut along both lines, four pieces.
+  const glm::vec3 corner(6.0f, 0.0f, 4.2f);
+  CHECK(floor_pieces({{glm::vec3(0.0f, 0.0f, 2.5f), corner}, {corner, glm::vec3(7.3f, 0.0f, 10.0f)}}) == 4);
+  // A block's four feet, a closed chain inside the floor, and a wall that stops in the middle
+  // of it: not cut (the mesh is graded toward them instead).
+  const glm::vec3 b0(3, 0, 3), b1(6, 0, 3.5f), b2(5.5f, 0, 6.5f), b3(2.5f, 0, 6);
+  CHECK(floor_pieces({{b0, b1}, {b1, b2}, {b2, b3}, {b3, b0}}) == 1);
+  CHECK(floor_pieces({{w0, 0.5f * (w0 + w1)}}) == 1);
+}
 
 TEST_CASE("meshing with a progress callback: the same mesh, reported from 0 to 1; a cancel leaves it empty") {
   const Scene scene = mixed_scene();
