@@ -69,16 +69,19 @@ struct ContactSegment {
 struct Contacts {
   /// Every line along which a polygon is divided by another that stands on it (an edge in its
   /// plane: a partition wall on a floor running from border to border) or passes through it,
-  /// the contact running across the polygon from border to border; not lines along its border
+  /// the contact running across the polygon from border to border, and the whole line of each
+  /// segment of a chain of `segments` whose loose ends all lie on its border (the facets of one
+  /// wall, a building's corner standing inside a ground triangle); not lines along its border
   /// (walls meeting at corners, T-junctions), not contacts that end inside it (a block's sides
-  /// on a floor: those are `segments`) and nothing for coplanar pairs. Sorted by polygon,
-  /// one entry per line (several polygons meeting a polygon along the same line give one).
+  /// on a floor, a closed chain: only `segments`) and nothing for coplanar pairs. Sorted by
+  /// polygon, one entry per line (several polygons meeting a polygon along the same line give one).
   /// PatchHierarchy cuts the polygons along them (MeshOptions::split_at_contacts): the light on
   /// the two sides of such a line differs by everything the other polygon blocks, and an
   /// element or an interpolated vertex across it would carry light into the dark side (Baum et
   /// al. 1991).
   std::vector<ContactLine> lines;
-  /// The contacts that end inside a polygon, sorted by polygon, then by other polygon.
+  /// The contacts that end inside a polygon, sorted by polygon, then by other polygon (those
+  /// of dividing chains included: the mesh is graded toward them as well).
   std::vector<ContactSegment> segments;
 };
 /// Both kinds at the cost of one search (as find_overlaps()). PatchHierarchy cuts polygons
