@@ -17,13 +17,13 @@ float luminance(const Rgb& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f *
 }  // namespace
 
 std::vector<std::uint32_t> leaves_to_refine(const PatchHierarchy& hierarchy, const std::vector<Rgb>& B_elements,
-                                            const AdaptiveOptions& options, std::uint8_t max_depth,
-                                            std::size_t element_budget) {
+                                            const std::vector<float>& exposure, const AdaptiveOptions& options,
+                                            std::uint8_t max_depth, std::size_t element_budget) {
   const std::vector<std::uint32_t>& leaves = hierarchy.leaves();
   if (leaves.size() >= element_budget) return {};
   // The corner values average the neighbouring leaves, so a leaf that differs from a corner
   // differs from the neighbours there: a gradient or a discontinuity (shadow edge) crosses it.
-  const std::vector<Rgb> vertex_B = hierarchy.vertex_values(B_elements);
+  const std::vector<Rgb> vertex_B = hierarchy.vertex_values(B_elements, exposure);
 
   double area = 0.0, sum = 0.0;
   for (std::uint32_t e : leaves) {
@@ -37,7 +37,7 @@ std::vector<std::uint32_t> leaves_to_refine(const PatchHierarchy& hierarchy, con
   std::vector<std::pair<float, std::uint32_t>> candidates;
   for (std::uint32_t e : leaves) {
     const Element& el = hierarchy.element(e);
-    if (el.depth >= max_depth) continue;
+    if (el.depth >= max_depth || (!exposure.empty() && exposure[e] == 0.0f)) continue;
     const float Le = luminance(B_elements[e]);
     float score = 0.0f;
     for (int k = 0; k < el.corner_count(); ++k) {

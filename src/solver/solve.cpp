@@ -753,8 +753,15 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     const std::size_t budget =
         o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * initial_leaves;
     for (int pass = 1; pass <= o.adaptive.max_passes; ++pass) {
+      // The leaves' front exposure per element id (inner nodes are not read).
+      std::vector<float> leaf_exposure;
+      if (!side_exposure.empty()) {
+        leaf_exposure.assign(hierarchy.elements().size(), 1.0f);
+        for (std::uint32_t e : hierarchy.leaves())
+          if (2 * std::size_t{e} < side_exposure.size()) leaf_exposure[e] = side_exposure[2 * std::size_t{e}];
+      }
       const std::vector<std::uint32_t> split =
-          detail::leaves_to_refine(hierarchy, B_elements, o.adaptive, max_depth, budget);
+          detail::leaves_to_refine(hierarchy, B_elements, leaf_exposure, o.adaptive, max_depth, budget);
       if (split.empty()) break;
       for (std::uint32_t e : split) {
         store.release(e);

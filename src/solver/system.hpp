@@ -225,9 +225,13 @@ SolverResult solve_progressive(const SolverContext& context, ColumnStore& store)
 
 /// Adaptive subdivision (Cohen, Greenberg, Immel & Brock 1986): the leaves whose radiosity
 /// differs from the interpolated values at their corners (i.e. from their neighbours) by more
-/// than `threshold`, relative, and that may still be split.
+/// than `threshold`, relative, and that may still be split. `exposure` (per element id, or
+/// empty: every leaf open) is the share of each leaf not buried under a solid standing on it:
+/// the corners weigh leaves by open area (PatchHierarchy::vertex_values()) and a wholly buried
+/// leaf is never split, so the floor under a block is not refined for the step from its 0 to
+/// the light beside it, which no one sees.
 std::vector<std::uint32_t> leaves_to_refine(const PatchHierarchy& hierarchy, const std::vector<Rgb>& B_elements,
-                                            const AdaptiveOptions& options, std::uint8_t max_depth,
-                                            std::size_t element_budget);
+                                            const std::vector<float>& exposure, const AdaptiveOptions& options,
+                                            std::uint8_t max_depth, std::size_t element_budget);
 
 }  // namespace radiosity::detail
