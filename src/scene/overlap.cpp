@@ -309,9 +309,16 @@ double depth_inside(const Search& s, PolygonId id, const glm::dvec3& x) {
 // foot, so wholly under the building or wholly open (the footprint is an intersection of the
 // half-planes of its edges, or a union of such). A closed chain (a block whose four feet all lie
 // inside a floor) or one with an end inside the polygon (a wall that stops in the middle of a
-// room) stays segments: cutting it along whole lines would spread slivers over the floor.
+// room) stays segments: cutting it along whole lines would spread slivers over the floor. So
+// does a chain shorter than kMinDividingChain of the polygon's diameter (a building standing
+// across the border of a large ground polygon, a corner clipping a triangle's corner): what it
+// leaves open is most of the polygon, which the exposure handles (only a leaf less than
+// kMinExposure open is taken as open, and shows dark), and its lines would run across the
+// whole polygon.
 // `segments` sorted by polygon; the lines are appended to `lines`, the segments kept (the mesh
 // is graded toward them as well).
+constexpr double kMinDividingChain = 0.25;
+
 void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>& segments,
                               std::vector<ContactLine>& lines) {
   const double join = 4.0 * s.tolerance;    // ends this close are one point (shared facet corners)
@@ -345,7 +352,15 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
         matched[ends[i]] = matched[ends[j]] = 1;
         parent[root(ends[i] / 2)] = root(ends[j] / 2);
       }
-    // A chain divides the polygon when it has loose ends and every one lies on the border.
+    // A chain divides the polygon when it has loose ends, every one on the border, and is long
+    // enough.
+    const Polygon& polygon = (*s.polygons)[id];
+    double diameter = 0.0;
+    for (const glm::vec3& u : polygon.vertices)
+      for (const glm::vec3& v : polygon.vertices) diameter = std::max(diameter, glm::length(glm::dvec3(u - v)));
+    std::vector<double> length(n, 0.0);
+    for (std::uint32_t k = 0; k < n; ++k)
+      length[root(k)] += glm::length(segments[first + k].to - segments[first + k].from);
     std::vector<std::uint8_t> loose(n, 0), inner(n, 0);
     for (std::uint32_t e = 0; e < 2 * n; ++e) {
       if (matched[e]) continue;
@@ -355,7 +370,7 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
     }
     for (std::uint32_t k = 0; k < n; ++k) {
       const std::uint32_t r = root(k);
-      if (!loose[r] || inner[r]) continue;
+      if (!loose[r] || inner[r] || length[r] < kMinDividingChain * diameter) continue;
       const ContactSegment& c = segments[first + k];
       ContactLine l;
       l.polygon = id;

@@ -550,11 +550,15 @@ TEST_CASE("a floor is cut along feet that cross it as a chain of facets, not alo
   // the floor is cut along both lines, four pieces.
   const glm::vec3 corner(6.0f, 0.0f, 4.2f);
   CHECK(floor_pieces({{glm::vec3(0.0f, 0.0f, 2.5f), corner}, {corner, glm::vec3(7.3f, 0.0f, 10.0f)}}) == 4);
-  // A block's four feet, a closed chain inside the floor, and a wall that stops in the middle
-  // of it: not cut (the mesh is graded toward them instead).
+  // A block's four feet, a closed chain inside the floor, a wall that stops in the middle of
+  // it, and a small block standing across its corner (feet 2 m long, under a quarter of the
+  // floor's diameter: 1 % of it buried, which the exposure handles): not cut (the mesh is
+  // graded toward them instead).
   const glm::vec3 b0(3, 0, 3), b1(6, 0, 3.5f), b2(5.5f, 0, 6.5f), b3(2.5f, 0, 6);
   CHECK(floor_pieces({{b0, b1}, {b1, b2}, {b2, b3}, {b3, b0}}) == 1);
   CHECK(floor_pieces({{w0, 0.5f * (w0 + w1)}}) == 1);
+  const glm::vec3 c0(0.0f, 0.0f, 1.0f), c1(1.0f, 0.0f, 1.0f), c2(1.0f, 0.0f, 0.0f);
+  CHECK(floor_pieces({{c0, c1}, {c1, c2}}) == 1);
 }
 
 TEST_CASE("meshing with a progress callback: the same mesh, reported from 0 to 1; a cancel leaves it empty") {
