@@ -70,8 +70,9 @@ struct Contacts {
   /// Every line along which a polygon is divided by another that stands on it (an edge in its
   /// plane: a partition wall on a floor running from border to border) or passes through it,
   /// the contact running across the polygon from border to border, and the whole line of each
-  /// segment of a chain of `segments` whose loose ends all lie on its border (the facets of one
-  /// wall, a building's corner standing inside a ground triangle); not lines along its border
+  /// segment of a chain of `segments` whose loose ends all lie on its border and that is at
+  /// least a quarter of its diameter long (the facets of one wall, a building's corner standing
+  /// inside a ground triangle); not lines along its border
   /// (walls meeting at corners, T-junctions), not contacts that end inside it (a block's sides
   /// on a floor, a closed chain: only `segments`) and nothing for coplanar pairs. Sorted by
   /// polygon, one entry per line (several polygons meeting a polygon along the same line give one).
