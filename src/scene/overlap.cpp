@@ -323,7 +323,8 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
                               std::vector<ContactLine>& lines) {
   const double join = 4.0 * s.tolerance;    // ends this close are one point (shared facet corners)
   const double border = 3.0 * s.tolerance;  // segments end `tolerance` inside a's border
-  std::vector<std::uint32_t> parent, ends, matched;
+  std::vector<std::uint32_t> parent, ends;
+  std::vector<std::uint8_t> matched, duplicate;
   for (std::size_t first = 0; first < segments.size();) {
     const PolygonId id = segments[first].polygon;
     std::size_t last = first;
@@ -345,13 +346,25 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
     std::sort(ends.begin(), ends.end(), [&](std::uint32_t x, std::uint32_t y) {
       return std::make_pair(end_point(x).x, x) < std::make_pair(end_point(y).x, y);
     });
+    auto near = [&](std::uint32_t x, std::uint32_t y) { return glm::length(end_point(x) - end_point(y)) <= join; };
+    // Each pair of ends within `join`: `meet(x, y)` for ends of different segments.
+    auto sweep = [&](const auto& meet) {
+      for (std::size_t i = 0; i < ends.size(); ++i)
+        for (std::size_t j = i + 1; j < ends.size() && end_point(ends[j]).x - end_point(ends[i]).x <= join; ++j)
+          if (ends[i] / 2 != ends[j] / 2 && near(ends[i], ends[j])) meet(ends[i], ends[j]);
+    };
+    // The same segment twice (a wall of two coincident faces, one per room) is one: its copies'
+    // ends would otherwise meet each other and leave the chain no loose end.
+    duplicate.assign(n, 0);
+    sweep([&](std::uint32_t x, std::uint32_t y) {
+      if (near(x ^ 1u, y ^ 1u)) duplicate[std::max(x, y) / 2] = 1;
+    });
     matched.assign(2 * std::size_t{n}, 0);
-    for (std::size_t i = 0; i < ends.size(); ++i)
-      for (std::size_t j = i + 1; j < ends.size() && end_point(ends[j]).x - end_point(ends[i]).x <= join; ++j) {
-        if (ends[i] / 2 == ends[j] / 2 || glm::length(end_point(ends[i]) - end_point(ends[j])) > join) continue;
-        matched[ends[i]] = matched[ends[j]] = 1;
-        parent[root(ends[i] / 2)] = root(ends[j] / 2);
-      }
+    sweep([&](std::uint32_t x, std::uint32_t y) {
+      if (duplicate[x / 2] || duplicate[y / 2]) return;
+      matched[x] = matched[y] = 1;
+      parent[root(x / 2)] = root(y / 2);
+    });
     // A chain divides the polygon when it has loose ends, every one on the border, and is long
     // enough.
     const Polygon& polygon = (*s.polygons)[id];
@@ -360,10 +373,10 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
       for (const glm::vec3& v : polygon.vertices) diameter = std::max(diameter, glm::length(glm::dvec3(u - v)));
     std::vector<double> length(n, 0.0);
     for (std::uint32_t k = 0; k < n; ++k)
-      length[root(k)] += glm::length(segments[first + k].to - segments[first + k].from);
+      if (!duplicate[k]) length[root(k)] += glm::length(segments[first + k].to - segments[first + k].from);
     std::vector<std::uint8_t> loose(n, 0), inner(n, 0);
     for (std::uint32_t e = 0; e < 2 * n; ++e) {
-      if (matched[e]) continue;
+      if (matched[e] || duplicate[e / 2]) continue;
       const std::uint32_t r = root(e / 2);
       loose[r] = 1;
       if (depth_inside(s, id, end_point(e)) > border) inner[r] = 1;
