@@ -334,7 +334,8 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
       const ContactSegment& c = segments[first + e / 2];
       return e % 2 == 0 ? c.from : c.to;
     };
-    // Union-find over the segments; ends are matched by a sweep along x.
+    // Union-find over the segments; ends are matched by a sweep along a direction oblique to
+    // every axis (along x, the ends of a row of buildings' walls would all share one x).
     parent.resize(n);
     std::iota(parent.begin(), parent.end(), 0u);
     auto root = [&](std::uint32_t k) {
@@ -343,14 +344,15 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
     };
     ends.resize(2 * std::size_t{n});
     std::iota(ends.begin(), ends.end(), 0u);
-    std::sort(ends.begin(), ends.end(), [&](std::uint32_t x, std::uint32_t y) {
-      return std::make_pair(end_point(x).x, x) < std::make_pair(end_point(y).x, y);
-    });
+    const glm::dvec3 oblique = glm::normalize(glm::dvec3(1.0, 0.6180339887, 0.3819660113));
+    auto along = [&](std::uint32_t e) { return glm::dot(end_point(e), oblique); };
+    std::sort(ends.begin(), ends.end(),
+              [&](std::uint32_t x, std::uint32_t y) { return std::make_pair(along(x), x) < std::make_pair(along(y), y); });
     auto near = [&](std::uint32_t x, std::uint32_t y) { return glm::length(end_point(x) - end_point(y)) <= join; };
     // Each pair of ends within `join`: `meet(x, y)` for ends of different segments.
     auto sweep = [&](const auto& meet) {
       for (std::size_t i = 0; i < ends.size(); ++i)
-        for (std::size_t j = i + 1; j < ends.size() && end_point(ends[j]).x - end_point(ends[i]).x <= join; ++j)
+        for (std::size_t j = i + 1; j < ends.size() && along(ends[j]) - along(ends[i]) <= join; ++j)
           if (ends[i] / 2 != ends[j] / 2 && near(ends[i], ends[j])) meet(ends[i], ends[j]);
     };
     // The same segment twice (a wall of two coincident faces, one per room) is one: its copies'
