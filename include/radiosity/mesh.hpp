@@ -40,10 +40,10 @@ struct MeshOptions {
   /// the line: the lit room's light would otherwise show in the dark room. A cut polygon is
   /// meshed as convex pieces (up to 64 lines each) and shares no vertices with its neighbours.
   /// Contacts that end inside a polygon join into chains: a chain whose loose ends all lie on
-  /// the polygon's border, at least a quarter of its diameter long, divides it too (a wall exported as facets, each foot ending inside
-  /// the ground triangle it stands on; a building's corner inside one), and the polygon is cut
-  /// along each of its contacts' whole lines, so that no element is left partly under the
-  /// building. A closed chain or one that ends inside (a block standing on a floor, a wall
+  /// the polygon's border, at least a quarter of its diameter long, divides it too (a wall
+  /// exported as facets, each foot ending inside the ground triangle it stands on; a
+  /// building's corner inside one), and the polygon is cut along each of its contacts' whole
+  /// lines, so that no element is left partly under the building. A closed chain or one that ends inside (a block standing on a floor, a wall
   /// that stops in the middle of a room) cuts nothing: rays and hemicubes find what it hides
   /// (grade_at_contacts refines the elements around it).
   /// Neither do lines along a polygon's border (T-junctions, walls meeting at a corner) nor

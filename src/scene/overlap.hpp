@@ -72,10 +72,10 @@ struct Contacts {
   /// the contact running across the polygon from border to border, and the whole line of each
   /// segment of a chain of `segments` whose loose ends all lie on its border and that is at
   /// least a quarter of its diameter long (the facets of one wall, a building's corner standing
-  /// inside a ground triangle); not lines along its border
-  /// (walls meeting at corners, T-junctions), not contacts that end inside it (a block's sides
-  /// on a floor, a closed chain: only `segments`) and nothing for coplanar pairs. Sorted by
-  /// polygon, one entry per line (several polygons meeting a polygon along the same line give one).
+  /// inside a ground triangle); not lines along its border (walls meeting at corners,
+  /// T-junctions), not contacts that end inside it (a block's sides on a floor, a closed chain:
+  /// only `segments`) and nothing for coplanar pairs. Sorted by polygon, one entry per line
+  /// (several polygons meeting a polygon along the same line give one).
   /// PatchHierarchy cuts the polygons along them (MeshOptions::split_at_contacts): the light on
   /// the two sides of such a line differs by everything the other polygon blocks, and an
   /// element or an interpolated vertex across it would carry light into the dark side (Baum et
