@@ -583,6 +583,27 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     }
     return x;
   };
+  // Per element id, the share of it that is not buried (Solution::exposure()), from `per_unknown`
+  // (current_exposure()): the leaves' fronts, inner nodes their children's area-weighted mean;
+  // empty when the solver has none.
+  auto exposure_by_element = [&](const std::vector<float>& per_unknown) {
+    std::vector<float> out;
+    if (per_unknown.empty()) return out;
+    out.assign(hierarchy.elements().size(), 1.0f);
+    for (std::size_t u = 0; u < system->fronts(); ++u) out[system->leaves[u]] = per_unknown[u];
+    for (std::size_t e = out.size(); e-- > 0;) {  // children before parents
+      const Element& el = hierarchy.element(static_cast<std::uint32_t>(e));
+      if (el.is_leaf()) continue;
+      double area = 0.0, open = 0.0;
+      for (std::uint32_t k = 0; k < 4; ++k) {
+        const double a = hierarchy.element(el.first_child + k).area;
+        area += a;
+        open += a * static_cast<double>(out[el.first_child + k]);
+      }
+      out[e] = area > 0.0 ? static_cast<float>(open / area) : 1.0f;
+    }
+    return out;
+  };
   // Side u's values, per element id.
   auto B_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? B_elements : B_back)[system->element(u)]; };
   auto H_of = [&](std::size_t u) -> Rgb& { return (u < system->fronts() ? H_elements : H_back)[system->element(u)]; };
@@ -753,15 +774,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     const std::size_t budget =
         o.adaptive.max_elements > 0 ? o.adaptive.max_elements : 4 * initial_leaves;
     for (int pass = 1; pass <= o.adaptive.max_passes; ++pass) {
-      // The leaves' front exposure per element id (inner nodes are not read).
-      std::vector<float> leaf_exposure;
-      if (!side_exposure.empty()) {
-        leaf_exposure.assign(hierarchy.elements().size(), 1.0f);
-        for (std::uint32_t e : hierarchy.leaves())
-          if (2 * std::size_t{e} < side_exposure.size()) leaf_exposure[e] = side_exposure[2 * std::size_t{e}];
-      }
-      const std::vector<std::uint32_t> split =
-          detail::leaves_to_refine(hierarchy, B_elements, leaf_exposure, o.adaptive, max_depth, budget);
+      const std::vector<std::uint32_t> split = detail::leaves_to_refine(
+          hierarchy, B_elements, exposure_by_element(current_exposure()), o.adaptive, max_depth, budget);
       if (split.empty()) break;
       for (std::uint32_t e : split) {
         store.release(e);
@@ -878,25 +892,8 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
   report.light_power = Rgb(lit);
   report.absorbed_power = Rgb(absorbed);
   report.escaped_power = Rgb(emitted - absorbed);
-  // Per element id, the share of it that is not buried (Solution::exposure()): the leaves'
-  // fronts from the solver, inner nodes their children's area-weighted mean; empty when the
-  // solver has none. Inner nodes' values are then their open parts' means, as the leaves' are.
-  std::vector<float> element_exposure;
-  if (!final_exposure.empty()) {
-    element_exposure.assign(hierarchy.elements().size(), 1.0f);
-    for (std::size_t u = 0; u < system->fronts(); ++u) element_exposure[system->leaves[u]] = final_exposure[u];
-    for (std::size_t e = element_exposure.size(); e-- > 0;) {  // children before parents
-      const Element& el = hierarchy.element(static_cast<std::uint32_t>(e));
-      if (el.is_leaf()) continue;
-      double area = 0.0, open = 0.0;
-      for (std::uint32_t k = 0; k < 4; ++k) {
-        const double a = hierarchy.element(el.first_child + k).area;
-        area += a;
-        open += a * static_cast<double>(element_exposure[el.first_child + k]);
-      }
-      element_exposure[e] = area > 0.0 ? static_cast<float>(open / area) : 1.0f;
-    }
-  }
+  // Inner nodes' values are then their open parts' means, as the leaves' are.
+  std::vector<float> element_exposure = exposure_by_element(final_exposure);
   auto aggregate = [&](std::vector<Rgb>& values) {
     if (element_exposure.empty())
       hierarchy.aggregate(values);
