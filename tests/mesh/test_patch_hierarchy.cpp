@@ -45,13 +45,6 @@ Scene mixed_scene() {
   return scene;
 }
 
-float centroid_x(const PatchHierarchy& h, std::uint32_t id) {
-  const Element& e = h.element(id);
-  float x = 0.0f;
-  for (int c = 0; c < e.corner_count(); ++c) x += h.vertices()[e.corners[static_cast<std::size_t>(c)]].x;
-  return x / static_cast<float>(e.corner_count());
-}
-
 double signed_area_along(const PatchHierarchy& h, std::uint32_t id) {
   const Element& e = h.element(id);
   const auto& v = h.vertices();
@@ -261,7 +254,7 @@ TEST_CASE("vertex values weigh leaves by their open area: buried leaves neither 
   std::vector<Rgb> values(h.elements().size(), Rgb(0.0f));
   std::vector<float> exposure(h.elements().size(), 1.0f);
   for (const std::uint32_t leaf : h.leaves()) {
-    const float x = centroid_x(h, leaf);
+    const float x = h.element(leaf).centroid.x;
     values[leaf] = Rgb(x < 2.0f ? 0.0f : x < 3.0f ? 1.0f : 3.0f);
     exposure[leaf] = x < 2.0f ? 0.0f : 1.0f;
   }
