@@ -324,7 +324,8 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
   const double join = 4.0 * s.tolerance;    // ends this close are one point (shared facet corners)
   const double border = 3.0 * s.tolerance;  // segments end `tolerance` inside a's border
   std::vector<std::uint32_t> parent, ends;
-  std::vector<std::uint8_t> matched, duplicate;
+  std::vector<std::uint8_t> matched, duplicate, loose, inner;
+  std::vector<double> length;
   for (std::size_t first = 0; first < segments.size();) {
     const PolygonId id = segments[first].polygon;
     std::size_t last = first;
@@ -373,10 +374,11 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
     double diameter = 0.0;
     for (const glm::vec3& u : polygon.vertices)
       for (const glm::vec3& v : polygon.vertices) diameter = std::max(diameter, glm::length(glm::dvec3(u - v)));
-    std::vector<double> length(n, 0.0);
+    length.assign(n, 0.0);
     for (std::uint32_t k = 0; k < n; ++k)
       if (!duplicate[k]) length[root(k)] += glm::length(segments[first + k].to - segments[first + k].from);
-    std::vector<std::uint8_t> loose(n, 0), inner(n, 0);
+    loose.assign(n, 0);
+    inner.assign(n, 0);
     for (std::uint32_t e = 0; e < 2 * n; ++e) {
       if (matched[e] || duplicate[e / 2]) continue;
       const std::uint32_t r = root(e / 2);
