@@ -147,23 +147,37 @@ def test_concurrent_solves_from_python_threads_agree():
 
 def test_turned_buildings_sliver_stays_within_the_sky_and_hierarchical_agrees_with_gauss_seidel(tmp_path):
     """An exported block with its buildings turned (benchmarks/exported_block.py --turn): the
-    contact lines leave slivers of ground open beside the buildings' feet. Until session 39 the
-    hierarchical solver gave one of them 402 W/m^2 under a sky of 100 (Gauss-Seidel: 62), what a
-    link into its mostly buried cluster brought, pushed by 1 / exposure; its element RMS against
-    Gauss-Seidel was 10 %. Measured now: at most 101 W/m^2 either way, 1.4 % element RMS (power
-    over area) against this Gauss-Seidel solve."""
+    ground is cut along the buildings' feet, which leaves slivers of ground open beside them and
+    pieces wholly under them. Until session 39 the hierarchical solver gave one sliver 402 W/m^2
+    under a sky of 100 (Gauss-Seidel: 62), what a link into its mostly buried cluster brought,
+    pushed by 1 / exposure; its element RMS against Gauss-Seidel was 10 %. Until session 41 the
+    slivers under 1 m^2 were 6.7 % off (the rest 1.4 %): they shared leaf clusters with the
+    buried pieces beside them, which the cluster tree now leaves out. Measured against the mean
+    of 8 Gauss-Seidel solves: 1.35 % element RMS (power over area), the slivers 1.7 %."""
     import subprocess
     import sys
     script = Path(__file__).resolve().parents[2] / "benchmarks" / "exported_block.py"
     subprocess.run([sys.executable, str(script), "--turn", str(tmp_path)], check=True, capture_output=True)
     scene = radiosity.load_scene(tmp_path / "daylight.json")
-    values = {}
-    for method, options in (("gauss-seidel", {"form_factors": "monte-carlo"}), ("hierarchical", {"epsilon": 0.05})):
-        solution = radiosity.solve(scene, method, **options)
+
+    def power_over_area(solution):
+        return solution.element_radiosity().mean(axis=1) * solution.element_exposure()
+
+    # The reference: the mean of 4 Gauss-Seidel solves with their own seeds (one solve's element
+    # spread is about 1 %, the mean's half of it).
+    references = []
+    for seed in range(2, 6):
+        solution = radiosity.solve(scene, "gauss-seidel", form_factors="monte-carlo", seed=seed)
         irradiance = solution.element_values("irradiance").mean(axis=1)
-        assert irradiance.max() < 1.2 * 100.0, method  # the sky's horizontal irradiance is 100 W/m^2
-        values[method] = solution.element_radiosity().mean(axis=1) * solution.element_exposure()
-    reference = values["gauss-seidel"]
+        assert irradiance.max() < 1.2 * 100.0  # the sky's horizontal irradiance is 100 W/m^2
+        references.append(power_over_area(solution))
+    reference = np.mean(references, axis=0)
+    solution = radiosity.solve(scene, "hierarchical", epsilon=0.05)
+    assert solution.element_values("irradiance").mean(axis=1).max() < 1.2 * 100.0
+    areas = solution.element_areas()
     kept = reference > 0.1 * reference.mean()
-    relative = (values["hierarchical"][kept] - reference[kept]) / reference[kept]
-    assert np.sqrt(np.mean(relative ** 2)) < 0.04
+    relative = (power_over_area(solution) - reference) / np.where(kept, reference, 1.0)
+    slivers = kept & (areas < 1.0)
+    assert slivers.sum() > 100
+    assert np.sqrt(np.mean(relative[kept] ** 2)) < 0.02
+    assert np.sqrt(np.mean(relative[slivers] ** 2)) < 0.035

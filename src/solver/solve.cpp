@@ -684,7 +684,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     // (multigridding) until no link changes (docs/HIERARCHICAL.md).
     if (!links)
     {
-      links = std::make_unique<detail::LinkHierarchy>(scene, hierarchy, o.seed, o.threads,
+      links = std::make_unique<detail::LinkHierarchy>(scene, o.seed, o.threads,
                                                       light_shooter ? &light_shooter->occluders() : nullptr);
       links->set_memory_budget(o.memory_budget_bytes, "SolveOptions::memory_budget_bytes");
       links->set_balancing(o.hierarchical.balance_closed_regions);

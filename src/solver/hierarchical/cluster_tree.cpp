@@ -105,12 +105,14 @@ struct Builder {
 
 }  // namespace
 
-ClusterTree::ClusterTree(const PatchHierarchy& hierarchy) {
-  const auto n = static_cast<std::uint32_t>(hierarchy.patches().size());
+ClusterTree::ClusterTree(const PatchHierarchy& hierarchy, const std::vector<std::uint8_t>& include) {
+  const auto patches = static_cast<std::uint32_t>(hierarchy.patches().size());
+  RADIOSITY_ASSERT(include.empty() || include.size() == patches);
+  leaf_of_.assign(patches, kNone);
+  for (std::uint32_t p = 0; p < patches; ++p)
+    if (include.empty() || include[p] != 0) order_.push_back(p);
+  const auto n = static_cast<std::uint32_t>(order_.size());
   if (n == 0) return;
-  order_.resize(n);
-  for (std::uint32_t p = 0; p < n; ++p) order_[p] = p;
-  leaf_of_.assign(n, kNone);
   nodes_.reserve(2 * static_cast<std::size_t>(n) - 1);
   Builder builder{hierarchy, nodes_, order_, leaf_of_};
   builder.build(0, n, 0);
@@ -242,6 +244,7 @@ void sending_moments(const ClusterTree& tree, const PatchHierarchy& hierarchy, c
   parallel_for(threads, patches.size(), 1024, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
       const std::uint32_t c = tree.leaf_of(static_cast<std::uint32_t>(p));
+      if (c == kNone) continue;  // left out of the tree
       const auto patch = static_cast<std::uint32_t>(p);
       const glm::vec3& n = patches[p].normal;
       add_surface(out[c], bases.of(c), bases.front(patch, n), front[p] * patches[p].area);

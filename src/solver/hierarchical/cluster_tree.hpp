@@ -74,17 +74,22 @@ static_assert(sizeof(ClusterNode) == 60, "the memory per node stated above");
 /// Thread safety: immutable after construction; const members may be called concurrently.
 class ClusterTree {
  public:
-  /// Builds the tree over every patch of `hierarchy` (empty when it has none). Reads only the
-  /// patches and their root elements' corners, so it stays valid as elements are subdivided.
-  explicit ClusterTree(const PatchHierarchy& hierarchy);
+  /// An empty tree.
+  ClusterTree() = default;
+  /// Builds the tree over the patches of `hierarchy` with `include[p] != 0`, or over every
+  /// patch when `include` is empty (empty when none is taken). Patches left out have no leaf
+  /// (leaf_of() is kNone) and take no part in the links: the link hierarchy leaves out patches
+  /// wholly buried under a solid, which exchange no light. Reads only the patches and their
+  /// root elements' corners, so it stays valid as elements are subdivided.
+  explicit ClusterTree(const PatchHierarchy& hierarchy, const std::vector<std::uint8_t>& include = {});
 
   const std::vector<ClusterNode>& nodes() const { return nodes_; }
   const ClusterNode& node(std::uint32_t id) const { return nodes_[id]; }
   bool empty() const { return nodes_.empty(); }
   static constexpr std::uint32_t root() { return 0; }
-  /// Patch ids, permuted so that every node's patches are contiguous.
+  /// Ids of the patches in the tree, permuted so that every node's patches are contiguous.
   const std::vector<std::uint32_t>& order() const { return order_; }
-  /// The leaf cluster that holds `patch`.
+  /// The leaf cluster that holds `patch`; kNone for a patch left out.
   std::uint32_t leaf_of(std::uint32_t patch) const { return leaf_of_[patch]; }
   /// Levels below the root of the deepest leaf (0 for a single patch).
   int depth() const { return depth_; }

@@ -218,7 +218,8 @@ struct BlockOutput {
 
 struct LinkHierarchy::Impl {
   const Scene& scene;
-  ClusterTree tree;
+  ClusterTree tree;        ///< over the patches not wholly buried (build_tree())
+  bool tree_built = false;
   std::unique_ptr<RayScene> own_occluders;  ///< when none was shared
   const RayScene& occluders;
   std::uint64_t seed;
@@ -365,14 +366,33 @@ struct LinkHierarchy::Impl {
     v.variation_cluster = std::move(cluster);
   }
 
-  Impl(const Scene& s, const PatchHierarchy& hierarchy, std::uint64_t seed_, unsigned threads_, const RayScene* shared)
+  Impl(const Scene& s, std::uint64_t seed_, unsigned threads_, const RayScene* shared)
       : scene(s),
-        tree(hierarchy),
         own_occluders(shared ? nullptr : std::make_unique<RayScene>(RayScene::from_polygons(s))),
         occluders(shared ? *shared : *own_occluders),
         seed(seed_),
         threads(threads_),
-        ray_epsilon(1e-5f * std::max(s.bounds().diagonal(), 1e-6f)) {
+        ray_epsilon(1e-5f * std::max(s.bounds().diagonal(), 1e-6f)) {}
+
+  /// The cluster tree, once (at the first refresh_patch_data(), which has set has_back), over
+  /// the patches not wholly buried. A patch wholly under a solid (the ground under a building,
+  /// once the mesher has cut it at the walls' feet) exchanges no light: in the tree it only
+  /// diluted the clusters it shared with open patches, whose pushes then multiplied a mostly
+  /// buried cluster's estimate by its exposure ratio (a sliver of ground beside a wall, in a
+  /// leaf cluster with the buried piece of its triangle, took 2.5 times its indirect light;
+  /// docs/HIERARCHICAL.md, "Buried parts"), and links into such clusters are refined further
+  /// (kBuriedClusterFloor). So the exposure is measured first, and the tree leaves those out:
+  /// they get no links and receive nothing, as their exposure 0 says.
+  void build_tree(const PatchHierarchy& hierarchy) {
+    measure_leaf_exposure(hierarchy);
+    const std::vector<Patch>& patches = hierarchy.patches();
+    std::vector<std::uint8_t> include(patches.size(), 1);
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      const std::uint32_t root = patches[p].root;
+      include[p] = element_exposure(root, false) != 0.0f || (has_back[p] && element_exposure(root, true) != 0.0f);
+    }
+    tree = ClusterTree(hierarchy, include);
+    tree_built = true;
     const std::vector<std::uint32_t>& order = tree.order();
     cumulative_area.resize(order.size() + 1, 0.0);
     for (std::size_t k = 0; k < order.size(); ++k)
@@ -421,6 +441,8 @@ struct LinkHierarchy::Impl {
   void refresh_patch_data(const PatchHierarchy& hierarchy, const RadiositySystem& sys) {
     has_back.assign(hierarchy.patches().size(), 0);
     for (std::size_t u = sys.fronts(); u < sys.unknowns(); ++u) has_back[hierarchy.element(sys.element(u)).patch] = 1;
+    const bool first = !tree_built;
+    if (first) build_tree(hierarchy);
     const std::vector<std::uint32_t>& order = tree.order();
     sample_patches.resize(order.size());
     for (std::size_t k = 0; k < order.size(); ++k) {
@@ -447,6 +469,8 @@ struct LinkHierarchy::Impl {
       add_surface(m, bases.of(i), bases.front(p, patch.normal), patch.area);
       if (has_back[p]) add_surface(m, bases.of(i), bases.back(p, patch.normal), patch.area);
     }
+    // The exposure measured with the tree: the first pass pushes by it too.
+    if (first) update_open_moments(hierarchy);
   }
 
   /// The area a node shows toward the unit direction `v`: sum over its sides of
@@ -1498,6 +1522,11 @@ struct LinkHierarchy::Impl {
   /// exposure, open_index and open_moments for the elements as they stand: new leaves sampled, inner
   /// elements and clusters aggregated. After refinement, which may split elements.
   void update_exposure(const PatchHierarchy& h) {
+    measure_leaf_exposure(h);
+    update_open_moments(h);
+  }
+  /// exposure and any_buried: leaves not measured yet sampled, inner elements aggregated.
+  void measure_leaf_exposure(const PatchHierarchy& h) {
     const std::size_t count = h.elements().size();
     const std::vector<Patch>& patches = h.patches();
     exposure.resize(2 * count, -1.0f);
@@ -1530,7 +1559,11 @@ struct LinkHierarchy::Impl {
     for (std::uint32_t e = 0; e < count && !any_buried; ++e)
       if (h.element(e).is_leaf())
         any_buried = leaf_exposure(e, false) < 1.0f || (has_back[h.element(e).patch] && leaf_exposure(e, true) < 1.0f);
-    // The clusters' exposed area moments, only where something below is buried.
+  }
+  /// open_index and open_moments: the clusters' exposed area moments, only where something
+  /// below is buried.
+  void update_open_moments(const PatchHierarchy& h) {
+    const std::vector<Patch>& patches = h.patches();
     const std::uint32_t C = cluster_count();
     open_index.assign(C, kNone);
     open_moments.clear();
@@ -1721,6 +1754,7 @@ struct LinkHierarchy::Impl {
     // Up the cluster chain: Q, what unit irradiance moments on each cluster deliver into e.
     const std::uint32_t p = h.element(e).patch;
     std::uint32_t c = tree.leaf_of(p);
+    RADIOSITY_ASSERT(c != kNone);  // a patch left out of the tree is wholly buried: returned above
     std::array<double, 6> Q{};
     const SideDirection front = bases.front(p, patches[p].normal);
     add_element_weight(Q, bases.of(c), front, W * exposure_ratio(element_exposure(x, false), cluster_exposure_toward(c, front)));
@@ -2702,17 +2736,16 @@ struct LinkHierarchy::Impl {
   }
 };
 
-LinkHierarchy::LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed,
-                             unsigned threads, const RayScene* occluders)
-    : impl_(std::make_unique<Impl>(scene, hierarchy, seed, threads, occluders)) {}
+LinkHierarchy::LinkHierarchy(const Scene& scene, std::uint64_t seed, unsigned threads, const RayScene* occluders)
+    : impl_(std::make_unique<Impl>(scene, seed, threads, occluders)) {}
 LinkHierarchy::~LinkHierarchy() = default;
 
 bool LinkHierarchy::refine(PatchHierarchy& hierarchy, const RadiositySystem& system, const std::vector<Rgb>& B,
                            float threshold, const SubdivisionLimits& limits, ProgressGate& gate,
                            std::vector<std::uint32_t>& split, RefineStats& stats) {
   Impl& m = *impl_;
-  if (m.tree.empty()) return true;
   m.refresh_patch_data(hierarchy, system);
+  if (m.tree.empty()) return true;
   Impl::Values values;
   m.node_values(hierarchy, system, B, values);
   m.node_variation(hierarchy, values);

@@ -54,16 +54,16 @@ struct RefineStats {
 };
 
 /// The links of a scene and the solve over them. Built empty; refine() makes and refines the
-/// links, solve() sweeps them. Keeps the cluster tree (over the patches, which subdivision does
-/// not change), the ray scene and the links between the solves of one Problem.
+/// links, solve() sweeps them. Keeps the cluster tree (built by the first refine() over the
+/// patches not wholly buried, which subdivision does not change), the ray scene and the links
+/// between the solves of one Problem.
 /// Thread safety: refine() needs exclusive access; solve() and the const members may be called
 /// concurrently with each other.
 class LinkHierarchy {
  public:
   /// `occluders`: the scene's polygons as a ray scene, shared with the caller (which keeps it
   /// alive as long as this), or null to build one.
-  LinkHierarchy(const Scene& scene, const PatchHierarchy& hierarchy, std::uint64_t seed, unsigned threads,
-                const RayScene* occluders = nullptr);
+  LinkHierarchy(const Scene& scene, std::uint64_t seed, unsigned threads, const RayScene* occluders = nullptr);
   ~LinkHierarchy();
   /// The most bytes refinement may hold in links and pairs (0: kDefaultMemoryBudget): a round
   /// that would pass it throws Error{memory_budget} with the figure before its arrays are made,
@@ -133,6 +133,7 @@ class LinkHierarchy {
   std::size_t link_count() const;
   /// Memory of the links, the cluster tree and the sweeps' per-node arrays, bytes.
   std::size_t bytes() const;
+  /// Empty until the first refine() or measure_buried_parts().
   const ClusterTree& tree() const;
 
  private:

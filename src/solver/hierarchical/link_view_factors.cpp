@@ -17,7 +17,7 @@ std::unique_ptr<LinkHierarchy> view_factor_links(const Scene& scene, PatchHierar
                                                  std::uint64_t seed, unsigned threads, std::size_t memory_budget,
                                                  ProgressGate& gate, std::uint64_t& rays, bool rows) {
   const RadiositySystem system(scene, hierarchy, false);
-  auto links = std::make_unique<LinkHierarchy>(scene, hierarchy, seed, threads);
+  auto links = std::make_unique<LinkHierarchy>(scene, seed, threads);
   links->set_memory_budget(memory_budget, "ViewFactorOptions::memory_budget_bytes");
   // The links' own factors: the view factor options have their own enclosure correction.
   links->set_balancing(false);
