@@ -291,17 +291,58 @@ OutwardFacing find_polygons_facing_outward(const Scene& scene, const std::vector
   // A polygon lying on another (a box's bottom on a floor) sees nothing in front because its
   // rays start past the other one, so rays cannot judge it. Turning the polygons found must
   // leave every coincident pair facing opposite ways (in contact) rather than the same way
-  // (z-fighting): of a pair that faces the same way, one is turned (the larger when both were
-  // found: the room's floor, not the box standing on it); of a pair in contact, both or none.
+  // (z-fighting): of a pair that faces the same way, one is turned; of a pair in contact, both
+  // or none. Which one: the one whose surface (the polygons it shares edges with, and theirs)
+  // the rays found wound outward, else the larger (the room's floor, not the box standing on
+  // it). By size alone, a floor exported as facets smaller than the box's bottom kept the
+  // facets under the box's edges facing down, and they came out black around it.
+  for (const PolygonOverlap& o : overlaps)
+    if (o.first >= polygons.size() || o.second >= polygons.size())
+      throw Error(ErrorCode::invalid_argument, "find_polygons_facing_outward: an overlap names polygon " +
+                                                   std::to_string(std::max(o.first, o.second)) + " of a scene of " +
+                                                   std::to_string(polygons.size()) + " (overlaps of another scene?)");
+  auto same_way = [&](const PolygonOverlap& o) {
+    return glm::dot(polygons[o.first].normal, polygons[o.second].normal) > 0.0f;
+  };
+  const bool judge_by_surface = std::any_of(overlaps.begin(), overlaps.end(), [&](const PolygonOverlap& o) {
+    return o.kind == OverlapKind::coincident && same_way(o) && outward[o.first] && outward[o.second];
+  });
+  // Per polygon, the share of the rest of its surface's area found outward (-1: no rest).
+  std::vector<double> surface_outward;
+  if (judge_by_surface) {
+    detail::PolygonAdjacency adjacency;
+    detail::polygon_adjacency(scene, {}, adjacency);
+    const std::vector<std::uint32_t> surface = detail::connected_surfaces(adjacency);
+    std::vector<double> area, found;
+    for (PolygonId p = 0; p < polygons.size(); ++p) {
+      if (surface[p] == kNone) continue;
+      if (surface[p] >= area.size()) {
+        area.resize(surface[p] + 1, 0.0);
+        found.resize(surface[p] + 1, 0.0);
+      }
+      area[surface[p]] += polygons[p].area;
+      found[surface[p]] += outward[p] ? polygons[p].area : 0.0;
+    }
+    surface_outward.assign(polygons.size(), -1.0);
+    for (PolygonId p = 0; p < polygons.size(); ++p) {
+      if (surface[p] == kNone) continue;
+      const double rest = area[surface[p]] - polygons[p].area;
+      if (rest > 0.0) surface_outward[p] = (found[surface[p]] - (outward[p] ? polygons[p].area : 0.0)) / rest;
+    }
+  }
+  const std::vector<std::uint8_t> found_by_rays = outward;
   for (const PolygonOverlap& o : overlaps) {
     if (o.kind != OverlapKind::coincident) continue;
     const PolygonId a = o.first, b = o.second;
-    if (a >= polygons.size() || b >= polygons.size())
-      throw Error(ErrorCode::invalid_argument, "find_polygons_facing_outward: an overlap names polygon " +
-                                                   std::to_string(std::max(a, b)) + " of a scene of " +
-                                                   std::to_string(polygons.size()) + " (overlaps of another scene?)");
-    if (glm::dot(polygons[a].normal, polygons[b].normal) > 0.0f) {
-      if (outward[a] && outward[b]) (polygons[a].area >= polygons[b].area ? outward[b] : outward[a]) = 0;
+    if (same_way(o)) {
+      if (!found_by_rays[a] || !found_by_rays[b]) continue;
+      // The one to keep facing as it does: the other's surface is the one wound outward.
+      const double sa = surface_outward[a], sb = surface_outward[b];
+      PolygonId keep = polygons[a].area >= polygons[b].area ? b : a;
+      if (sa >= 0.0 && sb >= 0.0 && sa != sb) keep = sa > sb ? b : a;
+      else if (sa >= 0.0 && sb < 0.0) keep = sa >= 0.5 ? b : a;
+      else if (sb >= 0.0 && sa < 0.0) keep = sb >= 0.5 ? a : b;
+      outward[keep] = 0;
     } else if (outward[a] != outward[b]) {
       outward[a] = outward[b] = 0;
     }

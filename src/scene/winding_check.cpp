@@ -96,9 +96,8 @@ std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const
   return warnings;
 }
 
-InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& keep_going) {
+bool polygon_adjacency(const Scene& scene, const KeepGoing& keep_going, PolygonAdjacency& adjacency) {
   const std::vector<Polygon>& polygons = scene.polygons();
-  InconsistentWinding out;
   // Polled every kPollEvery items of each pass (and between the sort's runs): solve() runs this
   // while meshing, where a cancel is to be seen within 100 ms (a terrain of 600k triangles takes
   // about a second in all).
@@ -119,7 +118,7 @@ InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& ke
     return forward;
   };
   for (PolygonId id = 0; id < polygons.size(); ++id) {
-    if (stopped(id)) return {};
+    if (stopped(id)) return false;
     const Polygon& p = polygons[id];
     if (p.obstruction_only || !detail::has_sides(scene.material(p.material))) continue;
     const auto n = static_cast<std::uint32_t>(p.vertices.size());
@@ -140,14 +139,14 @@ InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& ke
   for (std::size_t begin = 0; begin < edges.size(); begin += kPollEvery) {
     std::sort(edges.begin() + static_cast<std::ptrdiff_t>(begin),
               edges.begin() + static_cast<std::ptrdiff_t>(std::min(edges.size(), begin + kPollEvery)), by_key);
-    if (keep_going && !keep_going()) return {};
+    if (keep_going && !keep_going()) return false;
   }
   for (std::size_t width = kPollEvery; width < edges.size(); width *= 2)
     for (std::size_t begin = 0; begin + width < edges.size(); begin += 2 * width) {
       const auto first = edges.begin() + static_cast<std::ptrdiff_t>(begin);
       std::inplace_merge(first, first + static_cast<std::ptrdiff_t>(width),
                          edges.begin() + static_cast<std::ptrdiff_t>(std::min(edges.size(), begin + 2 * width)), by_key);
-      if (keep_going && !keep_going()) return {};
+      if (keep_going && !keep_going()) return false;
     }
   // Edges that exactly two polygons share (a third on it, as where a partition meets a floor
   // cut along it, says nothing about orientation): 1 when they run along it the same way.
@@ -171,7 +170,7 @@ InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& ke
   constexpr float kSameSide = 0.9998f;  // within about 1.1 degrees
   for (std::size_t i = 0, polled = 0; i < edges.size();) {
     if (i >= polled) {
-      if (keep_going && !keep_going()) return {};
+      if (keep_going && !keep_going()) return false;
       polled = i + kPollEvery;
     }
     std::size_t j = i + 1;
@@ -188,15 +187,16 @@ InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& ke
     i = j;
   }
   edges = {};
-  if (links.empty()) return out;
   // Both directions of every link, as adjacency lists (CSR).
-  std::vector<std::size_t> first(polygons.size() + 1, 0);
+  std::vector<std::size_t>& first = adjacency.first;
+  std::vector<std::pair<PolygonId, std::uint8_t>>& adjacent = adjacency.adjacent;
+  first.assign(polygons.size() + 1, 0);
   for (const Link& l : links) {
     ++first[l.a + 1];
     ++first[l.b + 1];
   }
   for (std::size_t p = 0; p < polygons.size(); ++p) first[p + 1] += first[p];
-  std::vector<std::pair<PolygonId, std::uint8_t>> adjacent(first.back());
+  adjacent.assign(first.back(), {});
   {
     std::vector<std::size_t> at(first.begin(), first.end() - 1);
     for (const Link& l : links) {
@@ -204,7 +204,40 @@ InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& ke
       adjacent[at[l.b]++] = {l.a, l.flipped};
     }
   }
-  links = {};
+  return true;
+}
+
+std::vector<std::uint32_t> connected_surfaces(const PolygonAdjacency& adjacency) {
+  const std::size_t count = adjacency.first.empty() ? 0 : adjacency.first.size() - 1;
+  std::vector<std::uint32_t> surface(count, kNone);
+  std::vector<PolygonId> queue;
+  std::uint32_t next = 0;
+  for (PolygonId start = 0; start < count; ++start) {
+    if (surface[start] != kNone || adjacency.first[start + 1] == adjacency.first[start]) continue;
+    queue.assign(1, start);
+    surface[start] = next;
+    for (std::size_t k = 0; k < queue.size(); ++k)
+      for (std::size_t e = adjacency.first[queue[k]]; e < adjacency.first[queue[k] + 1]; ++e) {
+        const PolygonId q = adjacency.adjacent[e].first;
+        if (surface[q] != kNone) continue;
+        surface[q] = next;
+        queue.push_back(q);
+      }
+    ++next;
+  }
+  return surface;
+}
+
+InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& keep_going) {
+  const std::vector<Polygon>& polygons = scene.polygons();
+  InconsistentWinding out;
+  constexpr std::size_t kPollEvery = 1u << 15;
+  auto stopped = [&](std::size_t item) { return keep_going && item % kPollEvery == 0 && !keep_going(); };
+  PolygonAdjacency adjacency;
+  if (!polygon_adjacency(scene, keep_going, adjacency)) return {};
+  const std::vector<std::size_t>& first = adjacency.first;
+  const std::vector<std::pair<PolygonId, std::uint8_t>>& adjacent = adjacency.adjacent;
+  if (adjacent.empty()) return out;
   // A breadth-first walk per connected surface, from its lowest polygon id (orientation 0):
   // each neighbour takes the orientation its shared edge says. The orientation with less area
   // is the one reported (ties: the one without the lowest id). Where a surface cannot be

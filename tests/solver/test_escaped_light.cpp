@@ -1,6 +1,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -273,5 +274,61 @@ TEST_SUITE("solver") {
     REQUIRE(found.polygons.size() == 1);
     CHECK(street.polygons()[found.polygons[0]].normal.y > 0.99f);
     CHECK(found.area < 0.5 * found.one_sided_area);
+  }
+  TEST_CASE("polygons facing outward: a room wound outward with its floor exported as facets smaller than a box's "
+            "bottom resting on it - the floor is turned whole, the box's bottom kept") {
+    // An exporter's room: every face wound out of the room, the floor as 1 m triangles, a lamp
+    // under the ceiling facing down, and a box wound out of itself (as it should be) turned 23
+    // degrees, resting on the floor with its bottom (1.2 x 1.2 m, larger than a floor facet).
+    // The floor facets under the box's bottom are coincident with it and face the same way;
+    // rays cannot judge them (their backs see into the box). Chosen by size, the box's bottom
+    // was turned and the facets under its edges kept facing down: black around the box in a
+    // render, and `--reverse-winding outward` left 7 facets wound against their neighbours.
+    rad::Material grey;
+    grey.reflectance = rad::Rgb(0.5f);
+    rad::Scene room = test::closed_box(grey, glm::vec3(4.0f, 3.0f, 4.0f));
+    rad::Scene scene;
+    const rad::MaterialId g = scene.add_material(grey);
+    for (const rad::Polygon& p : room.polygons())
+      if (p.normal.y < 0.5f) scene.add_polygon(std::vector<glm::vec3>(p.vertices.begin(), p.vertices.end()), g, "room");
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const glm::vec3 a(i, 0, j), b(i + 1, 0, j), c(i + 1, 0, j + 1), d(i, 0, j + 1);  // facing up
+        scene.add_polygon({a, c, b}, g, "floor");
+        scene.add_polygon({a, d, c}, g, "floor");
+      }
+    rad::Material lamp_material;
+    lamp_material.emission = rad::Rgb(10.0f);
+    const auto lamp_id = static_cast<rad::PolygonId>(scene.polygons().size());
+    rad::add_quad(scene, {1.6f, 2.99f, 1.6f}, {0.8f, 0, 0}, {0, 0, 0.8f}, scene.add_material(lamp_material), "lamp");
+    REQUIRE(scene.polygons().back().normal.y < -0.99f);
+    scene.reverse_winding();  // the room wound outward (and the lamp facing up)
+    rad::Scene box_only = test::turned_about_y(test::closed_box(grey, glm::vec3(1.2f, 0.8f, 1.2f)), 23.0f,
+                                               glm::vec3(0.6f, 0.0f, 0.6f));
+    box_only.reverse_winding();  // wound out of the box
+    const glm::vec3 at(1.45f, 0.0f, 2.15f);
+    for (const rad::Polygon& p : box_only.polygons()) {
+      std::vector<glm::vec3> v;
+      for (const glm::vec3& x : p.vertices) v.push_back(x + at - glm::vec3(0.6f, 0.0f, 0.6f));
+      scene.add_polygon(v, g, "box");
+    }
+    scene.reverse_winding({lamp_id});  // the lamp faces down again
+    const rad::OutwardFacing found = rad::find_polygons_facing_outward(scene);
+    CHECK(found.looks_wound_outward());
+    rad::Scene turned = scene;
+    turned.reverse_winding(found.polygons);
+    const rad::GroupId floor = *turned.find_group("floor"), box = *turned.find_group("box");
+    int floor_up = 0, floor_down = 0;
+    for (const rad::Polygon& p : turned.polygons()) {
+      if (p.group == floor) (p.normal.y > 0.99f ? floor_up : floor_down) += 1;
+      if (p.group == box && std::abs(p.normal.y) > 0.99f) CHECK(p.normal.y * (p.vertices[0].y > 0.4f ? 1.0f : -1.0f) > 0.0f);
+    }
+    CHECK(floor_up == 32);
+    CHECK(floor_down == 0);
+    CHECK(rad::find_inconsistent_winding(turned).polygons.empty());
+    // Nothing left facing the same way as what it lies on.
+    for (const rad::PolygonOverlap& o : rad::find_overlaps(turned))
+      if (o.kind == rad::OverlapKind::coincident)
+        CHECK(glm::dot(turned.polygons()[o.first].normal, turned.polygons()[o.second].normal) < 0.0f);
   }
 }
