@@ -495,8 +495,10 @@ struct OutwardFacing {
 /// the light is (OutwardFacing::looks_wound_outward(), OutwardFacing::lit_from_outside). Rays cannot judge a polygon coincident with another
 /// (find_overlaps(): a box's bottom on a floor), so such pairs are reported so that turning the
 /// polygons found leaves them facing opposite ways (in contact), not the same way: of a pair
-/// facing the same way one (the larger, when rays found both: the floor, not the box's bottom),
-/// of a pair in contact both or neither. Scene::reverse_winding() turns the polygons found over. Deterministic
+/// facing the same way one (when rays found both: the one whose surface, the polygons joined
+/// to it by shared edges, the rays found wound outward, else the larger: the floor, not the
+/// box's bottom, also where the floor is exported as facets smaller than the bottom), of a
+/// pair in contact both or neither. Scene::reverse_winding() turns the polygons found over. Deterministic
 /// (a fixed seed). Cost: a BVH over the scene, 32 rays per one-sided polygon (16 per emitting one), and find_overlaps(). Throws Error{internal} if Embree cannot create a
 /// device. Thread safety: concurrent calls are safe.
 RADIOSITY_API OutwardFacing find_polygons_facing_outward(const Scene& scene);
