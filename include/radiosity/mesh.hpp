@@ -38,7 +38,9 @@ struct MeshOptions {
   /// through it from border to border (a partition between two rooms that share one floor
   /// polygon, one ceiling, one side wall), so that no element and no interpolated vertex spans
   /// the line: the lit room's light would otherwise show in the dark room. A cut polygon is
-  /// meshed as convex pieces (up to 64 lines each) and shares no vertices with its neighbours.
+  /// meshed as convex pieces (up to 64 lines each), which share vertices (as crease_angle_deg
+  /// says) with each other and with the neighbours whose edges they share whole, except along
+  /// the contacts themselves.
   /// Contacts that end inside a polygon join into chains: a chain whose loose ends all lie on
   /// the polygon's border, at least a quarter of its diameter long, divides it too (a wall
   /// exported as facets, each foot ending inside the ground triangle it stands on; a
@@ -192,11 +194,14 @@ class RADIOSITY_API PatchHierarchy {
   void add_patch(PolygonId polygon_id, const Polygon& polygon, const std::array<std::uint32_t, 4>& corners);
   /// Meshing's view of which polygon corners and edges are shared (patch_hierarchy.cpp).
   struct Weld;
-  void mesh_quad(PolygonId polygon_id, const Polygon& polygon, Weld& weld);
+  /// Mesh polygon `polygon_id` (or a piece of it: `polygon` is then the piece, with the
+  /// polygon's material, group and normal); `weld_id` is its id in `weld` (the polygon's own, or
+  /// the piece's).
+  void mesh_quad(PolygonId polygon_id, const Polygon& polygon, Weld& weld, std::uint32_t weld_id);
   void mesh_triangle(PolygonId polygon_id, const Polygon& polygon, const glm::vec3& p0, const glm::vec3& p1,
-                     const glm::vec3& p2, Weld& weld);
+                     const glm::vec3& p2, Weld& weld, std::uint32_t weld_id);
   /// Vertex ids for a welded polygon's lattice points (see patch_hierarchy.cpp).
-  void place_lattice(PolygonId polygon_id, const std::vector<glm::vec3>& positions, Weld& weld,
+  void place_lattice(std::uint32_t weld_id, const std::vector<glm::vec3>& positions, Weld& weld,
                      std::vector<std::uint32_t>& ids);
 
   MeshOptions options_;

@@ -237,7 +237,12 @@ std::vector<Piece> cut_polygon(const PolygonVertices& corners, const glm::vec3& 
         if (d[i] >= -tolerance) positive.push_back(piece[i]);
         if (d[i] <= tolerance) negative.push_back(piece[i]);
         if ((d[i] > tolerance && d[k] < -tolerance) || (d[i] < -tolerance && d[k] > tolerance)) {
-          const glm::dvec3 x = piece[i] + (piece[k] - piece[i]) * (d[i] / (d[i] - d[k]));
+          // From the edge's lexicographically lower end, so that the two pieces that share this
+          // edge (which run along it in opposite directions) get the same point when a later
+          // line crosses it: their corners are then one vertex (Weld).
+          const bool up = std::tie(piece[i].x, piece[i].y, piece[i].z) < std::tie(piece[k].x, piece[k].y, piece[k].z);
+          const std::size_t from = up ? i : k, to = up ? k : i;
+          const glm::dvec3 x = piece[from] + (piece[to] - piece[from]) * (d[from] / (d[from] - d[to]));
           positive.push_back(x);
           negative.push_back(x);
         }
@@ -573,9 +578,13 @@ struct PatchHierarchy::Weld {
   std::uint32_t along_edges = 0;
 
   Weld() = default;
-  /// `excluded` (empty, or one flag per polygon): polygons that share nothing. `keep_going` (may
-  /// be empty) is asked every so many items; when it says no, the weld stops unfinished.
-  Weld(const std::vector<Polygon>& polygons, float crease_angle_deg, const std::vector<bool>& excluded,
+  /// Over `polygons` (the scene's: weld ids 0 ..) and `pieces` (triangles and quads of the cut
+  /// polygons: weld ids polygons.size() + k), with `piece_contacts[k]` bit c set where piece
+  /// k's edge from corner c lies along a contact (shared by nothing). `excluded` (empty, or one
+  /// flag per scene polygon): polygons that share nothing (those meshed as pieces). `keep_going`
+  /// (may be empty) is asked every so many items; when it says no, the weld stops unfinished.
+  Weld(const std::vector<Polygon>& polygons, const std::vector<Polygon>& pieces,
+       const std::vector<std::uint8_t>& piece_contacts, float crease_angle_deg, const std::vector<bool>& excluded,
        const detail::KeepGoing& keep_going);
 
   bool welded(PolygonId polygon) const { return !first_corner.empty() && first_corner[polygon] != kNone; }
@@ -583,8 +592,16 @@ struct PatchHierarchy::Weld {
   void make_seams(Edges& edges) const;
 };
 
-PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_angle_deg,
+PatchHierarchy::Weld::Weld(const std::vector<Polygon>& scene_polygons, const std::vector<Polygon>& pieces,
+                           const std::vector<std::uint8_t>& piece_contacts, float crease_angle_deg,
                            const std::vector<bool>& excluded, const detail::KeepGoing& keep_going) {
+  // Weld ids: the scene's polygons, then the pieces of the cut ones.
+  const std::size_t scene_count = scene_polygons.size(), total = scene_count + pieces.size();
+  struct Polygons {
+    const std::vector<Polygon>& scene;
+    const std::vector<Polygon>& pieces;
+    const Polygon& operator[](std::size_t p) const { return p < scene.size() ? scene[p] : pieces[p - scene.size()]; }
+  } polygons{scene_polygons, pieces};
   // Every pass below is O(corners); a million triangles take about 0.5 s in all.
   auto stop = [&](std::size_t i) { return i % 16384 == 0 && keep_going && !keep_going(); };
   // `v` as n copies of `value`, made in steps with a check between: the first touch of tens of
@@ -601,11 +618,11 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   };
   // Number the corners of the triangles and quads; a fan polygon shares nothing (its triangles
   // do not share vertices with each other either), nor does a polygon cut at contact lines.
-  first_corner.assign(polygons.size(), kNone);
+  first_corner.assign(total, kNone);
   std::size_t corner_count = 0;
-  for (std::size_t p = 0; p < polygons.size(); ++p) {
+  for (std::size_t p = 0; p < total; ++p) {
     const std::size_t n = polygons[p].vertices.size();
-    if ((n != 3 && n != 4) || (!excluded.empty() && excluded[p])) continue;
+    if ((n != 3 && n != 4) || (p < scene_count && !excluded.empty() && excluded[p])) continue;
     first_corner[p] = static_cast<std::uint32_t>(corner_count);
     corner_count += n;
     if (corner_count >= kNone)
@@ -613,7 +630,7 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   }
   const auto count = static_cast<std::uint32_t>(corner_count);
   std::vector<std::uint32_t> polygon_of(count);
-  for (std::size_t p = 0; p < polygons.size(); ++p) {
+  for (std::size_t p = 0; p < total; ++p) {
     if (stop(p)) return;
     if (first_corner[p] != kNone)
       for (std::size_t c = 0; c < polygons[p].vertices.size(); ++c)
@@ -625,6 +642,12 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   };
   auto position_of = [&](std::uint32_t c) -> const glm::vec3& {
     return polygons[polygon_of[c]].vertices[c - first_corner[polygon_of[c]]];
+  };
+  // A piece's edge along a contact (a wall's foot): its two sides are lit differently, so it is
+  // shared by nothing, as a crease.
+  auto on_contact = [&](std::uint32_t c) {
+    const std::uint32_t p = polygon_of[c];
+    return p >= scene_count && ((piece_contacts[p - scene_count] >> (c - first_corner[p])) & 1u) != 0;
   };
 
   // 1. Number the distinct positions, in an open-addressing hash table of corner indices (load
@@ -659,7 +682,7 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
   for (std::uint32_t c = 0; c < count; ++c) {
     if (stop(c)) return;
     const std::uint32_t a = position[c], b = position[next_corner(c)];
-    if (a != b) ++bucket_start[std::min(a, b) + 1];
+    if (a != b && !on_contact(c)) ++bucket_start[std::min(a, b) + 1];
   }
   std::partial_sum(bucket_start.begin(), bucket_start.end(), bucket_start.begin());
   std::vector<std::uint64_t> bucket;
@@ -669,7 +692,7 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& polygons, float crease_an
     for (std::uint32_t c = 0; c < count; ++c) {
       if (stop(c)) return;
       const std::uint32_t a = position[c], b = position[next_corner(c)];
-      if (a != b) bucket[fill[std::min(a, b)]++] = (static_cast<std::uint64_t>(std::max(a, b)) << 32) | c;
+      if (a != b && !on_contact(c)) bucket[fill[std::min(a, b)]++] = (static_cast<std::uint64_t>(std::max(a, b)) << 32) | c;
     }
   }
 
@@ -849,33 +872,91 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
   vertices_.reserve(expected);
   patches_.reserve(polygons.size());
   // Contact lines, by polygon: [first_line[p], first_line[p + 1]) in `lines`. A polygon that
-  // has any is cut along them and meshed piece by piece, and shares no vertices with its
-  // neighbours (welding would need its pieces' lattices to match theirs).
+  // has any is cut along them into convex pieces, each meshed as quads where it allows (a
+  // rectangle cut by a line parallel to its sides gives rectangles), else quads and a triangle
+  // of a fan (mesh_quad() grids planar convex quads). The pieces are welded as polygons of their
+  // own (with each other and with the neighbours whose edges they share whole), except along
+  // the contacts, whose two sides are lit differently: without it, the pieces' vertex values
+  // broke along every cut line, also where it runs on beyond the wall's foot that made it (faint
+  // lines from a box's feet across an exported floor).
   std::vector<detail::ContactLine> lines;
   std::vector<detail::ContactSegment> segments;
   std::vector<std::uint32_t> first_line;
   std::vector<bool> cut;
-  double tolerance = 0.0;
+  std::vector<Polygon> pieces;                // of the cut polygons, in polygon order
+  std::vector<std::uint32_t> first_piece;     // per polygon: its pieces are [first_piece[p], first_piece[p + 1])
+  std::vector<std::uint8_t> piece_contacts;   // per piece: bit c when its edge from corner c lies on a contact
   if (options_.split_at_contacts || options_.grade_at_contacts) {
     detail::Contacts contacts = detail::find_contacts(scene, keep_going);
     if (stopped) return false;
     if (options_.split_at_contacts) lines = std::move(contacts.lines);
-    if (options_.grade_at_contacts) segments = std::move(contacts.segments);
+    segments = std::move(contacts.segments);
   }
   if (options_.split_at_contacts) {
-    tolerance = detail::touching_tolerance(scene);
+    const double tolerance = detail::touching_tolerance(scene);
     first_line.assign(polygons.size() + 1, 0);
     for (const detail::ContactLine& l : lines) ++first_line[l.polygon + 1];
     std::partial_sum(first_line.begin(), first_line.end(), first_line.begin());
     cut.assign(polygons.size(), false);
     for (const detail::ContactLine& l : lines) cut[l.polygon] = true;
+    // The segments of each polygon (sorted by polygon), for the contacts of the pieces' edges.
+    std::vector<std::uint32_t> first_segment(polygons.size() + 1, 0);
+    for (const detail::ContactSegment& c : segments) ++first_segment[c.polygon + 1];
+    std::partial_sum(first_segment.begin(), first_segment.end(), first_segment.begin());
+    first_piece.assign(polygons.size() + 1, 0);
+    for (PolygonId id = 0; id < polygons.size(); ++id) {
+      first_piece[id] = static_cast<std::uint32_t>(pieces.size());
+      if (!cut[id]) continue;
+      if (id % kCheckEvery == 0 && keep_going && !keep_going()) return false;
+      const Polygon& polygon = polygons[id];
+      const std::size_t count = std::min<std::size_t>(first_line[id + 1] - first_line[id], kMaxContactLines);
+      const detail::ContactLine* own = &lines[first_line[id]];
+      // Whether the segment from a to b lies on a contact: on a line along which the other
+      // polygon stands whole, or along one of this polygon's segments.
+      auto on_contact = [&](const glm::dvec3& a, const glm::dvec3& b) {
+        const glm::dvec3 m = 0.5 * (a + b);
+        for (std::size_t l = 0; l < count; ++l) {
+          const glm::dvec3 d = m - own[l].point;
+          if (glm::length(d - glm::dot(d, own[l].direction) * own[l].direction) > 4.0 * tolerance) continue;
+          if (own[l].whole) return true;
+          for (std::uint32_t k = first_segment[id]; k < first_segment[id + 1]; ++k) {
+            const glm::dvec3 from = segments[k].from, along = segments[k].to - from;
+            const double t = std::clamp(glm::dot(m - from, along) / std::max(glm::dot(along, along), 1e-300), 0.0, 1.0);
+            if (glm::length(m - (from + t * along)) <= 4.0 * tolerance) return true;
+          }
+        }
+        return false;
+      };
+      Polygon entry = polygon;
+      for (const Piece& piece : cut_polygon(polygon.vertices, polygon.normal, own, count, tolerance)) {
+        std::vector<glm::vec3> corners;
+        for (const glm::dvec3& x : piece) corners.emplace_back(x);
+        auto add = [&](std::initializer_list<std::size_t> at) {
+          std::vector<glm::vec3> v;
+          std::uint8_t contacts = 0;
+          std::uint8_t bit = 1;
+          for (auto c = at.begin(); c != at.end(); ++c, bit = static_cast<std::uint8_t>(bit << 1)) {
+            v.push_back(corners[*c]);
+            const std::size_t next = c + 1 == at.end() ? *at.begin() : *(c + 1);
+            if (on_contact(piece[*c], piece[next])) contacts = static_cast<std::uint8_t>(contacts | bit);
+          }
+          entry.vertices = PolygonVertices(v.data(), v.size());
+          pieces.push_back(entry);
+          piece_contacts.push_back(contacts);
+        };
+        std::size_t i = 1;
+        for (; i + 2 < corners.size(); i += 2) add({0, i, i + 1, i + 2});
+        if (i + 1 < corners.size()) add({0, i, i + 1});
+      }
+    }
+    first_piece[polygons.size()] = static_cast<std::uint32_t>(pieces.size());
     if (!report(0.1)) return false;
   }
   Weld weld = options_.crease_angle_deg > 0.0f
-                  ? Weld(polygons, options_.crease_angle_deg, cut, keep_going)
+                  ? Weld(polygons, pieces, piece_contacts, options_.crease_angle_deg, cut, keep_going)
                   : Weld();
   if (stopped || !report(0.2)) return false;
-  Polygon piece_polygon;
+  const auto weld_piece = static_cast<std::uint32_t>(polygons.size());  // the first piece's weld id
   for (PolygonId id = 0; id < polygons.size(); ++id) {
     if (id % kCheckEvery == 0 && gate.due(Phase::meshing) &&
         !report(0.2 + 0.5 * static_cast<double>(id) / static_cast<double>(polygons.size())))
@@ -883,30 +964,20 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
     const Polygon& polygon = polygons[id];
     const PolygonVertices& p = polygon.vertices;
     if (!cut.empty() && cut[id]) {
-      const std::size_t count = std::min<std::size_t>(first_line[id + 1] - first_line[id], kMaxContactLines);
-      piece_polygon = polygon;
-      for (const Piece& piece : cut_polygon(p, polygon.normal, &lines[first_line[id]], count, tolerance)) {
-        std::vector<glm::vec3> corners;
-        for (const glm::dvec3& x : piece) corners.emplace_back(x);
-        // Quads where the piece allows (a rectangle cut by a line parallel to its sides gives
-        // rectangles), else quads and a triangle of a fan: mesh_quad() grids planar convex quads.
-        std::size_t i = 1;
-        for (; i + 2 < corners.size(); i += 2) {
-          const glm::vec3 quad[4] = {corners[0], corners[i], corners[i + 1], corners[i + 2]};
-          piece_polygon.vertices = PolygonVertices(quad, 4);
-          mesh_quad(id, piece_polygon, weld);
-        }
-        if (i + 1 < corners.size()) mesh_triangle(id, polygon, corners[0], corners[i], corners[i + 1], weld);
+      for (std::uint32_t k = first_piece[id]; k < first_piece[id + 1]; ++k) {
+        const PolygonVertices& q = pieces[k].vertices;
+        if (q.size() == 4) mesh_quad(id, pieces[k], weld, weld_piece + k);
+        else mesh_triangle(id, polygon, q[0], q[1], q[2], weld, weld_piece + k);
       }
     } else if (p.size() == 4) {
-      mesh_quad(id, polygon, weld);
+      mesh_quad(id, polygon, weld, id);
     } else if (p.size() == 3) {
-      mesh_triangle(id, polygon, p[0], p[1], p[2], weld);
+      mesh_triangle(id, polygon, p[0], p[1], p[2], weld, id);
     } else {
       // A convex polygon with more vertices is a fan of triangles around vertex 0. Each triangle
       // gets its own lattice, so vertices are not shared across the fan diagonals: vertex values
       // may be discontinuous there (the same as at a crease). Such polygons are not welded.
-      for (std::size_t i = 1; i + 1 < p.size(); ++i) mesh_triangle(id, polygon, p[0], p[i], p[i + 1], weld);
+      for (std::size_t i = 1; i + 1 < p.size(); ++i) mesh_triangle(id, polygon, p[0], p[i], p[i + 1], weld, id);
     }
   }
   weld.make_seams(*edges_);
@@ -944,7 +1015,7 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
     }
   }
   grading_ = ContactGrading{};
-  if (!segments.empty() && !grade_toward_contacts(
+  if (options_.grade_at_contacts && !segments.empty() && !grade_toward_contacts(
                                *this, scene, segments,
                                [&] { return ++splits % kCheckEvery != 0 || !gate.due(Phase::meshing) || report(0.99); },
                                grading_))
@@ -1004,7 +1075,7 @@ void PatchHierarchy::add_patch(PolygonId polygon_id, const Polygon& polygon,
   patches_.push_back(patch);
 }
 
-void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon, Weld& weld) {
+void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon, Weld& weld, std::uint32_t weld_id) {
   const PolygonVertices& p = polygon.vertices;
   const glm::dvec3 p0(p[0]), p1(p[1]), p2(p[2]), p3(p[3]);
   // Bilinear map P(s,t) = (1-s)(1-t)p0 + s(1-t)p1 + st p2 + (1-s)t p3; for a planar convex quad
@@ -1053,7 +1124,7 @@ void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon, Wel
     }
   auto index = [&](std::size_t i, std::size_t j) { return static_cast<std::uint32_t>(j * (nu + 1) + i); };
   std::vector<std::uint32_t>& ids = weld.ids;
-  if (weld.welded(polygon_id)) {
+  if (weld.welded(weld_id)) {
     // The four edges, each from its corner c to corner c + 1.
     weld.along.clear();
     weld.along_start[0] = 0;
@@ -1066,7 +1137,7 @@ void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon, Wel
     for (std::size_t j = nv + 1; j-- > 0;) weld.along.push_back(index(0, j));
     weld.along_start[4] = static_cast<std::uint32_t>(weld.along.size());
     weld.along_edges = 4;
-    place_lattice(polygon_id, q, weld, ids);
+    place_lattice(weld_id, q, weld, ids);
   } else {
     ids.clear();
     for (const glm::vec3& position : q) ids.push_back(add_vertex(position, kNone, kNone));
@@ -1078,7 +1149,7 @@ void PatchHierarchy::mesh_quad(PolygonId polygon_id, const Polygon& polygon, Wel
 }
 
 void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon, const glm::vec3& p0,
-                                   const glm::vec3& p1, const glm::vec3& p2, Weld& weld) {
+                                   const glm::vec3& p1, const glm::vec3& p2, Weld& weld, std::uint32_t weld_id) {
   const glm::dvec3 a(p0), b(p1), c(p2);
   const double area = triangle_area(a, b, c);
   // k x k similar sub-triangles, each of area area / k^2.
@@ -1101,7 +1172,7 @@ void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon,
   }
   auto index = [&](std::size_t i, std::size_t j) { return row_start[j] + static_cast<std::uint32_t>(i); };
   std::vector<std::uint32_t>& ids = weld.ids;
-  if (weld.welded(polygon_id)) {  // never a fan's triangle: fans are not welded
+  if (weld.welded(weld_id)) {  // never a fan's triangle: fans are not welded
     weld.along.clear();
     weld.along_start[0] = 0;
     for (std::size_t i = 0; i <= k; ++i) weld.along.push_back(index(i, 0));
@@ -1111,7 +1182,7 @@ void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon,
     for (std::size_t j = k + 1; j-- > 0;) weld.along.push_back(index(0, j));
     weld.along_start[3] = static_cast<std::uint32_t>(weld.along.size());
     weld.along_edges = 3;
-    place_lattice(polygon_id, q, weld, ids);
+    place_lattice(weld_id, q, weld, ids);
   } else {
     ids.clear();
     for (const glm::vec3& position : q) ids.push_back(add_vertex(position, kNone, kNone));
@@ -1126,10 +1197,10 @@ void PatchHierarchy::mesh_triangle(PolygonId polygon_id, const Polygon& polygon,
     }
 }
 
-void PatchHierarchy::place_lattice(PolygonId polygon_id, const std::vector<glm::vec3>& positions, Weld& weld,
+void PatchHierarchy::place_lattice(std::uint32_t weld_id, const std::vector<glm::vec3>& positions, Weld& weld,
                                    std::vector<std::uint32_t>& ids) {
   ids.assign(positions.size(), kNone);
-  const std::uint32_t first = weld.first_corner[polygon_id];
+  const std::uint32_t first = weld.first_corner[weld_id];
   const std::uint32_t edge_count = weld.along_edges;
   // Corners: one vertex per class, made by the first polygon that reaches it.
   for (std::uint32_t c = 0; c < edge_count; ++c) {

@@ -393,6 +393,7 @@ void lines_of_dividing_chains(const Search& s, const std::vector<ContactSegment>
       l.polygon = id;
       l.point = 0.5 * (c.from + c.to);
       l.direction = glm::normalize(c.to - c.from);
+      l.whole = false;
       lines.push_back(l);
     }
     first = last;
@@ -651,6 +652,7 @@ Contacts find_contacts(const Scene& scene, const KeepGoing& keep_going) {
       const double apart = glm::length(d - glm::dot(d, it->direction) * it->direction);
       if (parallel < 1e-6 && apart <= s.tolerance) {
         same = true;
+        it->whole = it->whole || l.whole;  // a wall across the polygon and a chain along it: whole
         break;
       }
     }

@@ -54,6 +54,11 @@ struct ContactLine {
   std::uint32_t polygon = 0;   ///< the polygon touched (a PolygonId)
   glm::dvec3 point{0.0};       ///< a point of the line, in the polygon's plane, inside it
   glm::dvec3 direction{0.0};   ///< unit, in the polygon's plane
+  /// The other polygon stands along the line's whole chord (it divides the polygon by itself);
+  /// false for the line of a segment of a dividing chain, in contact only along the chain's
+  /// segments (Contacts::segments), so that the pieces on its two sides may share vertices
+  /// beyond them.
+  bool whole = true;
 };
 
 /// A segment in a polygon's plane, inside it, along which another polygon stands on it or

@@ -1,6 +1,7 @@
 // Tests for PatchHierarchy: area bookkeeping, option handling, shared vertices, crack-free vertex
 // values, aggregation, area-uniform sampling and progress and cancel while meshing.
 #include <algorithm>
+#include <map>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -552,6 +553,87 @@ TEST_CASE("a floor is cut along feet that cross it as a chain of facets, not alo
   CHECK(floor_pieces({{w0, 0.5f * (w0 + w1)}}) == 1);
   const glm::vec3 c0(0.0f, 0.0f, 1.0f), c1(1.0f, 0.0f, 1.0f), c2(1.0f, 0.0f, 0.0f);
   CHECK(floor_pieces({{c0, c1}, {c1, c2}}) == 1);
+}
+
+TEST_CASE("the pieces of a cut floor share their vertices along the cut lines beyond the walls' feet, not along "
+          "the feet") {
+  // The floor cut by an L of two faceted walls (a building's corner standing on it): four
+  // pieces. Along the feet the two sides are lit differently and keep vertices of their own;
+  // along each line's run beyond the corner nothing stands, and the pieces' vertex values there
+  // were broken too (faint lines from a box's feet across an exported floor), since the pieces
+  // shared no vertices with each other.
+  Scene scene;
+  const MaterialId m = scene.add_material(Material{});
+  add_quad(scene, {0, 0, 10}, {10, 0, 0}, {0, 0, -10}, m, "floor");
+  const glm::vec3 a(0.0f, 0.0f, 2.5f), corner(6.0f, 0.0f, 4.2f), b(7.3f, 0.0f, 10.0f);
+  for (const auto& [from, to] : {std::pair{a, corner}, std::pair{corner, b}}) {
+    const glm::vec3 u = (to - from) / 3.0f, v(0.0f, 2.0f / 3.0f, 0.0f);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) add_quad(scene, from + static_cast<float>(i) * u + static_cast<float>(j) * v, u, v, m, "wall");
+  }
+  // The side of each foot's line a point lies on: the quadrant (0 .. 3) the two lines make.
+  auto quadrant = [&](const glm::vec3& x) {
+    auto side = [](const glm::vec3& p, const glm::vec3& q, const glm::vec3& y) {
+      return (q.x - p.x) * (y.z - p.z) - (q.z - p.z) * (y.x - p.x) > 0.0f ? 1 : 0;
+    };
+    return side(a, corner, x) + 2 * side(corner, b, x);
+  };
+  auto distance_to_segment = [](const glm::vec3& x, const glm::vec3& p, const glm::vec3& q) {
+    const glm::vec3 d = q - p;
+    const float t = std::clamp(glm::dot(x - p, d) / glm::dot(d, d), 0.0f, 1.0f);
+    return glm::length(x - (p + t * d));
+  };
+  auto distance_to_line = [](const glm::vec3& x, const glm::vec3& p, const glm::vec3& q) {
+    const glm::vec3 d = glm::normalize(q - p);
+    return glm::length((x - p) - glm::dot(x - p, d) * d);
+  };
+  for (const float element_area : {1000.0f, 1.0f}) {
+    CAPTURE(element_area);
+    const PatchHierarchy h(scene, MeshOptions{element_area, element_area});
+    // The floor's leaves take 10 x their quadrant: each quadrant uniform, a step between them.
+    std::vector<Rgb> values(h.elements().size(), Rgb(0.0f));
+    for (std::uint32_t leaf : h.leaves())
+      if (h.patches()[h.element(leaf).patch].polygon == 0)
+        values[leaf] = Rgb(10.0f * static_cast<float>(quadrant(h.element(leaf).centroid)));
+    const std::vector<Rgb> at = h.vertex_values(values);
+    // Per position (exact): the quadrant of each floor leaf with a corner there, and the
+    // value of that corner's vertex.
+    std::map<std::array<float, 3>, std::vector<std::pair<int, float>>> by_position;
+    for (std::uint32_t leaf : h.leaves()) {
+      const Element& e = h.element(leaf);
+      if (h.patches()[e.patch].polygon != 0) continue;
+      for (int c = 0; c < e.corner_count(); ++c) {
+        const std::uint32_t v = e.corners[static_cast<std::size_t>(c)];
+        const glm::vec3& x = h.vertices()[v];
+        by_position[{x.x, x.y, x.z}].push_back({quadrant(e.centroid), at[v].x});
+      }
+    }
+    int on_feet = 0, beyond = 0;
+    for (const auto& [key, seen] : by_position) {
+      const glm::vec3 x(key[0], key[1], key[2]);
+      if (glm::length(x - corner) < 1e-4f) continue;
+      bool two_sides = false;
+      float lo = seen[0].second, hi = seen[0].second;
+      for (const auto& [q, value] : seen) {
+        two_sides = two_sides || q != seen[0].first;
+        lo = std::min(lo, value);
+        hi = std::max(hi, value);
+      }
+      if (!two_sides) continue;  // a lattice point of one side only
+      const bool foot = distance_to_segment(x, a, corner) < 1e-4f || distance_to_segment(x, corner, b) < 1e-4f;
+      const bool line = distance_to_line(x, a, corner) < 1e-4f || distance_to_line(x, corner, b) < 1e-4f;
+      REQUIRE(line);  // quadrants meet only on the lines
+      if (foot) {
+        ++on_feet;
+        CHECK(hi - lo > 5.0f);  // each side its own value
+      } else {
+        ++beyond;
+        CHECK(hi - lo < 1e-4f);  // one value, shared across the line
+      }
+    }
+    CHECK(on_feet >= 2);
+    CHECK(beyond >= 2);
+  }
 }
 
 TEST_CASE("meshing with a progress callback: the same mesh, reported from 0 to 1; a cancel leaves it empty") {
