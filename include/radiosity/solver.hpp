@@ -497,7 +497,10 @@ class RADIOSITY_API Problem {
 /// Phase::meshing: a Solution without elements or meshes).
 /// Light that leaves the scene is diagnosed in SolveReport::warnings: emitters that face away
 /// from every surface (find_emitters_facing_away()), apart from those that lie against a
-/// polygon facing them (in contact: a fixture's top against a ceiling), and, for a converged
+/// polygon facing them (in contact: a fixture's top against a ceiling); emitters whose light is
+/// caught right in front of them (90 % of their rays meet a surface within a tenth of their
+/// size: a lamp wound to face the ceiling it hangs 1 cm under), whose light does not leave but
+/// hardly reaches the scene; and, for a converged
 /// solve, a scene that looks closed (over 95 % of the emitters' light meets a polygon directly,
 /// by rays) but loses more than half its emitted power (SolveReport::escaped_power): light that
 /// arrives at the back of a one-sided polygon is lost, so its polygons probably face outwards

@@ -50,9 +50,11 @@ std::string id_list(const std::vector<PolygonId>& ids) {
 /// of `rays_scene`: points from a jittered grid on the polygon, lifted by `lift`, directions from
 /// a second grid shuffled against the first, cosine-distributed. `order`, `origin`, `dir` and
 /// `hit` are the caller's scratch (resized here), `rng` the polygon's own stream.
+/// With `near` (not null), also the share that meets one within `near_distance`.
 double hit_fraction(const RayScene& rays_scene, const Polygon& polygon, const glm::vec3& n, std::size_t side, float lift,
                     Rng& rng, std::vector<std::uint32_t>& order, std::vector<glm::vec3>& origin,
-                    std::vector<glm::vec3>& dir, std::vector<std::uint8_t>& hit) {
+                    std::vector<glm::vec3>& dir, std::vector<std::uint8_t>& hit, float near_distance = 0.0f,
+                    double* near = nullptr) {
   const std::size_t rays = side * side;
   order.resize(rays);
   origin.resize(rays);
@@ -71,6 +73,10 @@ double hit_fraction(const RayScene& rays_scene, const Polygon& polygon, const gl
   for (std::size_t i = 0; i < rays; ++i) {
     origin[i] = fan.sample(stratum(i)) + lift * n;
     dir[i] = frame.to_world(cosine_hemisphere(stratum(order[i])));
+  }
+  if (near) {
+    rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, near_distance, hit.data());
+    *near = static_cast<double>(std::count(hit.begin(), hit.end(), std::uint8_t{1})) / static_cast<double>(rays);
   }
   rays_scene.occluded(rays, origin.data(), dir.data(), 0.0f, std::numeric_limits<float>::infinity(), hit.data());
   return static_cast<double>(std::count(hit.begin(), hit.end(), std::uint8_t{1})) / static_cast<double>(rays);
@@ -108,7 +114,9 @@ std::vector<EmitterReach> emitter_reach(const Scene& scene, unsigned threads, co
     for (std::size_t k = begin; k < end; ++k) {
       const Polygon& polygon = polygons[out[k].polygon];
       Rng rng(kSeed, out[k].polygon);
-      out[k].hit_fraction = hit_fraction(rays_scene, polygon, polygon.normal, side, lift, rng, order, origin, dir, hit);
+      const float near_distance = static_cast<float>(kNearEmitterShare * std::sqrt(static_cast<double>(polygon.area)));
+      out[k].hit_fraction = hit_fraction(rays_scene, polygon, polygon.normal, side, lift, rng, order, origin, dir, hit,
+                                         near_distance, &out[k].near_fraction);
     }
   });
   return out;
@@ -172,6 +180,29 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
                        (many ? " face away from every surface: their light leaves the scene; check the polygons' "
                              : " faces away from every surface: its light leaves the scene; check the polygon's ") +
                        "winding (vertex order) or use two-sided materials (--two-sided; Material::two_sided in code)");
+  }
+  // Emitters whose light is caught right in front of them: a lamp under a ceiling wound to face
+  // it (found by trying an exported room: the room came out at a fortieth of its light, with
+  // nothing said). Their light does not leave the scene, so the checks below stay silent.
+  std::vector<PolygonId> caught;
+  double caught_share = 1.0;  // the least near_fraction among them
+  for (const EmitterReach& r : reach)
+    if (r.near_fraction >= kCaughtEmitterFraction) {
+      caught.push_back(r.polygon);
+      caught_share = std::min(caught_share, r.near_fraction);
+    }
+  if (!caught.empty()) {
+    const bool many = caught.size() > 1;
+    char share_text[32];
+    std::snprintf(share_text, sizeof share_text, "%.0f", std::floor(100.0 * caught_share));
+    warnings.push_back(std::string(many ? "emitters " : "emitter ") + by_group(caught) +
+                       (many ? " face surfaces right in front of them (" : " faces a surface right in front of it (") +
+                       share_text + " % or more of " + (many ? "their" : "its") + " rays meet one within " +
+                       std::to_string(static_cast<int>(100.0 * kNearEmitterShare)) + " % of " +
+                       (many ? "their" : "its") + " size): most of " + (many ? "their" : "its") +
+                       " light stays between the two; if " + (many ? "they" : "it") +
+                       " should face the other way, reverse the winding (vertex order) or use two-sided materials "
+                       "(--two-sided; Material::two_sided in code)");
   }
   if (!against.empty()) {
     const bool many = against.size() > 1;

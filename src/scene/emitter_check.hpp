@@ -26,7 +26,15 @@ struct EmitterReach {
   /// Of the cosine-distributed rays leaving its front (from stratified points, so weighted as
   /// its light is), the fraction that hit some polygon, front or back.
   double hit_fraction = 0.0;
+  /// The fraction that hit one within kNearEmitterShare of the emitter's size (the square root
+  /// of its area): a lamp wound to face the ceiling it hangs 1 cm under sees it with almost all.
+  double near_fraction = 0.0;
 };
+
+/// What near_fraction counts as right in front of an emitter, as a share of its size.
+inline constexpr double kNearEmitterShare = 0.1;
+/// solve() warns about an emitter when at least this fraction of its rays is caught so near.
+inline constexpr double kCaughtEmitterFraction = 0.9;
 
 /// Every emitting polygon (emission > 0 in some channel), in polygon order. Each casts
 /// kEmitterRays rays (see above) from stratified points just in front of it, in stratified
