@@ -617,7 +617,8 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& scene_polygons, const std
     return true;
   };
   // Number the corners of the triangles and quads; a fan polygon shares nothing (its triangles
-  // do not share vertices with each other either), nor does a polygon cut at contact lines.
+  // do not share vertices with each other either), nor does a polygon cut at contact lines
+  // (its pieces, after the scene's polygons, are welded in its place).
   first_corner.assign(total, kNone);
   std::size_t corner_count = 0;
   for (std::size_t p = 0; p < total; ++p) {
