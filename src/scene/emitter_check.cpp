@@ -199,8 +199,8 @@ std::vector<std::string> escaped_light_warnings(const Scene& scene, const Rgb& e
                        (many ? " face surfaces right in front of them (" : " faces a surface right in front of it (") +
                        share_text + " % or more of " + (many ? "their" : "its") + " rays meet one within " +
                        std::to_string(static_cast<int>(100.0 * kNearEmitterShare)) + " % of " +
-                       (many ? "their" : "its") + " size): most of " + (many ? "their" : "its") +
-                       " light stays between the two; if " + (many ? "they" : "it") +
+                       (many ? "their" : "its") + " size), which " + (many ? "take" : "takes") +
+                       " almost all of " + (many ? "their" : "its") + " light first; if " + (many ? "they" : "it") +
                        " should face the other way, reverse the winding (vertex order) or use two-sided materials "
                        "(--two-sided; Material::two_sided in code)");
   }
