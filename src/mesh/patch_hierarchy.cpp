@@ -920,11 +920,8 @@ bool PatchHierarchy::build(const Scene& scene, const MeshOptions& options, const
           const glm::dvec3 d = m - own[l].point;
           if (glm::length(d - glm::dot(d, own[l].direction) * own[l].direction) > 4.0 * tolerance) continue;
           if (own[l].whole) return true;
-          for (std::uint32_t k = first_segment[id]; k < first_segment[id + 1]; ++k) {
-            const glm::dvec3 from = segments[k].from, along = segments[k].to - from;
-            const double t = std::clamp(glm::dot(m - from, along) / std::max(glm::dot(along, along), 1e-300), 0.0, 1.0);
-            if (glm::length(m - (from + t * along)) <= 4.0 * tolerance) return true;
-          }
+          for (std::uint32_t k = first_segment[id]; k < first_segment[id + 1]; ++k)
+            if (distance_to_segment(m, segments[k].from, segments[k].to) <= 4.0 * tolerance) return true;
         }
         return false;
       };

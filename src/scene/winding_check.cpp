@@ -60,6 +60,14 @@ struct EdgeRecord {
   std::uint32_t edge = 0;
 };
 
+// Polled every kPollEvery items of each pass (and between the sort's runs): solve() runs the
+// winding check while meshing, where a cancel is to be seen within 100 ms (a terrain of 600k
+// triangles takes about a second in all).
+constexpr std::size_t kPollEvery = 1u << 15;
+bool stopped_at(const KeepGoing& keep_going, std::size_t item) {
+  return keep_going && item % kPollEvery == 0 && !keep_going();
+}
+
 }  // namespace
 
 bool has_sides(const Material& m) { return !pass1_has_back(m) && !(max_channel(m.transmittance) > 0.0f); }
@@ -98,11 +106,7 @@ std::vector<std::string> inconsistent_winding_warnings(const Scene& scene, const
 
 bool polygon_adjacency(const Scene& scene, const KeepGoing& keep_going, PolygonAdjacency& adjacency) {
   const std::vector<Polygon>& polygons = scene.polygons();
-  // Polled every kPollEvery items of each pass (and between the sort's runs): solve() runs this
-  // while meshing, where a cancel is to be seen within 100 ms (a terrain of 600k triangles takes
-  // about a second in all).
-  constexpr std::size_t kPollEvery = 1u << 15;
-  auto stopped = [&](std::size_t item) { return keep_going && item % kPollEvery == 0 && !keep_going(); };
+  auto stopped = [&](std::size_t item) { return stopped_at(keep_going, item); };
   // Every edge of every one-sided polygon.
   std::vector<detail::EdgeRecord> edges;
   std::size_t count = 0;
@@ -231,8 +235,7 @@ std::vector<std::uint32_t> connected_surfaces(const PolygonAdjacency& adjacency)
 InconsistentWinding inconsistent_winding(const Scene& scene, const KeepGoing& keep_going) {
   const std::vector<Polygon>& polygons = scene.polygons();
   InconsistentWinding out;
-  constexpr std::size_t kPollEvery = 1u << 15;
-  auto stopped = [&](std::size_t item) { return keep_going && item % kPollEvery == 0 && !keep_going(); };
+  auto stopped = [&](std::size_t item) { return stopped_at(keep_going, item); };
   PolygonAdjacency adjacency;
   if (!polygon_adjacency(scene, keep_going, adjacency)) return {};
   const std::vector<std::size_t>& first = adjacency.first;
