@@ -173,6 +173,7 @@ TEST_SUITE("solver") {
     // a fortieth of its light with no warning, since nothing escaped the scene.
     rad::Material grey;
     grey.reflectance = rad::Rgb(0.8f);
+    float floor_lit_down = 0.0f;  // the floor's light with the lamp facing down (the first pass)
     for (const bool faces_down : {true, false}) {
       CAPTURE(faces_down);
       rad::Scene room = test::closed_box(grey, glm::vec3(4.0f, 3.0f, 4.0f));
@@ -185,11 +186,11 @@ TEST_SUITE("solver") {
       CHECK(!has_warning(sol.report(), "faces away from every surface"));
       // What it does: the floor's light, lamp facing up against facing down (0.31 at the default
       // mesh; less where the elements beside the lamp are finer than the gap).
-      if (!faces_down) {
-        rad::Scene down = test::closed_box(grey, glm::vec3(4.0f, 3.0f, 4.0f));
-        rad::add_quad(down, {1.6f, 2.99f, 1.6f}, {0.8f, 0, 0}, {0, 0, 0.8f}, down.add_material(lamp()), "lamp");
-        const rad::Solution lit = rad::solve(down, rad::SolveOptions{});
-        CHECK(sol.group_radiosity("y0").y < 0.5f * lit.group_radiosity("y0").y);
+      if (faces_down) {
+        floor_lit_down = sol.group_radiosity("y0").y;
+        REQUIRE(floor_lit_down > 0.0f);
+      } else {
+        CHECK(sol.group_radiosity("y0").y < 0.5f * floor_lit_down);
       }
     }
   }
