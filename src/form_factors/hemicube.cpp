@@ -33,6 +33,7 @@
 #include "form_factors/estimators.hpp"
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
+#include "core/quadrature.hpp"
 #include "core/streams.hpp"
 
 namespace radiosity::detail {
@@ -41,29 +42,6 @@ namespace {
 
 constexpr std::uint32_t kNoItem = 0xffffffffu;
 constexpr double kTwoPi = 6.283185307179586;
-
-// Gauss-Legendre nodes and weights on [0,1] (Newton's method on the Legendre polynomial).
-void gauss_legendre(int n, std::vector<float>& node, std::vector<double>& weight) {
-  node.resize(static_cast<std::size_t>(n));
-  weight.resize(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(3.14159265358979323846 * (i + 0.75) / (n + 0.5)), dp = 1.0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1.0, p1 = 0.0;
-      for (int k = 1; k <= n; ++k) {
-        const double p2 = p1;
-        p1 = p0;
-        p0 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p2) / k;
-      }
-      dp = n * (z * p0 - p1) / (z * z - 1.0);
-      const double step = p0 / dp;
-      z -= step;
-      if (std::fabs(step) < 1e-15) break;
-    }
-    node[static_cast<std::size_t>(i)] = static_cast<float>(0.5 * (1.0 - z));
-    weight[static_cast<std::size_t>(i)] = 1.0 / ((1.0 - z * z) * dp * dp);
-  }
-}
 
 // A point in a face's view coordinates: x right, y up, z forward.
 struct V3 {

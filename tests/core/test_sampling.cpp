@@ -10,6 +10,7 @@
 
 #include "core/frame.hpp"
 #include "core/halton.hpp"
+#include "core/quadrature.hpp"
 #include "core/sampling.hpp"
 #include "core/rng.hpp"
 
@@ -296,5 +297,32 @@ TEST_SUITE("core") {
       }
       for (const int c : count) CHECK(c == static_cast<int>(base));
     }
+  }
+
+  TEST_CASE("Gauss-Legendre rules integrate polynomials of degree 2n - 1 exactly, over [0,1], a triangle and a "
+            "trapezoid") {
+    for (int n = 1; n <= core::kMaxGaussOrder; ++n) {
+      const core::GaussRule& rule = core::gauss_rule(n);
+      double weights = 0.0, moment = 0.0;
+      for (int i = 0; i < n; ++i) {
+        weights += rule.weight[static_cast<std::size_t>(i)];
+        moment += rule.weight[static_cast<std::size_t>(i)] * std::pow(rule.node[static_cast<std::size_t>(i)], 2 * n - 1);
+      }
+      CHECK(weights == doctest::Approx(1.0).epsilon(1e-6));
+      CHECK(moment == doctest::Approx(1.0 / (2 * n)).epsilon(1e-5));  // the integral of t^(2n-1) over [0,1]
+    }
+    // Means of x^2 and y^2 (degree 2: exact with 2 x 2 points) against their integrals.
+    const glm::vec3 triangle[3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // mean of x^2: (1/12) / (1/2)
+    CHECK(core::polygon_gauss_mean(triangle, 3, 2, [](const glm::vec3& p) { return p.x * p.x; }) ==
+          doctest::Approx(1.0 / 6.0).epsilon(1e-5));
+    // A trapezoid (no parallelogram: the bilinear map's Jacobian varies), width 2 - y, area 1.5:
+    // the mean of y is (1 - 1/3) / 1.5 = 4/9, of y^2 (2/3 - 1/4) / 1.5 = 5/18.
+    const glm::vec3 trapezoid[4] = {{0, 0, 0}, {2, 0, 0}, {1.5f, 1, 0}, {0.5f, 1, 0}};
+    CHECK(core::polygon_gauss_mean(trapezoid, 4, 2, [](const glm::vec3& p) { return p.y; }) ==
+          doctest::Approx(4.0 / 9.0).epsilon(1e-5));
+    CHECK(core::polygon_gauss_mean(trapezoid, 4, 2, [](const glm::vec3& p) { return p.y * p.y; }) ==
+          doctest::Approx(5.0 / 18.0).epsilon(1e-5));
+    const glm::vec3 degenerate[3] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+    CHECK(core::polygon_gauss_mean(degenerate, 3, 2, [](const glm::vec3&) { return 1.0f; }) == 0.0f);
   }
 }

@@ -26,6 +26,7 @@
 #include "core/growable_array.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
+#include "core/quadrature.hpp"
 #include "core/rng.hpp"
 #include "core/streams.hpp"
 #include "form_factors/estimators.hpp"
@@ -130,14 +131,16 @@ constexpr float kHiddenClusterFloor = 0.03f;
 /// 1.27 %, 13.5 M; 0.03: 1.24 %, 18.9 M. The 246k city's links at 0.3: 20.8 -> 22.5-24.1 s; at
 /// 0.1: 31.5 s and 98 MiB more (the Cornell box's floor +0.50 -> +0.36 % there).
 constexpr float kBuriedClusterFloor = 0.3f;
-/// Receiver points per side (n x n) for the closed form of an element pair whose radii add up to
-/// R at distance d: 1 beyond 6 R, 2 beyond 3 R, 4 beyond R, 8 closer (touching: the factor varies
-/// fastest near a shared edge, logarithmically); one where the link carries little. Measured
-/// against 1 / 2 / 2 points (beyond 4 R / beyond R / touching): the 22k city's ground element RMS
-/// against its reference 4.0 % -> 3.0 %; the Cornell box's red wall, unshadowed elements, +1 to
-/// +2 % -> within 0.8 % of the reference; a black closed box's rows at epsilon 0.004, mean
-/// +0.07 % -> +0.08 %, worst leaf 0.16 % -> 0.24 %.
-int receiver_grid(float d, float R) { return d >= 6.0f * R ? 1 : d >= 3.0f * R ? 2 : d > R ? 4 : 8; }
+/// Gauss-Legendre points per side (n x n) of the receiver for the closed form of an element pair
+/// whose radii add up to R at distance d: 2 beyond 3 R (and where the link carries little), 3
+/// beyond R, 4 closer (touching: the factor varies fastest near a shared edge, logarithmically;
+/// two unit squares sharing an edge at 4 x 4 within 1e-5 of Howell's C-14). Session 42 (from
+/// 1 / 2 / 4 / 8 cell midpoints beyond 6 R / 3 R / R / closer, the single point corrected for
+/// curvature): the 1 x 2 x 3 box's element view factors over 0.01 within 0.22 % of the exact
+/// mode's (0.51 % before), summed per face within 0.021 % at epsilon 0.01 (0.053 %); the cities
+/// and the solve's time the same (docs/HIERARCHICAL.md, "One bounce through the links at the
+/// walls' feet").
+int receiver_grid(float d, float R) { return d >= 3.0f * R ? 2 : d > R ? 3 : 4; }
 /// An element pair's closed form is integrated over the source instead of the receiver when the
 /// receiver is more than this many times larger (process(), at the link).
 constexpr float kReciprocalAreaRatio = 4.0f;
@@ -928,13 +931,19 @@ struct LinkHierarchy::Impl {
     bool source_by_power_ = true;
   };
 
-  /// Element-to-element factor: the point-to-polygon closed form from receiver points to the
-  /// source element, averaged over an n x n grid of area-uniform cells of the receiver (n = 1:
-  /// its centroid, with a curvature correction), 0 at points behind the source's side.
+  /// Element-to-element factor: the point-to-polygon closed form (Lambert's contour integral,
+  /// point_to_polygon_factor_fast()) from receiver points to the source element, 0 at points
+  /// behind the source's side, averaged over the n x n Gauss-Legendre points of the receiver
+  /// (polygon_gauss_mean(), core/quadrature.hpp). Until session 42 the points were the
+  /// midpoints of n x n cells (twice as many per side), and one point with a curvature
+  /// correction where the link carried little or the pair was far apart; next to the source's
+  /// plane, where the factor vanishes and is concave over the receiver, both overestimated
+  /// (a ground square at a wall's foot, from the wall's second row of squares: 4 x 4 midpoints
+  /// +1.24 %, the corrected centroid +6.7 %; Gauss-Legendre 3 x 3 within 0.01 %).
   static float element_factor(const PatchHierarchy& h, NodeHandle r, NodeHandle s, int n) {
     const std::uint32_t re = element_of(r);
     const Element& es = h.element(element_of(s));
-    const glm::vec3 nr = side_normal(h, r), ns = side_normal(h, s);
+    const glm::vec3 ns = side_normal(h, s), nr = side_normal(h, r);
     std::array<glm::vec3, 4> polygon{};
     for (int k = 0; k < es.corner_count(); ++k) polygon[static_cast<std::size_t>(k)] = h.vertices()[es.corners[k]];
     auto at = [&](const glm::vec3& x) {
@@ -942,39 +951,36 @@ struct LinkHierarchy::Impl {
       return point_to_polygon_factor_fast(x, nr, polygon.data(), es.corner_count());
     };
     const Element& er = h.element(re);
-    const float centre = n == 1 ? at(er.centroid) : 0.0f;
-    if (n == 1 && !(centre > 0.0f)) return centre;
-    // PatchHierarchy::sample_point()'s warp, set up once for the n x n points rather than per point.
     std::array<glm::vec3, 4> receiver{};
     for (int k = 0; k < er.corner_count(); ++k) receiver[static_cast<std::size_t>(k)] = h.vertices()[er.corners[k]];
-    const CellSampler cell(receiver.data(), er.corner_count());
-    if (n == 1) {
-      // The centroid rule overestimates where the factor is concave over the receiver (it
-      // peaks toward the source): corrected by the point-to-point kernel's mean over the
-      // receiver's four quarter-cell centres against its value at the centroid, a few
-      // multiplications each. Measured on the Cornell box at 248 elements (patches = elements,
-      // which nothing splits), against Gauss-Seidel over ray-cast rows at epsilon 0.005: the
-      // ceiling +0.34 % -> +0.07 %, the green wall +0.37 % -> +0.15 % (at 0.05, over four
-      // seeds, the worst group 0.91 % -> about 0.5 %); the 22k city and the Cornell box at
-      // 16 679 elements within 0.03 % of before.
-      auto kernel = [&](const glm::vec3& x) {
-        const glm::vec3 u = es.centroid - x;
-        const float d2 = glm::dot(u, u);
-        return std::max(0.0f, glm::dot(nr, u)) * std::max(0.0f, -glm::dot(ns, u)) / (d2 * d2);
-      };
-      const float kc = kernel(er.centroid);
-      if (!(kc > 0.0f)) return centre;
-      float mean4 = 0.0f;
-      for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j) mean4 += kernel(cell(glm::vec2(0.25f + 0.5f * static_cast<float>(i), 0.25f + 0.5f * static_cast<float>(j))));
-      return centre * std::clamp(0.25f * mean4 / kc, 0.5f, 2.0f);
+    // A receiver that straddles the source's plane has a kink there (0 behind it), which no
+    // Gauss rule integrates well: its front part alone (a convex polygon of up to 5 corners) is
+    // integrated, triangle by triangle of a fan, over the whole receiver's area.
+    const float scale = std::max(1e-6f, element_radius(h, re));
+    std::array<float, 4> side{};
+    bool behind = false;
+    for (int k = 0; k < er.corner_count(); ++k) {
+      side[static_cast<std::size_t>(k)] = glm::dot(ns, receiver[static_cast<std::size_t>(k)] - es.centroid);
+      behind |= side[static_cast<std::size_t>(k)] < -1e-5f * scale;
     }
-    float sum = 0.0f;
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j)
-        sum += at(cell(glm::vec2((static_cast<float>(i) + 0.5f) / static_cast<float>(n),
-                                 (static_cast<float>(j) + 0.5f) / static_cast<float>(n))));
-    return sum / static_cast<float>(n * n);
+    if (!behind) return polygon_gauss_mean(receiver.data(), er.corner_count(), n, at);
+    std::array<glm::vec3, 5> front{};
+    int count = 0;
+    for (int k = 0; k < er.corner_count(); ++k) {
+      const int next = (k + 1) % er.corner_count();
+      const float a = side[static_cast<std::size_t>(k)], b = side[static_cast<std::size_t>(next)];
+      const glm::vec3 &p = receiver[static_cast<std::size_t>(k)], &q = receiver[static_cast<std::size_t>(next)];
+      if (a >= 0.0f) front[static_cast<std::size_t>(count++)] = p;
+      if ((a >= 0.0f) != (b >= 0.0f)) front[static_cast<std::size_t>(count++)] = p + (a / (a - b)) * (q - p);
+    }
+    if (count < 3 || !(er.area > 0.0f)) return 0.0f;
+    double sum = 0.0;
+    for (int k = 1; k + 1 < count; ++k) {
+      const std::array<glm::vec3, 3> t{front[0], front[static_cast<std::size_t>(k)], front[static_cast<std::size_t>(k + 1)]};
+      const float area = 0.5f * glm::length(glm::cross(t[1] - t[0], t[2] - t[0]));
+      sum += static_cast<double>(area) * polygon_gauss_mean(t.data(), 3, n, at);
+    }
+    return static_cast<float>(sum / er.area);
   }
 
   // ---- Refinement ---------------------------------------------------------------------------
@@ -1198,15 +1204,16 @@ struct LinkHierarchy::Impl {
     float coefficient = 0.0f;
     if (!is_cluster(r) && !is_cluster(s)) {
       // Receiver points by how close the pair is for its size (the closed form's variation
-      // over the receiver), one where the link carries little. A receiver much larger than its
+      // over the receiver), the fewest where the link carries little. A receiver much larger than its
       // source takes the source's points and reciprocity (A_r F_rs = A_s F_sr): its own points
       // miss where a small source beside it shows (a wall's 64 points gave it 1/17 of its
       // factor to a sliver of ground at its foot, and the view factors, the mean of both
       // directions, half the sliver's factor to the wall; session 40). Between elements of
       // about one size each direction keeps its own points: the two directions' quadratures
       // then differ, and the view factors' mean of them is closer to the exact factors (the
-      // 1 x 2 x 3 box's factors over 0.01 within 0.51 %, 1.1 % with the smaller's points).
-      const int n = error.bound < kSeparationFloor * rc.threshold ? 1 : receiver_grid(d, rr + rs);
+      // 1 x 2 x 3 box's factors over 0.01 within 0.51 %, 1.1 % with the smaller's points, at
+      // the midpoint grids of session 40).
+      const int n = error.bound < kSeparationFloor * rc.threshold ? 2 : receiver_grid(d, rr + rs);
       const float ar = area(h, r), as = area(h, s);
       coefficient = ar > kReciprocalAreaRatio * as ? element_factor(h, s, r, n) * (as / ar) : element_factor(h, r, s, n);
     } else {
