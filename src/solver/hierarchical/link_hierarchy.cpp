@@ -30,6 +30,7 @@
 #include "core/rng.hpp"
 #include "core/streams.hpp"
 #include "form_factors/estimators.hpp"
+#include "form_factors/sampling.hpp"
 #include "solver/exposure.hpp"
 
 namespace radiosity::detail {
@@ -131,16 +132,32 @@ constexpr float kHiddenClusterFloor = 0.03f;
 /// 1.27 %, 13.5 M; 0.03: 1.24 %, 18.9 M. The 246k city's links at 0.3: 20.8 -> 22.5-24.1 s; at
 /// 0.1: 31.5 s and 98 MiB more (the Cornell box's floor +0.50 -> +0.36 % there).
 constexpr float kBuriedClusterFloor = 0.3f;
-/// Gauss-Legendre points per side (n x n) of the receiver for the closed form of an element pair
-/// whose radii add up to R at distance d: 2 beyond 3 R (and where the link carries little), 3
-/// beyond R, 4 closer (touching: the factor varies fastest near a shared edge, logarithmically;
-/// two unit squares sharing an edge at 4 x 4 within 1e-5 of Howell's C-14). Session 42 (from
-/// 1 / 2 / 4 / 8 cell midpoints beyond 6 R / 3 R / R / closer, the single point corrected for
-/// curvature): the 1 x 2 x 3 box's element view factors over 0.01 within 0.22 % of the exact
-/// mode's (0.51 % before), summed per face within 0.021 % at epsilon 0.01 (0.053 %); the cities
-/// and the solve's time the same (docs/HIERARCHICAL.md, "One bounce through the links at the
-/// walls' feet").
-int receiver_grid(float d, float R) { return d >= 3.0f * R ? 2 : d > R ? 3 : 4; }
+/// How an element pair's closed form is averaged over the receiver: at n x n Gauss-Legendre
+/// points, or (`adaptive`) by the 2 x 2 Gauss rule refined by quarters where two levels differ
+/// by more than kTouchingTolerance, down to kTouchingDepth (adaptive_gauss_mean()).
+struct ReceiverRule {
+  int n;
+  bool adaptive;
+};
+constexpr double kTouchingTolerance = 1e-4;
+constexpr int kTouchingDepth = 3;
+/// The rule for an element pair whose radii add up to R at distance d: Gauss-Legendre 2 x 2
+/// beyond 3 R (and where the link carries little), 3 x 3 beyond R; touching or nearly,
+/// adaptive. Gauss-Legendre for pairs apart (session 42; from 1 / 2 / 4 cell midpoints beyond
+/// 6 R / 3 R / R, the single point corrected for curvature): next to the source's plane the
+/// factor vanishes and is concave over the receiver, which midpoints overestimate (the 1 x 2 x 3
+/// box's element view factors over 0.01 within 0.22 % of the exact mode's with 4 x 4 points for
+/// touching pairs, 0.51 % before; docs/HIERARCHICAL.md, "One bounce through the links at the
+/// walls' feet"). Adaptive for pairs that touch (session 43): the factor has a logarithmic edge
+/// there and, along a sliver of floor at a block's foot, a step where two of the block's facets
+/// meet, which a fixed rule puts in the wrong place: the closed Cornell box's link view factors
+/// (bench_view_factors --cornell 23) worst 0.069 against the exact mode's at 4 x 4 Gauss points,
+/// 0.046 at 8 x 8, 0.036 at the midpoints of 8 x 8 cells (before session 42).
+ReceiverRule receiver_rule(float d, float R) {
+  if (d >= 3.0f * R) return {2, false};
+  if (d > R) return {3, false};
+  return {0, true};
+}
 /// An element pair's closed form is integrated over the source instead of the receiver when the
 /// receiver is more than this many times larger (process(), at the link).
 constexpr float kReciprocalAreaRatio = 4.0f;
@@ -933,14 +950,15 @@ struct LinkHierarchy::Impl {
 
   /// Element-to-element factor: the point-to-polygon closed form (Lambert's contour integral,
   /// point_to_polygon_factor_fast()) from receiver points to the source element, 0 at points
-  /// behind the source's side, averaged over the n x n Gauss-Legendre points of the receiver
-  /// (polygon_gauss_mean(), core/quadrature.hpp). Until session 42 the points were the
+  /// behind the source's side, averaged over the receiver by `rule` (receiver_rule(): n x n
+  /// Gauss-Legendre points, polygon_gauss_mean() in core/quadrature.hpp, or adaptive for pairs
+  /// that touch). Until session 42 the points were always the
   /// midpoints of n x n cells (twice as many per side), and one point with a curvature
   /// correction where the link carried little or the pair was far apart; next to the source's
   /// plane, where the factor vanishes and is concave over the receiver, both overestimated
   /// (a ground square at a wall's foot, from the wall's second row of squares: 4 x 4 midpoints
   /// +1.24 %, the corrected centroid +6.7 %; Gauss-Legendre 3 x 3 within 0.01 %).
-  static float element_factor(const PatchHierarchy& h, NodeHandle r, NodeHandle s, int n) {
+  static float element_factor(const PatchHierarchy& h, NodeHandle r, NodeHandle s, ReceiverRule rule) {
     const std::uint32_t re = element_of(r);
     const Element& es = h.element(element_of(s));
     const glm::vec3 ns = side_normal(h, s), nr = side_normal(h, r);
@@ -953,6 +971,15 @@ struct LinkHierarchy::Impl {
     const Element& er = h.element(re);
     std::array<glm::vec3, 4> receiver{};
     for (int k = 0; k < er.corner_count(); ++k) receiver[static_cast<std::size_t>(k)] = h.vertices()[er.corners[k]];
+    if (rule.adaptive) {
+      const CellMap map(receiver.data(), er.corner_count());
+      auto g = [&](glm::vec2 st) -> double { return map.density(st) * at(map.point(st)); };
+      const double coarse = 0.25 * (g(glm::vec2(kGaussLo, kGaussLo)) + g(glm::vec2(kGaussHi, kGaussLo)) +
+                                    g(glm::vec2(kGaussLo, kGaussHi)) + g(glm::vec2(kGaussHi, kGaussHi)));
+      return static_cast<float>(
+          adaptive_gauss_mean(g, glm::vec2(0.0f), 1.0f, coarse, 0, kTouchingDepth, kTouchingTolerance));
+    }
+    const int n = rule.n;
     // A receiver that straddles the source's plane has a kink there (0 behind it), which no
     // Gauss rule integrates well: its front part alone (a convex polygon of up to 5 corners) is
     // integrated, triangle by triangle of a fan, over the whole receiver's area.
@@ -1213,9 +1240,11 @@ struct LinkHierarchy::Impl {
       // then differ, and the view factors' mean of them is closer to the exact factors (the
       // 1 x 2 x 3 box's factors over 0.01 within 0.51 %, 1.1 % with the smaller's points, at
       // the midpoint grids of session 40).
-      const int n = error.bound < kSeparationFloor * rc.threshold ? 2 : receiver_grid(d, rr + rs);
+      const ReceiverRule rule =
+          error.bound < kSeparationFloor * rc.threshold ? ReceiverRule{2, false} : receiver_rule(d, rr + rs);
       const float ar = area(h, r), as = area(h, s);
-      coefficient = ar > kReciprocalAreaRatio * as ? element_factor(h, s, r, n) * (as / ar) : element_factor(h, r, s, n);
+      coefficient =
+          ar > kReciprocalAreaRatio * as ? element_factor(h, s, r, rule) * (as / ar) : element_factor(h, r, s, rule);
     } else {
       coefficient = d > 0.0f ? 1.0f / (d * d) : 0.0f;
       // Corrected by the link's geometry integrated further down (refined_transport()); the
