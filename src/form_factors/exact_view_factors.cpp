@@ -40,6 +40,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 
 #include <glm/geometric.hpp>
 #include <glm/vector_relational.hpp>
@@ -116,6 +117,14 @@ struct Cluster {
   std::uint32_t first = 0, count = 0;
 };
 
+/// A convex solid bounded by occluders (a block: its faces, closed, or open where it stands on
+/// a floor, along boundary edges that all lie in one plane): the points behind all its planes.
+struct Solid {
+  std::vector<glm::dvec3> normals;  ///< outward unit normals
+  std::vector<double> offsets;      ///< inside where dot(normal, x) < offset
+};
+constexpr std::uint32_t kNoSolid = 0xffffffffu;
+
 /// A convex polygon in the receiver's plane (corners relative to the source point): its first
 /// corner and corner count in a workspace's corners.
 using Piece = std::pair<std::uint32_t, std::uint32_t>;
@@ -180,13 +189,17 @@ struct ExactPolygonTransport::Impl {
   std::vector<std::uint32_t> facets;  ///< the occluders' polygons
   std::vector<std::uint32_t> owner;   ///< per polygon: the occluder it is part of, or kNoOccluder
   std::vector<Cluster> clusters;
+  std::vector<Solid> solids;
+  std::vector<std::uint32_t> solid_of;  ///< per occluder: the solid it bounds, or kNoSolid
 
   void merge_occluders(std::vector<std::uint32_t> hiding);
+  void find_solids();
 
   void add_cluster(std::uint32_t begin, std::uint32_t end);
   void candidates(std::uint32_t s, std::uint32_t r, std::vector<std::uint32_t>& out) const;
   double unobstructed(const Face& S, const Face& R, Workspace& w) const;
   bool hidden_by_one(const Face& S, const Face& R, const std::vector<std::uint32_t>& candidates) const;
+  bool hidden_by_solid(const Face& S, const Face& R, const std::vector<std::uint32_t>& candidates) const;
   double visible_factor(const glm::vec3& point, const Face& S, const Face& R, Workspace& w) const;
   template <typename PointFactor, typename Forced>
   double integrate(const Face& S, const PointFactor& g, int max_depth, const Forced& forced) const;
@@ -300,6 +313,50 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
     facets.insert(facets.end(), members, members + count);
     occluders.push_back(std::move(o));
   };
+  // Reorders hiding[begin, end) into the parts that shared corners connect, in the order of
+  // each part's first facet (the facets within a part keep their order), and writes each
+  // part's end into `ends`; returns the number of parts.
+  std::vector<std::size_t> part_ends;
+  std::vector<std::uint32_t> part_parent, part_order;
+  std::vector<std::pair<std::array<std::int64_t, 3>, std::uint32_t>> part_corners;
+  auto connected_parts = [&](std::size_t begin, std::size_t end, std::vector<std::size_t>& ends) {
+    const std::size_t n = end - begin;
+    ends.clear();
+    if (n == 1) {
+      ends.push_back(end);
+      return std::size_t{1};
+    }
+    const double grid = 64.0 * static_cast<double>(epsilon);
+    part_corners.clear();
+    for (std::size_t k = 0; k < n; ++k)
+      for (const glm::vec3& v : faces[hiding[begin + k]].corners)
+        part_corners.push_back({{static_cast<std::int64_t>(std::floor(v.x / grid)), static_cast<std::int64_t>(std::floor(v.y / grid)),
+                                 static_cast<std::int64_t>(std::floor(v.z / grid))},
+                                static_cast<std::uint32_t>(k)});
+    std::sort(part_corners.begin(), part_corners.end());
+    part_parent.resize(n);
+    std::iota(part_parent.begin(), part_parent.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+      while (part_parent[x] != x) x = part_parent[x] = part_parent[part_parent[x]];
+      return x;
+    };
+    for (std::size_t i = 1; i < part_corners.size(); ++i)
+      if (part_corners[i].first == part_corners[i - 1].first) {
+        const std::uint32_t x = find(part_corners[i].second), y = find(part_corners[i - 1].second);
+        part_parent[std::max(x, y)] = std::min(x, y);  // the root is the part's first facet
+      }
+    part_order.resize(n);
+    std::iota(part_order.begin(), part_order.end(), 0u);
+    std::stable_sort(part_order.begin(), part_order.end(),
+                     [&](std::uint32_t x, std::uint32_t y) { return find(x) < find(y); });
+    std::vector<std::uint32_t> reordered(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      reordered[k] = hiding[begin + part_order[k]];
+      if (k + 1 == n || find(part_order[k + 1]) != find(part_order[k])) ends.push_back(begin + k + 1);
+    }
+    std::copy(reordered.begin(), reordered.end(), hiding.begin() + static_cast<std::ptrdiff_t>(begin));
+    return ends.size();
+  };
   std::vector<std::pair<glm::vec2, std::uint32_t>> points;
   std::vector<std::size_t> hull;
   std::size_t begin = 0;
@@ -311,58 +368,69 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
       if (next.key != plane.key || std::fabs(next.offset - plane.offset) > epsilon) break;
       ++end;
     }
-    bool merged = false;
-    if (end - begin > 1) {
-      // Andrew's monotone chain over the group's corners in the plane's 2-D frame.
-      const glm::vec3 n = plane.normal;
-      const glm::vec3 t = glm::normalize(std::fabs(n.x) < 0.9f ? glm::cross(n, glm::vec3(1, 0, 0))
-                                                              : glm::cross(n, glm::vec3(0, 1, 0)));
-      const glm::vec3 b = glm::cross(n, t);
-      points.clear();
-      double total = 0.0;
-      std::vector<glm::vec3> all;
-      for (std::size_t k = begin; k < end; ++k) {
-        total += faces[hiding[k]].area;
-        for (const glm::vec3& v : faces[hiding[k]].corners) {
-          points.emplace_back(glm::vec2(glm::dot(v, t), glm::dot(v, b)), static_cast<std::uint32_t>(all.size()));
-          all.push_back(v);
+    // The group's facets in connected parts (facets that share a corner, compared on a grid
+    // of 64 epsilon), each merged on its own: the walls of a row of buildings lie in one plane,
+    // and the union of all of them, not convex, kept every facet of every wall an occluder of
+    // its own (the exported city block, benchmarks/exported_block.py: 2 400 occluders for its
+    // 16 buildings, 80 since session 43).
+    const std::size_t parts = connected_parts(begin, end, part_ends);
+    std::size_t cb = begin;
+    for (std::size_t part = 0; part < parts; ++part) {
+      const std::size_t ce = part_ends[part];
+      bool merged = false;
+      if (ce - cb > 1) {
+        // Andrew's monotone chain over the group's corners in the plane's 2-D frame.
+        const glm::vec3 n = plane.normal;
+        const glm::vec3 t = glm::normalize(std::fabs(n.x) < 0.9f ? glm::cross(n, glm::vec3(1, 0, 0))
+                                                                : glm::cross(n, glm::vec3(0, 1, 0)));
+        const glm::vec3 b = glm::cross(n, t);
+        points.clear();
+        double total = 0.0;
+        std::vector<glm::vec3> all;
+        for (std::size_t k = cb; k < ce; ++k) {
+          total += faces[hiding[k]].area;
+          for (const glm::vec3& v : faces[hiding[k]].corners) {
+            points.emplace_back(glm::vec2(glm::dot(v, t), glm::dot(v, b)), static_cast<std::uint32_t>(all.size()));
+            all.push_back(v);
+          }
+        }
+        std::sort(points.begin(), points.end(), [](const auto& x, const auto& y) {
+          return x.first.x < y.first.x || (x.first.x == y.first.x && (x.first.y < y.first.y ||
+                                                                      (x.first.y == y.first.y && x.second < y.second)));
+        });
+        auto turn = [&](std::size_t o, std::size_t a, std::size_t c) {
+          const glm::vec2 u = points[a].first - points[o].first, v = points[c].first - points[o].first;
+          return static_cast<double>(u.x) * v.y - static_cast<double>(u.y) * v.x;
+        };
+        hull.clear();
+        for (int pass = 0; pass < 2; ++pass) {
+          const std::size_t floor = hull.size();
+          for (std::size_t k = 0; k < points.size(); ++k) {
+            const std::size_t i = pass == 0 ? k : points.size() - 1 - k;
+            while (hull.size() >= floor + 2 && turn(hull[hull.size() - 2], hull.back(), i) <= 0.0) hull.pop_back();
+            hull.push_back(i);
+          }
+          hull.pop_back();
+        }
+        double area = 0.0;
+        for (std::size_t k = 0; k < hull.size(); ++k) {
+          const glm::vec2 p = points[hull[k]].first, q = points[hull[(k + 1) % hull.size()]].first;
+          area += 0.5 * (static_cast<double>(p.x) * q.y - static_cast<double>(q.x) * p.y);
+        }
+        if (hull.size() >= 3 && std::fabs(area - total) <= 1e-5 * total) {
+          std::vector<glm::vec3> corners;
+          for (const std::size_t k : hull) corners.push_back(all[points[k].second]);
+          add(corners, glm::cross(t, b), hiding.data() + cb, ce - cb);
+          merged = true;
         }
       }
-      std::sort(points.begin(), points.end(), [](const auto& x, const auto& y) {
-        return x.first.x < y.first.x || (x.first.x == y.first.x && (x.first.y < y.first.y ||
-                                                                    (x.first.y == y.first.y && x.second < y.second)));
-      });
-      auto turn = [&](std::size_t o, std::size_t a, std::size_t c) {
-        const glm::vec2 u = points[a].first - points[o].first, v = points[c].first - points[o].first;
-        return static_cast<double>(u.x) * v.y - static_cast<double>(u.y) * v.x;
-      };
-      hull.clear();
-      for (int pass = 0; pass < 2; ++pass) {
-        const std::size_t floor = hull.size();
-        for (std::size_t k = 0; k < points.size(); ++k) {
-          const std::size_t i = pass == 0 ? k : points.size() - 1 - k;
-          while (hull.size() >= floor + 2 && turn(hull[hull.size() - 2], hull.back(), i) <= 0.0) hull.pop_back();
-          hull.push_back(i);
+      if (!merged)
+        for (std::size_t k = cb; k < ce; ++k) {
+          const Face& f = faces[hiding[k]];
+          add(f.corners, f.normal, hiding.data() + k, 1);
         }
-        hull.pop_back();
-      }
-      double area = 0.0;
-      for (std::size_t k = 0; k < hull.size(); ++k) {
-        const glm::vec2 p = points[hull[k]].first, q = points[hull[(k + 1) % hull.size()]].first;
-        area += 0.5 * (static_cast<double>(p.x) * q.y - static_cast<double>(q.x) * p.y);
-      }
-      if (hull.size() >= 3 && std::fabs(area - total) <= 1e-5 * total) {
-        std::vector<glm::vec3> corners;
-        for (const std::size_t k : hull) corners.push_back(all[points[k].second]);
-        add(corners, glm::cross(t, b), hiding.data() + begin, end - begin);
-        merged = true;
-      }
+      cb = ce;
     }
-    if (!merged)
-      for (std::size_t k = begin; k < end; ++k) {
-        const Face& f = faces[hiding[k]];
-        add(f.corners, f.normal, hiding.data() + k, 1);
-      }
     begin = end;
   }
   add_cluster(0, static_cast<std::uint32_t>(occluders.size()));
@@ -450,6 +518,196 @@ bool ExactPolygonTransport::Impl::hidden_by_one(const Face& S, const Face& R,
           const glm::vec3 edge = O.corners[(e + 1) % n] - u;
           hidden = glm::dot(glm::cross(edge, z - u), O.normal) > epsilon * glm::length(edge);
         }
+      }
+    if (hidden) return true;
+  }
+  return false;
+}
+
+// The occluders that bound convex solids (solids, solid_of). Occluders that share edges (both
+// ends within a few epsilon: corners are compared on a grid of 64 epsilon, so a pair that
+// straddles a grid line merely leaves its solid unfound) are joined; a joined set is a solid
+// when every edge is shared by two of its occluders, or the edges shared by none all lie in
+// one plane (a block standing on a floor, without a bottom), and every corner of the set lies
+// behind-or-on each occluder's plane and that plane (all of them supporting planes of the
+// corners' convex hull, the set's centroid strictly behind each). Then the occluders with the
+// open region cover the hull's boundary, and a segment between two points outside the hull
+// that passes through its interior crosses the boundary twice, in two planes, so at most once
+// in the open one: it meets an occluder.
+void ExactPolygonTransport::Impl::find_solids() {
+  solid_of.assign(occluders.size(), kNoSolid);
+  const double grid = 64.0 * static_cast<double>(epsilon);
+  using Key = std::array<std::int64_t, 3>;
+  auto key = [&](const glm::vec3& v) {
+    return Key{static_cast<std::int64_t>(std::floor(v.x / grid)), static_cast<std::int64_t>(std::floor(v.y / grid)),
+               static_cast<std::int64_t>(std::floor(v.z / grid))};
+  };
+  // Every occluder edge by its two ends' keys (the smaller first), sorted to find equal edges.
+  struct Edge {
+    Key a, b;
+    std::uint32_t occluder;
+    glm::vec3 p, q;  ///< its ends
+  };
+  std::vector<Edge> edges;
+  std::vector<glm::vec3> c;
+  for (std::size_t k = 0; k < occluders.size(); ++k) {
+    // The corners without those within epsilon of the line through their neighbours: a merged
+    // face's hull keeps the facets' corners along its sides where rounding turns them outward
+    // (a turned block's top, 10 corners), while the side beside it has one edge there.
+    c = occluders[k].corners;
+    for (bool dropped = true; dropped && c.size() > 3;) {
+      dropped = false;
+      for (std::size_t i = 0; i < c.size() && c.size() > 3; ++i) {
+        const glm::vec3& a = c[(i + c.size() - 1) % c.size()];
+        const glm::vec3 ab = c[(i + 1) % c.size()] - a;
+        if (distance_to_segment(c[i], a, ab, glm::dot(ab, ab)) <= epsilon) {
+          c.erase(c.begin() + static_cast<std::ptrdiff_t>(i));
+          dropped = true;
+        }
+      }
+    }
+    for (std::size_t e = 0; e < c.size(); ++e) {
+      Key a = key(c[e]), b = key(c[(e + 1) % c.size()]);
+      if (a == b) continue;
+      if (b < a) std::swap(a, b);
+      edges.push_back({a, b, static_cast<std::uint32_t>(k), c[e], c[(e + 1) % c.size()]});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return std::tie(x.a, x.b, x.occluder) < std::tie(y.a, y.b, y.occluder);
+  });
+  std::vector<std::uint32_t> parent(occluders.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  // Per edge: how many occluders share it (2 joins them; 3 or more spoils the set).
+  std::vector<std::uint8_t> spoilt(occluders.size(), 0);
+  std::vector<const Edge*> open;  // the edges no other occluder shares
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
+    if (j - i == 1) open.push_back(&edges[i]);
+    else if (j - i == 2) parent[find(edges[i].occluder)] = find(edges[i + 1].occluder);
+    else
+      for (std::size_t k = i; k < j; ++k) spoilt[edges[k].occluder] = 1;
+    i = j;
+  }
+  std::vector<std::vector<std::uint32_t>> members(occluders.size());
+  for (std::uint32_t k = 0; k < occluders.size(); ++k) members[find(k)].push_back(k);
+  std::vector<std::vector<const Edge*>> open_of(occluders.size());
+  for (const Edge* e : open) open_of[find(e->occluder)].push_back(e);
+  const double eps = epsilon;
+  for (std::uint32_t root = 0; root < occluders.size(); ++root) {
+    const std::vector<std::uint32_t>& set = members[root];
+    if (set.size() < 3) continue;
+    bool ok = true;
+    glm::dvec3 centre(0.0);
+    std::size_t count = 0;
+    for (const std::uint32_t k : set) {
+      ok = ok && !spoilt[k];
+      for (const glm::vec3& v : occluders[k].corners) centre += glm::dvec3(v), ++count;
+    }
+    if (!ok) continue;
+    centre /= static_cast<double>(count);
+    Solid solid;
+    auto add_plane = [&](glm::dvec3 n, double offset) {
+      const double side = glm::dot(n, centre) - offset;
+      if (!(std::fabs(side) > eps)) return false;  // the centre on the plane: flat, no inside
+      if (side > 0.0) n = -n, offset = -offset;
+      for (const std::uint32_t k : set)
+        for (const glm::vec3& v : occluders[k].corners)
+          if (glm::dot(n, glm::dvec3(v)) - offset > eps) return false;  // a corner in front: not convex
+      solid.normals.push_back(n);
+      solid.offsets.push_back(offset);
+      return true;
+    };
+    for (const std::uint32_t k : set) {
+      const glm::dvec3 n = glm::normalize(glm::dvec3(occluders[k].normal));
+      ok = ok && add_plane(n, glm::dot(n, glm::dvec3(occluders[k].corners[0])));
+    }
+    const auto& boundary = open_of[root];
+    if (ok && !boundary.empty()) {
+      // The open edges' plane: through the first end, spanned by the farthest end and the end
+      // farthest from that line; every open edge's ends on it.
+      std::vector<glm::dvec3> ends;
+      for (const Edge* e : boundary) {
+        ends.emplace_back(e->p);
+        ends.emplace_back(e->q);
+      }
+      const glm::dvec3 p0 = ends[0];
+      glm::dvec3 p1 = p0;
+      for (const glm::dvec3& p : ends)
+        if (glm::length(p - p0) > glm::length(p1 - p0)) p1 = p;
+      glm::dvec3 n(0.0);
+      for (const glm::dvec3& p : ends) {
+        const glm::dvec3 span = glm::cross(p1 - p0, p - p0);
+        if (glm::length(span) > glm::length(n)) n = span;
+      }
+      ok = glm::length(n) > eps * glm::length(p1 - p0);
+      if (ok) {
+        n = glm::normalize(n);
+        const double offset = glm::dot(n, p0);
+        for (const glm::dvec3& p : ends) ok = ok && std::fabs(glm::dot(n, p) - offset) <= eps;
+        ok = ok && add_plane(n, offset);
+      }
+    }
+    if (!ok) continue;
+    for (const std::uint32_t k : set) solid_of[k] = static_cast<std::uint32_t>(solids.size());
+    solids.push_back(std::move(solid));
+  }
+}
+
+// Whether a convex solid that one of the candidates bounds hides all of R from all of S: S and
+// R each lie outside it (all corners on the outer side of one of its planes, not all in it), and every
+// segment between a corner of S and a corner of R passes through its interior (shrunk by
+// epsilon). As in hidden_by_one(), the corners are enough: for a point y, the points x whose
+// segment to y meets a convex set form a convex set. Such a segment meets one of the solid's
+// occluders (find_solids()). What a block hides as a whole but none of its faces alone: 13 %
+// (the closed Cornell box) to 33 % (the room around a block) of the pairs with candidates
+// integrated to exactly 0 point by point before (session 43).
+bool ExactPolygonTransport::Impl::hidden_by_solid(const Face& S, const Face& R,
+                                                  const std::vector<std::uint32_t>& candidates) const {
+  std::array<std::uint32_t, 8> tried{};
+  std::size_t tried_count = 0;
+  for (const std::uint32_t k : candidates) {
+    const std::uint32_t id = solid_of[k];
+    if (id == kNoSolid || std::find(tried.begin(), tried.begin() + tried_count, id) != tried.begin() + tried_count)
+      continue;
+    if (tried_count < tried.size()) tried[tried_count++] = id;
+    const Solid& solid = solids[id];
+    const std::size_t planes = solid.normals.size();
+    // Beyond one of its planes, and not in it: then all of the polygon but a sliver epsilon
+    // thin lies strictly outside. A polygon in one of the solid's planes may be inside it (the
+    // walls of a room within a building, wound inward, see each other across it).
+    auto outside = [&](const Face& F) {
+      for (std::size_t p = 0; p < planes; ++p) {
+        bool all = true, beyond = false;
+        for (const glm::vec3& v : F.corners) {
+          const double d = glm::dot(solid.normals[p], glm::dvec3(v)) - solid.offsets[p];
+          all = all && d >= -epsilon;
+          beyond = beyond || d > epsilon;
+        }
+        if (all && beyond) return true;
+      }
+      return false;
+    };
+    if (!outside(S) || !outside(R)) continue;
+    bool hidden = true;
+    for (std::size_t a = 0; a < S.corners.size() && hidden; ++a)
+      for (std::size_t b = 0; b < R.corners.size() && hidden; ++b) {
+        // Cyrus-Beck: the part of the segment inside every plane moved in by epsilon.
+        const glm::dvec3 p(S.corners[a]), q(R.corners[b]);
+        double t0 = 0.0, t1 = 1.0;
+        for (std::size_t i = 0; i < planes && t0 < t1; ++i) {
+          const double dp = glm::dot(solid.normals[i], p) - solid.offsets[i] + epsilon,
+                       dq = glm::dot(solid.normals[i], q) - solid.offsets[i] + epsilon;
+          if (dp >= 0.0 && dq >= 0.0) t1 = -1.0;
+          else if (dp >= 0.0) t0 = std::max(t0, dp / (dp - dq));
+          else if (dq >= 0.0) t1 = std::min(t1, dp / (dp - dq));
+        }
+        hidden = t0 < t1;
       }
     if (hidden) return true;
   }
@@ -651,6 +909,7 @@ ExactPolygonTransport::ExactPolygonTransport(const Scene& scene) : impl_(std::ma
     if (front && back) hiding.push_back(static_cast<std::uint32_t>(i));
   }
   if (!hiding.empty()) m.merge_occluders(std::move(hiding));
+  m.find_solids();
 }
 
 ExactPolygonTransport::~ExactPolygonTransport() = default;
@@ -660,6 +919,8 @@ std::unique_ptr<ExactPolygonTransport::Workspace> ExactPolygonTransport::workspa
 }
 
 std::size_t ExactPolygonTransport::occluder_count() const { return impl_->occluders.size(); }
+
+std::size_t ExactPolygonTransport::solid_count() const { return impl_->solids.size(); }
 
 double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Workspace& w) const {
   const Impl& m = *impl_;
@@ -678,7 +939,7 @@ double ExactPolygonTransport::transport(std::uint32_t i, std::uint32_t j, Worksp
   if (!s_in_front) return 0.0;
   if (!m.clusters.empty()) m.candidates(s, r, w.candidates);
   if (m.clusters.empty() || w.candidates.empty()) return m.unobstructed(S, R, w);
-  if (m.hidden_by_one(S, R, w.candidates)) return 0.0;
+  if (m.hidden_by_one(S, R, w.candidates) || m.hidden_by_solid(S, R, w.candidates)) return 0.0;
   auto g = [&](const glm::vec3& x) { return m.visible_factor(x, S, R, w); };
   // A source edge in the plane of an occluder (a floor facet along a block's face): the shadow
   // may be a wedge along that edge thinner than the first levels' Gauss points can see.

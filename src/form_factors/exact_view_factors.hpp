@@ -45,6 +45,10 @@ class ExactPolygonTransport {
   /// The occluders, coplanar facets whose union is convex counted once (a block's face cut
   /// into facets is one).
   std::size_t occluder_count() const;
+  /// The convex solids that occluders bound (a block, closed or standing open on a floor),
+  /// each of which hides a pair as a whole (without integrating it) when it stands across
+  /// every segment between them.
+  std::size_t solid_count() const;
 
  private:
   struct Impl;
