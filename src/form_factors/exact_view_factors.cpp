@@ -193,7 +193,7 @@ struct ExactPolygonTransport::Impl {
   std::vector<std::uint32_t> solid_of;  ///< per occluder: the solid it bounds, or kNoSolid
 
   void merge_occluders(std::vector<std::uint32_t> hiding);
-  void find_solids();
+  void find_solids(const Bounds& box);
 
   void add_cluster(std::uint32_t begin, std::uint32_t end);
   void candidates(std::uint32_t s, std::uint32_t r, std::vector<std::uint32_t>& out) const;
@@ -527,14 +527,15 @@ bool ExactPolygonTransport::Impl::hidden_by_one(const Face& S, const Face& R,
 // The occluders that bound convex solids (solids, solid_of). Occluders that share edges (both
 // ends within a few epsilon: corners are compared on a grid of 64 epsilon, so a pair that
 // straddles a grid line merely leaves its solid unfound) are joined; a joined set is a solid
-// when every edge is shared by two of its occluders, or the edges shared by none all lie in
-// one plane (a block standing on a floor, without a bottom), and every corner of the set lies
-// behind-or-on each occluder's plane and that plane (all of them supporting planes of the
-// corners' convex hull, the set's centroid strictly behind each). Then the occluders with the
-// open region cover the hull's boundary, and a segment between two points outside the hull
-// that passes through its interior crosses the boundary twice, in two planes, so at most once
-// in the open one: it meets an occluder.
-void ExactPolygonTransport::Impl::find_solids() {
+// when every edge is shared by two of its occluders, or the edges shared by none make loops
+// each in one plane (a block standing on a floor has no bottom), of which all planes but one
+// are sealed (nothing of the scene beyond them), and every corner of the set lies behind-or-on
+// each occluder's plane and those planes (all of them supporting planes of the corners' convex
+// hull, the set's centroid strictly behind each). Then the occluders with the openings cover
+// the hull's boundary, and a segment between two points outside the hull that passes through
+// its interior crosses the boundary twice, in two planes, neither of them a sealed one (an end
+// would lie beyond it), so at most once in an opening: it meets an occluder.
+void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
   solid_of.assign(occluders.size(), kNoSolid);
   const double grid = 64.0 * static_cast<double>(epsilon);
   using Key = std::array<std::int64_t, 3>;
@@ -627,15 +628,35 @@ void ExactPolygonTransport::Impl::find_solids() {
       const glm::dvec3 n = glm::normalize(glm::dvec3(occluders[k].normal));
       ok = ok && add_plane(n, glm::dot(n, glm::dvec3(occluders[k].corners[0])));
     }
-    const auto& boundary = open_of[root];
-    if (ok && !boundary.empty()) {
-      // The open edges' plane: through the first end, spanned by the farthest end and the end
-      // farthest from that line; every open edge's ends on it.
+    // The open edges in loops (joined by their ends), each loop in one plane. Of those planes
+    // all but one must be sealed, with no corner of the scene (by its box) strictly beyond:
+    // no segment between two of the scene's points can cross such an opening (the ground
+    // under a building; the roof plane of the tallest one, whose roof hides nothing above and
+    // is no occluder).
+    const std::vector<const Edge*>& boundary = open_of[root];
+    std::vector<std::uint32_t> loop(boundary.size());
+    std::iota(loop.begin(), loop.end(), 0u);
+    auto loop_of = [&](std::uint32_t x) {
+      while (loop[x] != x) x = loop[x] = loop[loop[x]];
+      return x;
+    };
+    for (std::size_t i = 0; i < boundary.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (boundary[i]->a == boundary[j]->a || boundary[i]->a == boundary[j]->b || boundary[i]->b == boundary[j]->a ||
+            boundary[i]->b == boundary[j]->b)
+          loop[loop_of(static_cast<std::uint32_t>(i))] = loop_of(static_cast<std::uint32_t>(j));
+    int unsealed = 0;
+    std::vector<std::pair<glm::dvec3, double>> openings;  // outward normal, offset
+    for (std::uint32_t first = 0; ok && first < boundary.size(); ++first) {
+      if (loop_of(first) != first) continue;
+      // The loop's plane: through its first end, spanned by the farthest end and the end
+      // farthest from that line; every end on it.
       std::vector<glm::dvec3> ends;
-      for (const Edge* e : boundary) {
-        ends.emplace_back(e->p);
-        ends.emplace_back(e->q);
-      }
+      for (std::uint32_t i = 0; i < boundary.size(); ++i)
+        if (loop_of(i) == first) {
+          ends.emplace_back(boundary[i]->p);
+          ends.emplace_back(boundary[i]->q);
+        }
       const glm::dvec3 p0 = ends[0];
       glm::dvec3 p1 = p0;
       for (const glm::dvec3& p : ends)
@@ -646,13 +667,21 @@ void ExactPolygonTransport::Impl::find_solids() {
         if (glm::length(span) > glm::length(n)) n = span;
       }
       ok = glm::length(n) > eps * glm::length(p1 - p0);
-      if (ok) {
-        n = glm::normalize(n);
-        const double offset = glm::dot(n, p0);
-        for (const glm::dvec3& p : ends) ok = ok && std::fabs(glm::dot(n, p) - offset) <= eps;
-        ok = ok && add_plane(n, offset);
-      }
+      if (!ok) break;
+      n = glm::normalize(n);
+      double offset = glm::dot(n, p0);
+      for (const glm::dvec3& p : ends) ok = ok && std::fabs(glm::dot(n, p) - offset) <= eps;
+      if (glm::dot(n, centre) > offset) n = -n, offset = -offset;
+      bool seen = false;
+      for (const auto& o : openings) seen = seen || (glm::dot(o.first, n) > 1.0 - 1e-9 && std::fabs(o.second - offset) <= eps);
+      if (!ok || seen) continue;
+      openings.emplace_back(n, offset);
+      ok = add_plane(n, offset);
+      const glm::dvec3 far(n.x > 0.0 ? box.upper.x : box.lower.x, n.y > 0.0 ? box.upper.y : box.lower.y,
+                           n.z > 0.0 ? box.upper.z : box.lower.z);
+      unsealed += glm::dot(n, far) - offset > eps ? 1 : 0;
     }
+    ok = ok && unsealed <= 1;
     if (!ok) continue;
     for (const std::uint32_t k : set) solid_of[k] = static_cast<std::uint32_t>(solids.size());
     solids.push_back(std::move(solid));
@@ -909,7 +938,7 @@ ExactPolygonTransport::ExactPolygonTransport(const Scene& scene) : impl_(std::ma
     if (front && back) hiding.push_back(static_cast<std::uint32_t>(i));
   }
   if (!hiding.empty()) m.merge_occluders(std::move(hiding));
-  m.find_solids();
+  m.find_solids(box);
 }
 
 ExactPolygonTransport::~ExactPolygonTransport() = default;

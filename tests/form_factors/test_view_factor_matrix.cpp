@@ -747,6 +747,34 @@ TEST_SUITE("form_factors") {
     CHECK(through > 0.5 * clear);
     CHECK(through < clear);
 
+    // With nothing above the block its top hides nothing and is no occluder: its walls alone,
+    // open at the floor and at the top, are a solid, as neither opening can be crossed (the
+    // scene ends there); a tube hanging in the air, open at both ends toward the floor and the
+    // ceiling, is not: the floor sees the ceiling through it.
+    rad::Scene low_only;
+    const rad::MaterialId lm = low_only.add_material(rad::Material{});
+    for (std::size_t i = 0; i < 7; ++i) {
+      const rad::Polygon& q = scene.polygons()[i];
+      low_only.add_polygon(std::vector<glm::vec3>(q.vertices.begin(), q.vertices.end()), lm, "part");
+    }
+    const detail::ExactPolygonTransport walls(low_only);
+    CHECK(walls.occluder_count() == 5);  // the four walls and the square above the floor
+    CHECK(walls.solid_count() == 1);
+    auto w4 = walls.workspace();
+    CHECK(walls.transport(5, 6, *w4) == 0.0);
+    CHECK(w4->work == 1);
+    rad::Scene tube;
+    const rad::MaterialId tm = tube.add_material(rad::Material{});
+    rad::add_quad(tube, {0, 0, 0}, {0, 0, 3}, {3, 0, 0}, tm, "floor");    // 0, facing up
+    rad::add_quad(tube, {0, 3, 0}, {3, 0, 0}, {0, 0, 3}, tm, "ceiling");  // 1, facing down
+    rad::add_quad(tube, {1, 1, 1}, {0, 0, 1}, {0, 1, 0}, tm, "tube");
+    rad::add_quad(tube, {2, 1, 1}, {0, 1, 0}, {0, 0, 1}, tm, "tube");
+    rad::add_quad(tube, {1, 1, 1}, {0, 1, 0}, {1, 0, 0}, tm, "tube");
+    rad::add_quad(tube, {1, 1, 2}, {1, 0, 0}, {0, 1, 0}, tm, "tube");
+    const detail::ExactPolygonTransport tubed(tube);
+    CHECK(tubed.occluder_count() == 4);
+    CHECK(tubed.solid_count() == 0);
+
   }
 
   TEST_CASE("view_factor_matrix, hierarchical, per element: a sliver of ground at a wall's foot sees the wall as the "
