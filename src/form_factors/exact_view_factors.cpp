@@ -124,6 +124,10 @@ struct Solid {
   std::vector<double> offsets;      ///< inside where dot(normal, x) < offset
 };
 constexpr std::uint32_t kNoSolid = 0xffffffffu;
+/// The most occluders a solid may have: its convexity test takes every corner against every
+/// plane, and a finely tessellated dome of 100 000 triangles would take minutes. A block or a
+/// building has 5 or 6 (its faces' facets merge into one occluder per face).
+constexpr std::size_t kMaxSolidFaces = 256;
 
 /// A convex polygon in the receiver's plane (corners relative to the source point): its first
 /// corner and corner count in a workspace's corners.
@@ -602,7 +606,7 @@ void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
   const double eps = epsilon;
   for (std::uint32_t root = 0; root < occluders.size(); ++root) {
     const std::vector<std::uint32_t>& set = members[root];
-    if (set.size() < 3) continue;
+    if (set.size() < 3 || set.size() > kMaxSolidFaces) continue;
     bool ok = true;
     glm::dvec3 centre(0.0);
     std::size_t count = 0;
