@@ -152,7 +152,9 @@ constexpr int kTouchingDepth = 3;
 /// there and, along a sliver of floor at a block's foot, a step where two of the block's facets
 /// meet, which a fixed rule puts in the wrong place: the closed Cornell box's link view factors
 /// (bench_view_factors --cornell 23) worst 0.069 against the exact mode's at 4 x 4 Gauss points,
-/// 0.046 at 8 x 8, 0.036 at the midpoints of 8 x 8 cells (before session 42).
+/// 0.046 at 8 x 8, 0.036 at the midpoints of 8 x 8 cells (before session 42), 0.046 adaptive
+/// (where the rest is a row's excess from cluster links, not quadrature: docs/HIERARCHICAL.md,
+/// "Pairs that touch"); the 1 x 2 x 3 box's factors over 0.01 within 0.063 % adaptive.
 ReceiverRule receiver_rule(float d, float R) {
   if (d >= 3.0f * R) return {2, false};
   if (d > R) return {3, false};
