@@ -118,7 +118,7 @@ struct Cluster {
 };
 
 /// A convex solid bounded by occluders (a block: its faces, closed, or open where it stands on
-/// a floor, along boundary edges that all lie in one plane): the points behind all its planes.
+/// a floor or where nothing lies beyond; find_solids()): the points behind all its planes.
 struct Solid {
   std::vector<glm::dvec3> normals;  ///< outward unit normals
   std::vector<double> offsets;      ///< inside where dot(normal, x) < offset
@@ -128,6 +128,13 @@ constexpr std::uint32_t kNoSolid = 0xffffffffu;
 /// plane, and a finely tessellated dome of 100 000 triangles would take minutes. A block or a
 /// building has 5 or 6 (its faces' facets merge into one occluder per face).
 constexpr std::size_t kMaxSolidFaces = 256;
+
+/// The cell of `v` on a grid of side `grid`: corners that coincide but for rounding fall in one
+/// cell unless they straddle a grid line (what would join them then stays apart).
+std::array<std::int64_t, 3> grid_key(const glm::vec3& v, double grid) {
+  return {static_cast<std::int64_t>(std::floor(v.x / grid)), static_cast<std::int64_t>(std::floor(v.y / grid)),
+          static_cast<std::int64_t>(std::floor(v.z / grid))};
+}
 
 /// A convex polygon in the receiver's plane (corners relative to the source point): its first
 /// corner and corner count in a workspace's corners.
@@ -334,9 +341,7 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
     part_corners.clear();
     for (std::size_t k = 0; k < n; ++k)
       for (const glm::vec3& v : faces[hiding[begin + k]].corners)
-        part_corners.push_back({{static_cast<std::int64_t>(std::floor(v.x / grid)), static_cast<std::int64_t>(std::floor(v.y / grid)),
-                                 static_cast<std::int64_t>(std::floor(v.z / grid))},
-                                static_cast<std::uint32_t>(k)});
+        part_corners.emplace_back(grid_key(v, grid), static_cast<std::uint32_t>(k));
     std::sort(part_corners.begin(), part_corners.end());
     part_parent.resize(n);
     std::iota(part_parent.begin(), part_parent.end(), 0u);
@@ -376,7 +381,7 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
     // of 64 epsilon), each merged on its own: the walls of a row of buildings lie in one plane,
     // and the union of all of them, not convex, kept every facet of every wall an occluder of
     // its own (the exported city block, benchmarks/exported_block.py: 2 400 occluders for its
-    // 16 buildings, 80 since session 43).
+    // 16 buildings, 75 since session 43).
     const std::size_t parts = connected_parts(begin, end, part_ends);
     std::size_t cb = begin;
     for (std::size_t part = 0; part < parts; ++part) {
@@ -543,10 +548,7 @@ void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
   solid_of.assign(occluders.size(), kNoSolid);
   const double grid = 64.0 * static_cast<double>(epsilon);
   using Key = std::array<std::int64_t, 3>;
-  auto key = [&](const glm::vec3& v) {
-    return Key{static_cast<std::int64_t>(std::floor(v.x / grid)), static_cast<std::int64_t>(std::floor(v.y / grid)),
-               static_cast<std::int64_t>(std::floor(v.z / grid))};
-  };
+  auto key = [&](const glm::vec3& v) { return grid_key(v, grid); };
   // Every occluder edge by its two ends' keys (the smaller first), sorted to find equal edges.
   struct Edge {
     Key a, b;
@@ -677,7 +679,8 @@ void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
       for (const glm::dvec3& p : ends) ok = ok && std::fabs(glm::dot(n, p) - offset) <= eps;
       if (glm::dot(n, centre) > offset) n = -n, offset = -offset;
       bool seen = false;
-      for (const auto& o : openings) seen = seen || (glm::dot(o.first, n) > 1.0 - 1e-9 && std::fabs(o.second - offset) <= eps);
+      for (const auto& o : openings)
+        seen = seen || (glm::dot(o.first, n) > 1.0 - 1e-9 && std::fabs(o.second - offset) <= eps);
       if (!ok || seen) continue;
       openings.emplace_back(n, offset);
       ok = add_plane(n, offset);

@@ -1005,7 +1005,8 @@ struct LinkHierarchy::Impl {
     if (count < 3 || !(er.area > 0.0f)) return 0.0f;
     double sum = 0.0;
     for (int k = 1; k + 1 < count; ++k) {
-      const std::array<glm::vec3, 3> t{front[0], front[static_cast<std::size_t>(k)], front[static_cast<std::size_t>(k + 1)]};
+      const std::array<glm::vec3, 3> t{front[0], front[static_cast<std::size_t>(k)],
+                                       front[static_cast<std::size_t>(k + 1)]};
       const float area = 0.5f * glm::length(glm::cross(t[1] - t[0], t[2] - t[0]));
       sum += static_cast<double>(area) * polygon_gauss_mean(t.data(), 3, n, at);
     }
