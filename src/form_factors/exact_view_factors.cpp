@@ -45,6 +45,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vector_relational.hpp>
 
+#include "core/union_find.hpp"
 #include "form_factors/estimators.hpp"
 #include "form_factors/sampling.hpp"
 #include "form_factors/shaft.hpp"
@@ -343,17 +344,11 @@ void ExactPolygonTransport::Impl::merge_occluders(std::vector<std::uint32_t> hid
       for (const glm::vec3& v : faces[hiding[begin + k]].corners)
         part_corners.emplace_back(grid_key(v, grid), static_cast<std::uint32_t>(k));
     std::sort(part_corners.begin(), part_corners.end());
-    part_parent.resize(n);
-    std::iota(part_parent.begin(), part_parent.end(), 0u);
-    auto find = [&](std::uint32_t x) {
-      while (part_parent[x] != x) x = part_parent[x] = part_parent[part_parent[x]];
-      return x;
-    };
+    make_sets(part_parent, n);
     for (std::size_t i = 1; i < part_corners.size(); ++i)
-      if (part_corners[i].first == part_corners[i - 1].first) {
-        const std::uint32_t x = find(part_corners[i].second), y = find(part_corners[i - 1].second);
-        part_parent[std::max(x, y)] = std::min(x, y);  // the root is the part's first facet
-      }
+      if (part_corners[i].first == part_corners[i - 1].first)
+        unite(part_parent, part_corners[i].second, part_corners[i - 1].second);  // root: the first facet
+    auto find = [&](std::uint32_t x) { return find_root(part_parent, x); };
     part_order.resize(n);
     std::iota(part_order.begin(), part_order.end(), 0u);
     std::stable_sort(part_order.begin(), part_order.end(),
@@ -583,12 +578,9 @@ void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
   std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
     return std::tie(x.a, x.b, x.occluder) < std::tie(y.a, y.b, y.occluder);
   });
-  std::vector<std::uint32_t> parent(occluders.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  std::vector<std::uint32_t> parent;
+  make_sets(parent, occluders.size());
+  auto find = [&](std::uint32_t x) { return find_root(parent, x); };
   // Per edge: how many occluders share it (2 joins them; 3 or more spoils the set).
   std::vector<std::uint8_t> spoilt(occluders.size(), 0);
   std::vector<const Edge*> open;  // the edges no other occluder shares
@@ -596,7 +588,7 @@ void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
     std::size_t j = i + 1;
     while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
     if (j - i == 1) open.push_back(&edges[i]);
-    else if (j - i == 2) parent[find(edges[i].occluder)] = find(edges[i + 1].occluder);
+    else if (j - i == 2) unite(parent, edges[i].occluder, edges[i + 1].occluder);
     else
       for (std::size_t k = i; k < j; ++k) spoilt[edges[k].occluder] = 1;
     i = j;
@@ -640,17 +632,14 @@ void ExactPolygonTransport::Impl::find_solids(const Bounds& box) {
     // under a building; the roof plane of the tallest one, whose roof hides nothing above and
     // is no occluder).
     const std::vector<const Edge*>& boundary = open_of[root];
-    std::vector<std::uint32_t> loop(boundary.size());
-    std::iota(loop.begin(), loop.end(), 0u);
-    auto loop_of = [&](std::uint32_t x) {
-      while (loop[x] != x) x = loop[x] = loop[loop[x]];
-      return x;
-    };
+    std::vector<std::uint32_t> loop;
+    make_sets(loop, boundary.size());
+    auto loop_of = [&](std::uint32_t x) { return find_root(loop, x); };
     for (std::size_t i = 0; i < boundary.size(); ++i)
       for (std::size_t j = 0; j < i; ++j)
         if (boundary[i]->a == boundary[j]->a || boundary[i]->a == boundary[j]->b || boundary[i]->b == boundary[j]->a ||
             boundary[i]->b == boundary[j]->b)
-          loop[loop_of(static_cast<std::uint32_t>(i))] = loop_of(static_cast<std::uint32_t>(j));
+          unite(loop, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
     int unsealed = 0;
     std::vector<std::pair<glm::dvec3, double>> openings;  // outward normal, offset
     for (std::uint32_t first = 0; ok && first < boundary.size(); ++first) {

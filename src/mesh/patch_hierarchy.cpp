@@ -39,6 +39,7 @@
 #include "core/assert.hpp"
 #include "core/progress.hpp"
 #include "core/sampling.hpp"
+#include "core/union_find.hpp"
 #include "scene/overlap.hpp"
 
 namespace radiosity {
@@ -295,23 +296,6 @@ std::uint64_t mix(std::uint64_t x) {
 std::uint64_t position_hash(const glm::vec3& p) {
   const std::array<std::uint32_t, 3> b = position_bits(p);
   return mix(((static_cast<std::uint64_t>(b[0]) << 32) | b[1]) ^ mix(b[2]));
-}
-
-// Union-find with path halving; the smaller index becomes the root, so every class's root is
-// its first member whatever the order of the unions.
-std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
-  while (parent[x] != x) {
-    parent[x] = parent[parent[x]];
-    x = parent[x];
-  }
-  return x;
-}
-
-void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
-  a = find_root(parent, a);
-  b = find_root(parent, b);
-  if (a < b) parent[b] = a;
-  else if (b < a) parent[a] = b;
 }
 
 // A contact segment a polygon is graded toward (grade_toward_contacts()).
@@ -726,19 +710,19 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& scene_polygons, const std
             if (!smooth(polygon_of[ci], polygon_of[cj])) continue;
             const std::uint32_t ni = next_corner(ci), nj = next_corner(cj);
             if (position[ci] == position[cj]) {  // same direction (the polygons' orders disagree)
-              unite(root, ci, cj);
-              unite(root, ni, nj);
+              detail::unite(root, ci, cj);
+              detail::unite(root, ni, nj);
             } else {  // opposite directions: consistently oriented neighbours
-              unite(root, ci, nj);
-              unite(root, ni, cj);
+              detail::unite(root, ci, nj);
+              detail::unite(root, ni, cj);
             }
-            unite(local, i, j);
+            detail::unite(local, i, j);
           }
         members.assign(r, 0);
         local_edge.assign(r, kNone);
-        for (std::uint32_t i = 0; i < r; ++i) ++members[find_root(local, i)];
+        for (std::uint32_t i = 0; i < r; ++i) ++members[detail::find_root(local, i)];
         for (std::uint32_t i = 0; i < r; ++i) {
-          const std::uint32_t l = find_root(local, i);
+          const std::uint32_t l = detail::find_root(local, i);
           if (members[l] < 2) continue;
           if (local_edge[l] == kNone) local_edge[l] = edge_count++;
           edge[static_cast<std::uint32_t>(run[i])] = local_edge[l];
@@ -749,7 +733,7 @@ PatchHierarchy::Weld::Weld(const std::vector<Polygon>& scene_polygons, const std
   }
   for (std::uint32_t c = 0; c < count; ++c) {
     if (stop(c)) return;
-    root[c] = find_root(root, c);
+    root[c] = detail::find_root(root, c);
   }
   vertex = std::move(position);  // reuse the memory
   std::fill(vertex.begin(), vertex.end(), kNone);
