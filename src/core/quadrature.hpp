@@ -11,10 +11,11 @@
 #include <cstddef>
 #include <vector>
 
-#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/assert.hpp"
+#include "core/sampling.hpp"
 
 namespace radiosity::detail {
 
@@ -71,40 +72,28 @@ inline const GaussRule& gauss_rule(int n) {
 }
 
 /// The mean of f over a triangle or a planar quad (`count` 3 or 4 corners, in order) by the
-/// n x n Gauss-Legendre rule of a smooth map from the unit square: the bilinear map of a quad,
-/// each point weighted by its Jacobian |dP/ds x dP/dt|; the collapsed square of a triangle,
-/// P(u, v) = c0 + u (c1 - c0) + u v (c2 - c1), Jacobian proportional to u. Exact for polynomials
-/// of degree 2n - 1 in the map's coordinates, where a midpoint grid of n x n cells is exact only
-/// for degree 1: a receiver beside a source's plane sees it with a factor that vanishes along
-/// that plane, and the midpoint rule overestimates such a concave profile (docs/HIERARCHICAL.md,
-/// session 42). 0 for a degenerate polygon.
+/// n x n Gauss-Legendre rule through the cell's polynomial map from the unit square (CellMap,
+/// core/sampling.hpp: the bilinear map of a quad, the collapsed square of a triangle), each
+/// point weighted by the map's area density. Exact for polynomials of degree 2n - 1 in the map's
+/// coordinates, where a midpoint grid of n x n cells is exact only for degree 1: a receiver
+/// beside a source's plane sees it with a factor that vanishes along that plane, and the
+/// midpoint rule overestimates such a concave profile (docs/HIERARCHICAL.md, session 42). 0 for
+/// a degenerate polygon.
 template <typename F>
 float polygon_gauss_mean(const glm::vec3* c, int count, int n, const F& f) {
   RADIOSITY_ASSERT(count == 3 || count == 4);
+  const CellMap map(c, count);
+  if (!(map.area() > 0.0f)) return 0.0f;
   const GaussRule& rule = gauss_rule(n);
-  const float twice_area = count == 3 ? glm::length(glm::cross(c[1] - c[0], c[2] - c[0])) : 0.0f;
   double sum = 0.0, weights = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const float s = rule.node[static_cast<std::size_t>(i)];
+  for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const float t = rule.node[static_cast<std::size_t>(j)];
-      glm::vec3 p;
-      float jacobian;
-      if (count == 3) {
-        p = c[0] + s * (c[1] - c[0]) + (s * t) * (c[2] - c[1]);
-        jacobian = s * twice_area;
-      } else {
-        p = (1.0f - s) * (1.0f - t) * c[0] + s * (1.0f - t) * c[1] + s * t * c[2] + (1.0f - s) * t * c[3];
-        const glm::vec3 ds = (1.0f - t) * (c[1] - c[0]) + t * (c[2] - c[3]);
-        const glm::vec3 dt = (1.0f - s) * (c[3] - c[0]) + s * (c[2] - c[1]);
-        jacobian = glm::length(glm::cross(ds, dt));
-      }
+      const glm::vec2 st(rule.node[static_cast<std::size_t>(i)], rule.node[static_cast<std::size_t>(j)]);
       const double w = static_cast<double>(rule.weight[static_cast<std::size_t>(i)]) *
-                       rule.weight[static_cast<std::size_t>(j)] * jacobian;
-      sum += w * static_cast<double>(f(p));
+                       rule.weight[static_cast<std::size_t>(j)] * map.density(st);
+      sum += w * static_cast<double>(f(map.point(st)));
       weights += w;
     }
-  }
   return weights > 0.0 ? static_cast<float>(sum / weights) : 0.0f;
 }
 
