@@ -822,10 +822,10 @@ TEST_SUITE("form_factors") {
     // linear push clamped its gradient by their bounding spheres and passed their relative
     // gradient down: the lowest row's factor to the ground was +2.9 % of the exact mode's in the
     // links' own rows (+20 % from ground 9-20 m away, +55 % beyond), +2.5 % in the matrix (the
-    // mean of both directions), the walls above -0.8 %. Since session 44 a planar cluster
-    // clamps per axis of its box and a child inherits the gradient itself (docs/HIERARCHICAL.md,
-    // "The push at a wall's foot"): +0.37 % in the links' rows, +1.7 % and -0.6 % in the
-    // matrix, the rest from the ground's rows beside the walls (mixed clusters at the corner).
+    // mean of both directions), the walls above -0.8 %. Since session 44 a cluster clamps per
+    // axis of its box, a child inherits the gradient itself and the shares are normalised per
+    // direction (docs/HIERARCHICAL.md, "The push at a wall's foot"): -0.07 % in the links' rows,
+    // +1.2 % and -0.6 % in the matrix (the rest from the ground's rows beside the walls).
     namespace cd = bench::city_detail;
     rad::Scene s;
     const rad::MaterialId m = s.add_material(rad::Material{});
@@ -876,7 +876,7 @@ TEST_SUITE("form_factors") {
                                                    << 100.0 * (foot_links / foot_exact - 1.0) << " %); the walls above exact "
                                                    << walls_exact << ", links " << walls_links << " ("
                                                    << 100.0 * (walls_links / walls_exact - 1.0) << " %)");
-    CHECK(std::fabs(foot_links / foot_exact - 1.0) < 0.02);
+    CHECK(std::fabs(foot_links / foot_exact - 1.0) < 0.015);
     CHECK(std::fabs(walls_links / walls_exact - 1.0) < 0.01);
   }
 

@@ -317,11 +317,13 @@ struct LinkHierarchy::Impl {
   std::vector<std::array<float, 6>> open_moments;
 
   /// Node radiosity for the oracle and the sweeps.
-  /// The linear push's shares in one gather (gather_sides()): per cluster, of its parent's
-  /// irradiance; per element side (2 e + side), of its parent element's. 1 where not recorded.
+  /// The linear push's shares in one gather (gather_sides()): per cluster and slot of its
+  /// moment basis, of its parent's irradiance (cluster_shares()); per element side (2 e + side),
+  /// of its parent element's. 1 where not recorded.
   struct PushShares {
-    std::vector<float> cluster, side;
-    double of_cluster(std::uint32_t c) const { return c < cluster.size() ? cluster[c] : 1.0; }
+    std::vector<std::array<float, 6>> cluster;
+    std::vector<float> side;
+    double of_cluster(std::uint32_t c, std::size_t slot) const { return c < cluster.size() ? cluster[c][slot] : 1.0; }
     double of_side(std::size_t k) const { return k < side.size() ? side[k] : 1.0; }
   };
 
@@ -1808,7 +1810,7 @@ struct LinkHierarchy::Impl {
       const std::uint32_t parent = context.parent[c];
       if (parent == kNone) break;
       std::array<double, 6> shared = Q;
-      for (double& q : shared) q *= context.shares.of_cluster(c);
+      for (std::size_t q = 0; q < shared.size(); ++q) shared[q] *= context.shares.of_cluster(c, q);
       Q = {};
       push_exposed_transpose(shared, c, Q, parent);
       c = parent;
@@ -2237,7 +2239,7 @@ struct LinkHierarchy::Impl {
       if (!c.is_leaf()) {
         for (const std::uint32_t child : c.children) {
           std::array<double, 6> shared = Q[child];
-          for (double& q : shared) q *= shares.of_cluster(child);
+          for (std::size_t q = 0; q < shared.size(); ++q) shared[q] *= shares.of_cluster(child, q);
           push_exposed_transpose(shared, child, Q[i], i);
         }
         continue;
@@ -2375,18 +2377,18 @@ struct LinkHierarchy::Impl {
     return g;
   }
   /// `g` (a relative gradient at `x`) with each component shortened so that 1 + g_a (p_a - x_a)
-  /// >= 0 along axis a across the box `to`: the clamp for a planar receiver instead of
-  /// irradiance_slope()'s sphere, which is much larger than the receiver's extent along any one
-  /// axis of its plane. A wall cluster from its foot to 8 m high, lit by ground far away at
-  /// grazing, has an irradiance about linear in height and 0 at the foot: its relative gradient
-  /// is 1 / (the centroid's height), which the sphere of that 4.4 x 8 m cluster (radius 4.6 m
-  /// against a height of 3.6 m) cut to 0.8 times, so the linear push gave the wall's lowest
-  /// elements that far light 1.5 times over (docs/HIERARCHICAL.md, "The push at a wall's
-  /// foot"). Per axis rather than over the whole box: the box's corners take a gradient across
-  /// the wall as well, which cut the height's again (the lowest row's view factor to far ground
-  /// +28 % instead of +8 %); push_factor() keeps every share within [0, 2] anyway. Only for
-  /// planar receivers: across a cluster of mixed orientation the linear model does not hold
-  /// that far (a wall's second row came out up to 35 % bright with the box clamp everywhere).
+  /// >= 0 along axis a across the box `to`: the clamp for a receiving cluster instead of
+  /// irradiance_slope()'s sphere, which is much larger than the cluster's extent along any one
+  /// axis. A wall cluster from its foot to 8 m high, lit by ground far away at grazing, has an
+  /// irradiance about linear in height and 0 at the foot: its relative gradient is 1 / (the
+  /// centroid's height), which the sphere of that 4.4 x 8 m cluster (radius 4.6 m against a
+  /// height of 3.6 m) cut to 0.8 times, so the linear push gave the wall's lowest elements that
+  /// far light 1.5 times over (docs/HIERARCHICAL.md, "The push at a wall's foot"). Per axis
+  /// rather than over the whole box: the box's corners take a gradient across the wall as well,
+  /// which cut the height's again (the lowest row's view factor to far ground +28 % instead of
+  /// +8 %); push_factor() keeps every share within [0, 2] anyway. Across a cluster of mixed
+  /// orientation this needs cluster_shares(): with one share per child over all its sides, a
+  /// wall's lowest elements took 1.9 times their light.
   static glm::vec3 clamp_to_box(glm::vec3 g, const glm::vec3& x, const Bounds& to) {
     for (int a = 0; a < 3; ++a) {
       const float lowest = std::min(g[a] * (to.lower[a] - x[a]), g[a] * (to.upper[a] - x[a]));
@@ -2577,6 +2579,37 @@ struct LinkHierarchy::Impl {
     }
     for (int k = 0; k < n; ++k) share[k] *= total / weighted;
   }
+  /// The push's `share` of cluster `c`'s irradiance for each of its two children, per slot of
+  /// the child's moment basis: normalised per direction, so that the sides facing a direction
+  /// (the children's area moments in it) take, on their area-weighted mean, what the cluster
+  /// received from it (keep_power() holds the mean over all sides). A link's light into a
+  /// cluster is its mean over the sides that face the light (the link's factor is corrected by
+  /// the transport to its descendants), so in a cluster of a wall's foot with the ground before
+  /// it, light that only the wall faces went to the wall child times the wall's share over the
+  /// whole area: with the box clamp the wall's lowest elements 1.9 times too much, and a clamp
+  /// by the sphere had to keep those shares near 1 (docs/HIERARCHICAL.md, "The push at a wall's
+  /// foot"). A direction only one child faces goes to it whole. A tilted direction that a
+  /// sibling on the axes holds only in its axis moments keeps the child's one share.
+  std::array<std::array<float, 6>, 2> cluster_shares(std::uint32_t c, const std::array<float, 2>& share) const {
+    const ClusterNode& node = tree.node(c);
+    std::array<std::array<float, 6>, 2> out{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::uint32_t child = node.children[k], other = node.children[1 - k];
+      const MomentBasis& cb = bases.of(child);
+      const MomentBasis& ob = bases.of(other);
+      out[k].fill(share[k]);
+      for (int j = 0; j < cb.slots(); ++j) {
+        const int o = ob.slot(cb.direction(j).id);
+        if (o < 0 && ob.axes) continue;
+        const float mine = area_moments[child][static_cast<std::size_t>(j)];
+        const float theirs = o < 0 ? 0.0f : area_moments[other][static_cast<std::size_t>(o)];
+        const float weighted = mine * share[k] + theirs * share[1 - k];
+        if (weighted > 0.0f) out[k][static_cast<std::size_t>(j)] = share[k] * (mine + theirs) / weighted;
+      }
+    }
+    return out;
+  }
+
 
   /// Gather and push: the irradiance per unknown from the links with node values `v`.
   /// With `hold`, each unknown's irradiance is then held to the discrete maximum principle: at
@@ -2633,7 +2666,7 @@ struct LinkHierarchy::Impl {
     std::vector<glm::vec4> slope_cluster(C, glm::vec4(0.0f)), slope_front(inner_elements ? elements : 0, glm::vec4(0.0f)),
         slope_back(inner_elements && backs ? elements : 0, glm::vec4(0.0f));
     if (shares) {
-      shares->cluster.assign(C, 1.0f);
+      shares->cluster.assign(C, {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f});
       shares->side.assign(2 * std::size_t{elements}, 1.0f);
     }
     const std::uint64_t receivers = offsets.size() - 1;
@@ -2654,11 +2687,7 @@ struct LinkHierarchy::Impl {
           // A one-patch cluster's slope goes to its patch's root element: used if that has children.
           const bool has_children =
               !node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf();
-          // A planar cluster (its sides all face one way) clamps its gradients by its box.
-          const std::array<float, 6>& facing = area_moments[handle_index(r)];
-          const bool planar =
-              has_children && std::count_if(facing.begin(), facing.end(), [](float m) { return m > 0.0f; }) == 1;
-          const float radius_r = planar ? 0.0f : radius(hierarchy, r);
+          // A cluster clamps its links' gradients by its box (clamp_to_box()).
           for (std::uint64_t k = first; k < last; ++k) {
             const NodeHandle s = sources[k];
             const glm::vec3 cs = centroid(hierarchy, s);
@@ -2667,9 +2696,9 @@ struct LinkHierarchy::Impl {
                              source_intensity(hierarchy, v, s, w);
             add_irradiance(E, bases.of(handle_index(r)), -w, flux);
             if (!has_children) continue;
-            glm::vec3 g = irradiance_slope(cr, glm::vec3(0.0f), directional_q(hierarchy, nullptr, r, -w), cs,
-                                           directional_q(hierarchy, &v, s, w), radius_r);
-            if (planar) g = clamp_to_box(g, cr, node.bounds);
+            const glm::vec3 g = clamp_to_box(irradiance_slope(cr, glm::vec3(0.0f), directional_q(hierarchy, nullptr, r, -w),
+                                                              cs, directional_q(hierarchy, &v, s, w), 0.0f),
+                                             cr, node.bounds);
             slope += mean(flux) * glm::vec4(g, 1.0f);
           }
           continue;
@@ -2722,13 +2751,14 @@ struct LinkHierarchy::Impl {
           area[k] = static_cast<float>(cumulative_area[cn.first + cn.count] - cumulative_area[cn.first]);
         }
         keep_power(share.data(), area.data(), 2);
+        const std::array<std::array<float, 6>, 2> by_slot = cluster_shares(c, share);
         for (std::size_t k = 0; k < 2; ++k) {
           const std::uint32_t child = node.children[k];
           const float f = share[k];
-          if (shares) shares->cluster[child] = f;
+          if (shares) shares->cluster[child] = by_slot[k];
           Moments pushed{};
           push_exposed(received[c], c, pushed, child);
-          for (std::size_t q = 0; q < pushed.size(); ++q) received[child][q] += f * pushed[q];
+          for (std::size_t q = 0; q < pushed.size(); ++q) received[child][q] += by_slot[k][q] * pushed[q];
           slope_cluster[child] += carried_slope(slope_cluster[c], f);
           if (hold) bound_cluster[child] = glm::max(bound_cluster[child], bound_cluster[c]);
         }
