@@ -749,15 +749,23 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       if (status == SolveStatus::cancelled) break;
       B_now = r.B;
     }
-    // The irradiance of the radiosity kept, once, with the links as they stand (those of its
-    // solve, or after a cancelled pass those restored, over any elements it split): the
-    // passes' solves leave it to here, each a gather fewer (the 246k city's three passes: 9
-    // gathers -> 7).
+    // The final gather: the irradiance of the radiosity kept, once, with the links as they
+    // stand (those of its solve, or after a cancelled pass those restored, over any elements it
+    // split), each leaf taking the links into its ancestors by the kernel at the leaf rather
+    // than the sweeps' linear push, and the radiosity it gives (B = E + rho H + tau H'): one
+    // sweep more, for the display (docs/HIERARCHICAL.md, "The final gather"). The passes'
+    // solves leave it to here, each a gather fewer (the 246k city's three passes: 9 gathers
+    // -> 7).
     if (solved) {
-      const std::vector<Rgb> H = links->irradiance(hierarchy, *system, current_B(), held);
+      const std::vector<Rgb> H = links->irradiance(hierarchy, *system, current_B(), held, true);
       const std::vector<float> exposure = current_exposure();
-      for (std::size_t i = 0; i < system->unknowns(); ++i)
+      const std::vector<Rgb> source = system->exposed_source(exposure);
+      for (std::size_t i = 0; i < system->unknowns(); ++i) {
         H_of(i) = system->light.empty() ? H[i] : H[i] + system->exposed_light(i, exposure);
+        Rgb b = source[i] + system->reflectance[i] * H[i];
+        if (system->twin[i] != kNone) b += system->transmittance[i] * H[system->twin[i]];
+        B_of(i) = b;
+      }
     }
     report.link_count = links->link_count();
     report.form_factor_bytes = std::max(report.form_factor_bytes, links->bytes());

@@ -99,9 +99,12 @@ class LinkHierarchy {
   /// The irradiance per unknown that radiosity `B` (per unknown) sends along the links: one
   /// gather and push (`hold`: held to the maximum principle, as solve() holds it). With B = the
   /// emission it is the direct irradiance from the emitters. Onto each side's open part where
-  /// it is partly buried, as solve()'s H and B (SolverResult::exposure).
+  /// it is partly buried, as solve()'s H and B (SolverResult::exposure). With `kernel_push`,
+  /// the links into open nodes with children reach each leaf by the kernel evaluated there
+  /// (normalised to what the linear push delivers) rather than by the sweeps' linear push: the
+  /// display's final gather (docs/HIERARCHICAL.md, "The final gather").
   std::vector<Rgb> irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
-                              const std::vector<Rgb>& B, bool hold = false) const;
+                              const std::vector<Rgb>& B, bool hold = false, bool kernel_push = false) const;
 
   /// The share of the power that radiosity `B` (per unknown) sends from sides whose rays all
   /// meet receiving surfaces (kEnclosureRays each; estimated from sides drawn by power): near 1
