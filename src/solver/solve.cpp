@@ -762,9 +762,7 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
       const std::vector<Rgb> source = system->exposed_source(exposure);
       for (std::size_t i = 0; i < system->unknowns(); ++i) {
         H_of(i) = system->light.empty() ? H[i] : H[i] + system->exposed_light(i, exposure);
-        Rgb b = source[i] + system->reflectance[i] * H[i];
-        if (system->twin[i] != kNone) b += system->transmittance[i] * H[system->twin[i]];
-        B_of(i) = b;
+        B_of(i) = system->radiosity_of(i, source[i], H);
       }
     }
     report.link_count = links->link_count();

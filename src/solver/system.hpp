@@ -88,6 +88,13 @@ struct RadiositySystem {
   }
   /// `source` with the lights' first shot onto the open parts (exposed_light()).
   std::vector<Rgb> exposed_source(const std::vector<float>& exposure) const;
+  /// The radiosity of unknown `u` from its source term and the irradiance per unknown `H`:
+  /// B_u = source_u + rho_u H_u + tau_u H_twin (opaque sides have no twin).
+  Rgb radiosity_of(std::size_t u, const Rgb& source_u, const std::vector<Rgb>& H) const {
+    Rgb b = source_u + reflectance[u] * H[u];
+    if (twin[u] != kNone) b += transmittance[u] * H[twin[u]];
+    return b;
+  }
   /// The unknown at position `index` of an estimator's column over `leaves`: the front for
   /// index < fronts(), the back of leaves[index - fronts()] beyond (kNone if it has none).
   std::uint32_t column_unknown(std::size_t index) const {

@@ -3182,8 +3182,7 @@ SolverResult LinkHierarchy::solve(const SolverContext& ctx, const std::vector<Rg
     // B_u = E_u + rho_u H_u + tau_u H_twin (system.hpp), from the previous sweep's values.
     double change = 0.0;
     for (std::size_t u = 0; u < n; ++u) {
-      Rgb b = source[u] + sys.reflectance[u] * result.H[u];
-      if (sys.twin[u] != kNone) b += sys.transmittance[u] * result.H[sys.twin[u]];
+      const Rgb b = sys.radiosity_of(u, source[u], result.H);
       next[u] = b;
       change += sys.area[u] * channel_l1(b - result.B[u]);
     }
