@@ -2849,7 +2849,9 @@ struct LinkHierarchy::Impl {
     std::vector<float> weights(kernel ? (inner_elements ? sources.size() : offsets[C]) : 0, 0.0f);
     const std::uint64_t receivers = offsets.size() - 1;
     parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
-      thread_local std::vector<LeafSide> leaves;  // the kernel push's, per receiver
+      // The kernel push's leaf sides of a receiver, per block of receivers (not kept per thread:
+      // a receiver near the root holds most of the scene's leaves).
+      std::vector<LeafSide> leaves;
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint64_t first = offsets[i], last = offsets[i + 1];
         if (first == last) continue;
