@@ -2654,6 +2654,8 @@ struct LinkHierarchy::Impl {
   struct LeafSide {
     glm::vec3 centroid, normal;
     float area;
+    std::uint32_t element;
+    bool back;
   };
   /// The leaf sides below node `r`: a cluster's, each leaf of its patches on both sides where
   /// the patch has a back; an element's, its leaves on its side. False (and `out` partly
@@ -2679,8 +2681,8 @@ struct LinkHierarchy::Impl {
           continue;
         }
         const glm::vec3& n = h.normal(e);
-        if (front) out.push_back({el.centroid, n, el.area});
-        if (back) out.push_back({el.centroid, -n, el.area});
+        if (front) out.push_back({el.centroid, n, el.area, e, false});
+        if (back) out.push_back({el.centroid, -n, el.area, e, true});
         open = open && !(front && enclosed(e, false)) && !(back && enclosed(e, true));
       }
     };
@@ -2741,17 +2743,22 @@ struct LinkHierarchy::Impl {
   /// at the leaves against the point kernel at the centroid, within a factor of 2) also
   /// turned away the ground beside a wall lit by the wall above it, where the two
   /// legitimately differ (the 22k city's ground within 1.2 m of a wall +0.43 -> +0.50 %).
+  /// `lit` receives each leaf side's point_kernel().
   float kernel_weight(const PatchHierarchy& h, const Values& v, NodeHandle s, const glm::vec3& cr,
-                      const std::vector<LeafSide>& leaves, float irradiance, bool facing) const {
+                      const std::vector<LeafSide>& leaves, std::vector<Rgb>& lit_by_leaf, float irradiance,
+                      bool facing) const {
     if (!(irradiance > 0.0f)) return 0.0f;
     const glm::vec3 u = cr - centroid(h, s);
     const float d2 = glm::dot(u, u);
     if (!(d2 > 0.0f)) return 0.0f;
     const glm::vec3 w = u / std::sqrt(d2);
+    lit_by_leaf.resize(leaves.size());
     double lit = 0.0, area = 0.0, far = 0.0;
     float brightest = 0.0f, most_facing = facing ? 0.0f : 1.0f;
-    for (const LeafSide& l : leaves) {
-      const float kernel = mean(point_kernel(h, v, s, l.centroid, l.normal));
+    for (std::size_t k = 0; k < leaves.size(); ++k) {
+      const LeafSide& l = leaves[k];
+      lit_by_leaf[k] = point_kernel(h, v, s, l.centroid, l.normal);
+      const float kernel = mean(lit_by_leaf[k]);
       const float cosine = std::max(0.0f, -glm::dot(l.normal, w));
       lit += static_cast<double>(l.area) * kernel;
       area += static_cast<double>(l.area);
@@ -2764,49 +2771,44 @@ struct LinkHierarchy::Impl {
     if (!(weight * brightest <= kKernelPeak * irradiance * most_facing)) return 0.0f;
     return static_cast<float>(weight);
   }
-  /// Adds to every leaf side what the links with a kernel weight (`weights`, by link) bring it
-  /// through its ancestors: weight x point_kernel() at the leaf's centroid. The linear push
-  /// spreads a link's light over its receiver by a gradient at the receiver's centroid, and
-  /// each node's links alike: between clusters cut where the tree's median splits fall, the
-  /// leaves took an error that changes from one element to the next (on the 22k city 0.73 % of
-  /// the walls' radiosity, where the Monte Carlo rows err by 0.18 %; with every link refined
-  /// down to the leaves 0.22 %). Per leaf, in a fixed order (its ancestors from the nearest
-  /// up): the same sums at any thread count.
-  void kernel_push(const PatchHierarchy& h, const Values& v, const std::vector<float>& weights, std::vector<Rgb>& front,
-                   std::vector<Rgb>& back) const {
+  /// The kernel push's pass (gather_sides() with `kernel`): `receive(i, true, leaves, lit)` for
+  /// every receiver `i` with links that `candidate` takes, level by level (clusters by depth,
+  /// then elements with children by depth), each level in parallel. The nodes of one level
+  /// hold disjoint leaves, so each leaf side takes its ancestors' links in one order, from the
+  /// root down, at any thread count, and each link's kernel is evaluated once per leaf. The
+  /// linear push spreads a link's light over its receiver by a gradient at the receiver's
+  /// centroid, and each node's links alike: between clusters cut where the tree's median
+  /// splits fall, the leaves took an error that changes from one element to the next (on the
+  /// 22k city 0.73 % of the walls' radiosity, where the Monte Carlo rows err by 0.18 %; with
+  /// every link refined down to the leaves 0.22 %).
+  template <typename Candidate, typename Receive>
+  void kernel_push(const PatchHierarchy& h, const Candidate& candidate, const Receive& receive) const {
     const std::uint32_t elements = linked_elements;
     const std::uint32_t C = cluster_count();
-    std::vector<std::uint32_t> parent(C, kNone), leaf_cluster(h.patches().size(), kNone);
+    std::vector<std::vector<std::uint64_t>> levels;
+    auto add = [&](std::size_t level, std::uint64_t i) {
+      if (offsets[i] == offsets[i + 1] || !candidate(receiver_handle(i, elements))) return;
+      if (levels.size() <= level) levels.resize(level + 1);
+      levels[level].push_back(i);
+    };
+    std::vector<std::uint32_t> depth(C, 0);
     for (std::uint32_t c = 0; c < C; ++c) {
       const ClusterNode& node = tree.node(c);
-      if (node.is_leaf()) {
-        leaf_cluster[tree.order()[node.first]] = c;
-      } else {
-        for (const std::uint32_t child : node.children) parent[child] = c;
-      }
+      if (!node.is_leaf())
+        for (const std::uint32_t child : node.children) depth[child] = depth[c] + 1;
+      add(depth[c], c);
     }
-    auto links_of = [&](std::uint64_t receiver, const glm::vec3& x, const glm::vec3& n, Rgb& sum) {
-      const std::uint64_t last = std::min<std::uint64_t>(offsets[receiver + 1], weights.size());
-      for (std::uint64_t k = offsets[receiver]; k < last; ++k)
-        if (weights[k] > 0.0f) sum += weights[k] * point_kernel(h, v, sources[k], x, n);
-    };
-    parallel_for(threads, elements, 256, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        const auto e = static_cast<std::uint32_t>(i);
-        const Element& el = h.element(e);
-        if (!el.is_leaf()) continue;
-        const std::uint32_t p = el.patch;
-        for (const bool b : {false, true}) {
-          if (b && (back.empty() || !has_back[p])) continue;
-          const glm::vec3 n = b ? -h.normal(e) : h.normal(e);
-          Rgb sum(0.0f);
-          for (std::uint32_t a = el.parent; a != kNone; a = h.element(a).parent)
-            links_of(std::uint64_t{C} + (b ? elements : 0u) + a, el.centroid, n, sum);
-          for (std::uint32_t c = leaf_cluster[p]; c != kNone; c = parent[c]) links_of(c, el.centroid, n, sum);
-          (b ? back : front)[e] += sum;
-        }
-      }
-    });
+    const std::size_t cluster_levels = levels.size();
+    for (std::uint64_t i = C; i + 1 < offsets.size(); ++i) {
+      const NodeHandle r = receiver_handle(i, elements);
+      add(cluster_levels + h.element(element_of(r)).depth, i);
+    }
+    for (const std::vector<std::uint64_t>& level : levels)
+      parallel_for(threads, level.size(), 1, [&](std::size_t begin, std::size_t end) {
+        std::vector<LeafSide> leaves;
+        std::vector<Rgb> lit;
+        for (std::size_t k = begin; k < end; ++k) receive(level[k], true, leaves, lit);
+      });
   }
 
   /// gather()'s work: the irradiance per element side (`back` empty without `backs`), pushed
@@ -2844,94 +2846,105 @@ struct LinkHierarchy::Impl {
       shares->cluster.assign(C, {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f});
       shares->side.assign(2 * std::size_t{elements}, 1.0f);
     }
-    // The kernel push's weight per link (0: pushed linearly), for the links into clusters and,
-    // where elements have children, into elements too.
-    std::vector<float> weights(kernel ? (inner_elements ? sources.size() : offsets[C]) : 0, 0.0f);
     const std::uint64_t receivers = offsets.size() - 1;
-    parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
-      // The kernel push's leaf sides of a receiver, per block of receivers (not kept per thread:
-      // a receiver near the root holds most of the scene's leaves).
-      std::vector<LeafSide> leaves;
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint64_t first = offsets[i], last = offsets[i + 1];
-        if (first == last) continue;
-        const NodeHandle r = receiver_handle(i, elements);
-        const glm::vec3 cr = centroid(hierarchy, r);
-        Rgb bound(0.0f);
-        if (hold)
-          for (std::uint64_t k = first; k < last; ++k) bound = glm::max(bound, source_max(sources[k]));
-        if (is_cluster(r)) {
-          if (hold) bound_cluster[handle_index(r)] = bound;
-          Moments& E = received[handle_index(r)];
-          glm::vec4& slope = slope_cluster[handle_index(r)];
-          const ClusterNode& node = tree.node(handle_index(r));
-          // A one-patch cluster's slope goes to its patch's root element: used if that has children.
-          const bool has_children =
-              !node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf();
-          const bool by_kernel =
-              kernel && has_children && wholly_exposed(handle_index(r)) && leaf_sides(hierarchy, r, leaves);
-          // A cluster clamps its links' gradients by its box (clamp_to_box()).
-          for (std::uint64_t k = first; k < last; ++k) {
-            const NodeHandle s = sources[k];
-            const glm::vec3 cs = centroid(hierarchy, s);
-            const glm::vec3 w = glm::normalize(cr - cs);
-            const Rgb flux = std::abs(coefficients[k]) * pull_factor(hierarchy, v, r, cr, s, cs, w) *
-                             source_intensity(hierarchy, v, s, w);
-            if (by_kernel) {
-              weights[k] = kernel_weight(hierarchy, v, s, cr, leaves, mean(flux), true);
-              if (weights[k] > 0.0f) continue;
-            }
-            add_irradiance(E, bases.of(handle_index(r)), -w, flux);
-            if (!has_children) continue;
-            const glm::vec3 g = clamp_to_box(irradiance_slope(cr, glm::vec3(0.0f), directional_q(hierarchy, nullptr, r, -w),
-                                                              cs, directional_q(hierarchy, &v, s, w), 0.0f),
-                                             cr, node.bounds);
-            slope += mean(flux) * glm::vec4(g, 1.0f);
-          }
-          continue;
-        }
-        const glm::vec3 nr = side_normal(hierarchy, r);
-        Rgb sum(0.0f);
-        glm::vec4 slope(0.0f);
-        const bool has_children = !hierarchy.element(element_of(r)).is_leaf();
-        const Bounds box = has_children ? node_bounds(hierarchy, r) : Bounds{};
-        const bool by_kernel = kernel && has_children && element_exposure(element_of(r), is_back(r)) == 1.0f &&
-                               leaf_sides(hierarchy, r, leaves);
+    // A receiver the kernel push may take (with children and wholly open) is left to the pass by
+    // levels below; there `leaves` holds its leaf sides and `lit` each one's point_kernel() of
+    // the link at hand.
+    auto kernel_candidate = [&](NodeHandle r) {
+      if (!kernel) return false;
+      if (is_cluster(r)) {
+        const ClusterNode& node = tree.node(handle_index(r));
+        return (!node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf()) &&
+               wholly_exposed(handle_index(r));
+      }
+      return !hierarchy.element(element_of(r)).is_leaf() && element_exposure(element_of(r), is_back(r)) == 1.0f;
+    };
+    auto receive = [&](std::size_t i, bool by_levels, std::vector<LeafSide>& leaves, std::vector<Rgb>& lit) {
+      const std::uint64_t first = offsets[i], last = offsets[i + 1];
+      if (first == last) return;
+      const NodeHandle r = receiver_handle(i, elements);
+      if (!by_levels && kernel_candidate(r)) return;
+      // By levels, the links whose kernel weight is positive go to the leaves; the rest below.
+      const bool by_kernel = by_levels && leaf_sides(hierarchy, r, leaves);
+      auto to_leaves = [&](NodeHandle s, const glm::vec3& cr, float irradiance, bool facing) {
+        if (!by_kernel) return false;
+        const float weight = kernel_weight(hierarchy, v, s, cr, leaves, lit, irradiance, facing);
+        if (!(weight > 0.0f)) return false;
+        for (std::size_t l = 0; l < leaves.size(); ++l)
+          (leaves[l].back ? back : front)[leaves[l].element] += weight * lit[l];
+        return true;
+      };
+      const glm::vec3 cr = centroid(hierarchy, r);
+      Rgb bound(0.0f);
+      if (hold)
+        for (std::uint64_t k = first; k < last; ++k) bound = glm::max(bound, source_max(sources[k]));
+      if (is_cluster(r)) {
+        if (hold) bound_cluster[handle_index(r)] = bound;
+        Moments& E = received[handle_index(r)];
+        glm::vec4& slope = slope_cluster[handle_index(r)];
+        const ClusterNode& node = tree.node(handle_index(r));
+        // A one-patch cluster's slope goes to its patch's root element: used if that has children.
+        const bool has_children =
+            !node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf();
+        // A cluster clamps its links' gradients by its box (clamp_to_box()).
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
-          Rgb brought;
-          if (!is_cluster(s)) {
-            brought = std::abs(coefficients[k]) * (is_back(s) ? v.back : v.front)[element_of(s)];
-            const glm::vec3& offset = pull_offset(v, s);
-            if (offset != glm::vec3(0.0f)) {
-              const glm::vec3 cs = centroid(hierarchy, s);
-              brought *= pull_factor(hierarchy, v, r, cr, s, cs, glm::normalize(cr - cs));
-            }
-          } else {
-            const glm::vec3 cs = centroid(hierarchy, s);
-            const glm::vec3 w = glm::normalize(cr - cs);
-            brought = (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w)) * pull_factor(hierarchy, v, r, cr, s, cs, w)) *
-                      source_intensity(hierarchy, v, s, w);
-          }
-          if (by_kernel) {
-            weights[k] = kernel_weight(hierarchy, v, s, cr, leaves, mean(brought), false);
-            if (weights[k] > 0.0f) continue;
-          }
-          sum += brought;
-          // Leaves (most receivers) push nothing: no slope, and no look-up of an element
-          // source's centroid and normal, which the sum alone does not need.
-          if (!has_children) continue;
           const glm::vec3 cs = centroid(hierarchy, s);
-          const glm::vec3 g = clamp_to_box(
-              irradiance_slope(cr, nr, glm::vec3(0.0f), cs, directional_q(hierarchy, &v, s, glm::normalize(cr - cs)), 0.0f), cr,
-              box);
-          slope += mean(brought) * glm::vec4(g, 1.0f);
+          const glm::vec3 w = glm::normalize(cr - cs);
+          const Rgb flux = std::abs(coefficients[k]) * pull_factor(hierarchy, v, r, cr, s, cs, w) *
+                           source_intensity(hierarchy, v, s, w);
+          if (to_leaves(s, cr, mean(flux), true)) continue;
+          add_irradiance(E, bases.of(handle_index(r)), -w, flux);
+          if (!has_children) continue;
+          const glm::vec3 g = clamp_to_box(irradiance_slope(cr, glm::vec3(0.0f), directional_q(hierarchy, nullptr, r, -w),
+                                                            cs, directional_q(hierarchy, &v, s, w), 0.0f),
+                                           cr, node.bounds);
+          slope += mean(flux) * glm::vec4(g, 1.0f);
         }
-        (is_back(r) ? back : front)[element_of(r)] = sum;
-        if (has_children) (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
-        if (hold) (is_back(r) ? bound_back : bound_front)[element_of(r)] = bound;
+        return;
       }
+      const glm::vec3 nr = side_normal(hierarchy, r);
+      Rgb sum(0.0f);
+      glm::vec4 slope(0.0f);
+      const bool has_children = !hierarchy.element(element_of(r)).is_leaf();
+      const Bounds box = has_children ? node_bounds(hierarchy, r) : Bounds{};
+      for (std::uint64_t k = first; k < last; ++k) {
+        const NodeHandle s = sources[k];
+        Rgb brought;
+        if (!is_cluster(s)) {
+          brought = std::abs(coefficients[k]) * (is_back(s) ? v.back : v.front)[element_of(s)];
+          const glm::vec3& offset = pull_offset(v, s);
+          if (offset != glm::vec3(0.0f)) {
+            const glm::vec3 cs = centroid(hierarchy, s);
+            brought *= pull_factor(hierarchy, v, r, cr, s, cs, glm::normalize(cr - cs));
+          }
+        } else {
+          const glm::vec3 cs = centroid(hierarchy, s);
+          const glm::vec3 w = glm::normalize(cr - cs);
+          brought = (std::abs(coefficients[k]) * std::max(0.0f, -glm::dot(nr, w)) * pull_factor(hierarchy, v, r, cr, s, cs, w)) *
+                    source_intensity(hierarchy, v, s, w);
+        }
+        if (to_leaves(s, cr, mean(brought), false)) continue;
+        sum += brought;
+        // Leaves (most receivers) push nothing: no slope, and no look-up of an element
+        // source's centroid and normal, which the sum alone does not need.
+        if (!has_children) continue;
+        const glm::vec3 cs = centroid(hierarchy, s);
+        const glm::vec3 g = clamp_to_box(
+            irradiance_slope(cr, nr, glm::vec3(0.0f), cs, directional_q(hierarchy, &v, s, glm::normalize(cr - cs)), 0.0f), cr,
+            box);
+        slope += mean(brought) * glm::vec4(g, 1.0f);
+      }
+      (is_back(r) ? back : front)[element_of(r)] = sum;
+      if (has_children) (is_back(r) ? slope_back : slope_front)[element_of(r)] = slope;
+      if (hold) (is_back(r) ? bound_back : bound_front)[element_of(r)] = bound;
+    };
+    parallel_for(threads, receivers, 2048, [&](std::size_t begin, std::size_t end) {
+      std::vector<LeafSide> leaves;
+      std::vector<Rgb> lit;
+      for (std::size_t i = begin; i < end; ++i) receive(i, false, leaves, lit);
     });
+    if (kernel) kernel_push(hierarchy, kernel_candidate, receive);
     // Push: clusters to their children (ids increase downward), one-patch clusters to their
     // patch's root element by its normal, elements to their children; the bounds alike.
     for (std::uint32_t c = 0; c < C; ++c) {
@@ -3005,7 +3018,6 @@ struct LinkHierarchy::Impl {
           bound_back[el.first_child + k] = glm::max(bound_back[el.first_child + k], bound_back[e]);
       }
     }
-    if (kernel) kernel_push(hierarchy, v, weights, front, back);
   }
 
   /// Scales the irradiance `H` (per unknown) that radiosity `B` (per unknown) sent along the
