@@ -2743,7 +2743,7 @@ struct LinkHierarchy::Impl {
   /// at the leaves against the point kernel at the centroid, within a factor of 2) also
   /// turned away the ground beside a wall lit by the wall above it, where the two
   /// legitimately differ (the 22k city's ground within 1.2 m of a wall +0.43 -> +0.50 %).
-  /// `lit` receives each leaf side's point_kernel().
+  /// `lit_by_leaf` receives each leaf side's point_kernel().
   float kernel_weight(const PatchHierarchy& h, const Values& v, NodeHandle s, const glm::vec3& cr,
                       const std::vector<LeafSide>& leaves, std::vector<Rgb>& lit_by_leaf, float irradiance,
                       bool facing) const {
