@@ -826,6 +826,13 @@ struct LinkHierarchy::Impl {
   }
 
   bool is_leaf_cluster(NodeHandle h) const { return is_cluster(h) && tree.node(handle_index(h)).is_leaf(); }
+  /// Whether a receiver has parts below it to push its light to: an element with children, an
+  /// inner cluster, or a one-patch cluster whose root element has children.
+  bool node_has_children(const PatchHierarchy& hierarchy, NodeHandle h) const {
+    if (!is_cluster(h)) return !hierarchy.element(element_of(h)).is_leaf();
+    const ClusterNode& node = tree.node(handle_index(h));
+    return !node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf();
+  }
 
   // ---- Visibility ---------------------------------------------------------------------------
 
@@ -962,6 +969,12 @@ struct LinkHierarchy::Impl {
     bool source_by_power_ = true;
   };
 
+  /// An element's corners (the fourth unused for a triangle): the polygon the closed forms take.
+  static std::array<glm::vec3, 4> corner_points(const PatchHierarchy& h, const Element& e) {
+    std::array<glm::vec3, 4> out{};
+    for (int k = 0; k < e.corner_count(); ++k) out[static_cast<std::size_t>(k)] = h.vertices()[e.corners[k]];
+    return out;
+  }
   /// Element-to-element factor: the point-to-polygon closed form (Lambert's contour integral,
   /// point_to_polygon_factor_fast()) from receiver points to the source element, 0 at points
   /// behind the source's side, averaged over the receiver by `rule` (receiver_rule(): n x n
@@ -976,15 +989,13 @@ struct LinkHierarchy::Impl {
     const std::uint32_t re = element_of(r);
     const Element& es = h.element(element_of(s));
     const glm::vec3 ns = side_normal(h, s), nr = side_normal(h, r);
-    std::array<glm::vec3, 4> polygon{};
-    for (int k = 0; k < es.corner_count(); ++k) polygon[static_cast<std::size_t>(k)] = h.vertices()[es.corners[k]];
+    const std::array<glm::vec3, 4> polygon = corner_points(h, es);
     auto at = [&](const glm::vec3& x) {
       if (!(glm::dot(ns, x - es.centroid) > 0.0f)) return 0.0f;
       return point_to_polygon_factor_fast(x, nr, polygon.data(), es.corner_count());
     };
     const Element& er = h.element(re);
-    std::array<glm::vec3, 4> receiver{};
-    for (int k = 0; k < er.corner_count(); ++k) receiver[static_cast<std::size_t>(k)] = h.vertices()[er.corners[k]];
+    const std::array<glm::vec3, 4> receiver = corner_points(h, er);
     if (rule.adaptive) {
       const CellMap map(receiver.data(), er.corner_count());
       auto g = [&](glm::vec2 st) -> double { return map.density(st) * at(map.point(st)); };
@@ -2724,9 +2735,7 @@ struct LinkHierarchy::Impl {
       if (!(cosine > 0.0f)) return Rgb(0.0f);
       return B * (es.area * kInvPi * ahead * cosine / (d2 * d2));
     }
-    std::array<glm::vec3, 4> polygon{};
-    for (int k = 0; k < es.corner_count(); ++k) polygon[static_cast<std::size_t>(k)] = h.vertices()[es.corners[k]];
-    return B * point_to_polygon_factor_fast(x, n, polygon.data(), es.corner_count());
+    return B * point_to_polygon_factor_fast(x, n, corner_points(h, es).data(), es.corner_count());
   }
   /// The kernel push's weight of a link from `s` into the node of centroid `cr` whose leaf
   /// sides are `leaves`, which brings it `irradiance` (W/m^2, mean channel) as the linear push
@@ -2851,13 +2860,8 @@ struct LinkHierarchy::Impl {
     // levels below; there `leaves` holds its leaf sides and `lit` each one's point_kernel() of
     // the link at hand.
     auto kernel_candidate = [&](NodeHandle r) {
-      if (!kernel) return false;
-      if (is_cluster(r)) {
-        const ClusterNode& node = tree.node(handle_index(r));
-        return (!node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf()) &&
-               wholly_exposed(handle_index(r));
-      }
-      return !hierarchy.element(element_of(r)).is_leaf() && element_exposure(element_of(r), is_back(r)) == 1.0f;
+      return kernel && node_has_children(hierarchy, r) &&
+             (is_cluster(r) ? wholly_exposed(handle_index(r)) : element_exposure(element_of(r), is_back(r)) == 1.0f);
     };
     auto receive = [&](std::size_t i, bool by_levels, std::vector<LeafSide>& leaves, std::vector<Rgb>& lit) {
       const std::uint64_t first = offsets[i], last = offsets[i + 1];
@@ -2884,8 +2888,7 @@ struct LinkHierarchy::Impl {
         glm::vec4& slope = slope_cluster[handle_index(r)];
         const ClusterNode& node = tree.node(handle_index(r));
         // A one-patch cluster's slope goes to its patch's root element: used if that has children.
-        const bool has_children =
-            !node.is_leaf() || !hierarchy.element(hierarchy.patches()[tree.order()[node.first]].root).is_leaf();
+        const bool has_children = node_has_children(hierarchy, r);
         // A cluster clamps its links' gradients by its box (clamp_to_box()).
         for (std::uint64_t k = first; k < last; ++k) {
           const NodeHandle s = sources[k];
@@ -2906,7 +2909,7 @@ struct LinkHierarchy::Impl {
       const glm::vec3 nr = side_normal(hierarchy, r);
       Rgb sum(0.0f);
       glm::vec4 slope(0.0f);
-      const bool has_children = !hierarchy.element(element_of(r)).is_leaf();
+      const bool has_children = node_has_children(hierarchy, r);
       const Bounds box = has_children ? node_bounds(hierarchy, r) : Bounds{};
       for (std::uint64_t k = first; k < last; ++k) {
         const NodeHandle s = sources[k];
