@@ -37,6 +37,7 @@ enum class Stream : std::uint64_t {
   // Hierarchical radiosity (key_a: the link's receiver and source handles, 32 bits each).
   hierarchical_link = 0xe0000000000ull,  ///< a link's visibility rays
   hierarchical_enclosure = 0xe1000000000ull,  ///< key_a 2 x element + back: a side's enclosure rays
+  hierarchical_leaf_visibility = 0xe2000000000ull,  ///< the final gather's rays to a link's leaves
   // View factors (key_a: the element).
   view_factor_sky = 0xf0000000000ull,    ///< an element's rays for its sky view factor
   view_factor_cost = 0xf1000000000ull,   ///< key_a 0: the pairs the automatic choice integrates to estimate
@@ -66,6 +67,7 @@ constexpr Range kRanges[] = {
     {stream_key(Stream::light_front), 1ull << 31},          {stream_key(Stream::light_back), 1ull << 31},
     {stream_key(Stream::two_pass_sky), 1},                  {stream_key(Stream::hierarchical_link), 1},
     {stream_key(Stream::view_factor_sky), 1},               {stream_key(Stream::hierarchical_enclosure), 1},
+    {stream_key(Stream::hierarchical_leaf_visibility), 1},
 };
 
 constexpr bool disjoint() {

@@ -698,15 +698,17 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     // held: an earlier pass's sweeps grew and were held (the maximum principle); later passes
     // start held, and the warning below is given once.
     bool solved = false, held = false;
-    for (int pass = 1; pass <= o.hierarchical.max_passes; ++pass) {
-      // The oracle's scale: the scene's mean radiosity estimate, power emitted (lights
-      // included) per area times the mean interreflection factor.
+    // The oracle's scale: the scene's mean radiosity estimate, power emitted (lights
+    // included) per area times the mean interreflection factor.
+    auto radiosity_scale = [&] {
       double source_power = 0.0;
       for (std::size_t u = 0; u < system->unknowns(); ++u)
         source_power += system->area[u] * (system->source[u].x + system->source[u].y + system->source[u].z) / 3.0;
       const Rgb& k = system->interreflection;
-      const double mean_B = source_power / system->total_area * (k.x + k.y + k.z) / 3.0;
-      const auto threshold = static_cast<float>(o.hierarchical.epsilon * mean_B);
+      return source_power / system->total_area * (k.x + k.y + k.z) / 3.0;
+    };
+    for (int pass = 1; pass <= o.hierarchical.max_passes; ++pass) {
+      const auto threshold = static_cast<float>(o.hierarchical.epsilon * radiosity_scale());
       std::vector<std::uint32_t> split;
       detail::RefineStats stats;
       const auto tf = std::chrono::steady_clock::now();
@@ -751,13 +753,13 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     }
     // The final gather: the irradiance of the radiosity kept, once, with the links as they
     // stand (those of its solve, or after a cancelled pass those restored, over any elements it
-    // split), each leaf taking the links into its ancestors by the kernel at the leaf rather
-    // than the sweeps' linear push, and the radiosity it gives (B = E + rho H + tau H'): one
+    // split), each leaf taking the links into its ancestors by the kernel at the leaf (and the
+    // weak ones by a visibility ray to it) rather than the sweeps' linear push, and the radiosity it gives (B = E + rho H + tau H'): one
     // sweep more, for the display (docs/HIERARCHICAL.md, "The final gather"). The passes'
     // solves leave it to here, each a gather fewer (the 246k city's three passes: 9 gathers
     // -> 7).
     if (solved) {
-      const std::vector<Rgb> H = links->irradiance(hierarchy, *system, current_B(), held, true);
+      const std::vector<Rgb> H = links->final_gather(hierarchy, *system, current_B(), static_cast<float>(radiosity_scale()), held);
       const std::vector<float> exposure = current_exposure();
       const std::vector<Rgb> source = system->exposed_source(exposure);
       for (std::size_t i = 0; i < system->unknowns(); ++i) {

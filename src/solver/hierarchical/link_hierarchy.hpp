@@ -99,12 +99,18 @@ class LinkHierarchy {
   /// The irradiance per unknown that radiosity `B` (per unknown) sends along the links: one
   /// gather and push (`hold`: held to the maximum principle, as solve() holds it). With B = the
   /// emission it is the direct irradiance from the emitters. Onto each side's open part where
-  /// it is partly buried, as solve()'s H and B (SolverResult::exposure). With `kernel_push`,
-  /// the links into open nodes with children reach each leaf by the kernel evaluated there
-  /// (normalised to what the linear push delivers) rather than by the sweeps' linear push: the
-  /// display's final gather (docs/HIERARCHICAL.md, "The final gather").
+  /// it is partly buried, as solve()'s H and B (SolverResult::exposure).
   std::vector<Rgb> irradiance(const PatchHierarchy& hierarchy, const RadiositySystem& system,
-                              const std::vector<Rgb>& B, bool hold = false, bool kernel_push = false) const;
+                              const std::vector<Rgb>& B, bool hold = false) const;
+  /// The display's final gather (docs/HIERARCHICAL.md, "The final gather"): irradiance(), but
+  /// the links into open nodes with children reach each leaf by the kernel evaluated there
+  /// (normalised to what the linear push delivers), not by the sweeps' linear push, and those
+  /// that bring less than a small share of `scale` (the scene's radiosity scale, W/m^2: the
+  /// oracle's threshold over epsilon) by one visibility ray from the source to each leaf too.
+  /// Builds the point-sampling records for its rays and releases them (not to be called
+  /// concurrently with anything else on this object).
+  std::vector<Rgb> final_gather(const PatchHierarchy& hierarchy, const RadiositySystem& system,
+                                const std::vector<Rgb>& B, float scale, bool hold = false);
 
   /// The share of the power that radiosity `B` (per unknown) sends from sides whose rays all
   /// meet receiving surfaces (kEnclosureRays each; estimated from sides drawn by power): near 1
