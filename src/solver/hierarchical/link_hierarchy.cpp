@@ -179,24 +179,30 @@ constexpr float kFarKernel = 16.0f;
 /// receiver's most facing side by the linear push; a link that would is pushed linearly
 /// (kernel_weight()).
 constexpr double kKernelPeak = 4.0;
-/// Points of a link's source from which the final gather's visibility rays reach its
-/// receiver's leaves (ShadowSampler::leaf_visibility()).
-constexpr int kLeafRaySources = 4;
 /// Leaf sides per parallel block of one link's final gather (kernel_weight()).
 constexpr std::size_t kLeafBlock = 4096;
-/// The final gather casts its visibility rays to the leaves of links that bring their receiver
-/// less than this share of the scene's radiosity scale (the oracle's, before epsilon). The
-/// links into clusters each share one visible fraction over their leaves; the weakest ones,
-/// far sources seen past other buildings, are most of them, and their shared fraction is
-/// wrong the same way on many leaves: on the 22k city the links below 0.03 of the threshold
-/// (0.0015 of the scale) carry most of the transport's error left (walls 0.46 % of the
-/// radiosity against the Monte Carlo rows, 0.34 % with a ray per leaf for every link). One
-/// binary ray per leaf is noise where a link is a large part of a leaf's light: on plates
-/// with a strip between them, every link's leaves ray-tested took the leaf RMS at epsilon 0.5
-/// from 3.4 % to 8.5 % (a quarter of the emitter's light put on 2 of 16 leaves); at this
-/// share, 3.4 %. Measured: the 22k city's element RMS 0.90 -> 0.87 % (0.87 % with every link
-/// ray-tested, 0.88 % at 0.002).
+/// The final gather's visibility rays (kernel_weight(), ShadowSampler::leaf_visibility()): a
+/// link that brings its receiver an irradiance E casts n = (E / (kLeafRayShare x the scene's
+/// radiosity scale))^2 rays to each leaf it lights, at least 1 and at most kMaxLeafRays, from
+/// max(n, kLeafRaySources) points of its source drawn by power, so that the noise of a leaf's
+/// visible fraction costs it at most about half that share of the scale (a binary ray's
+/// standard error is at most 1 / (2 sqrt(n))), whatever the link. The scale is the oracle's
+/// (its threshold over epsilon).
+///
+/// Why a ray per leaf for every link: a link into a cluster has one visible fraction, and the
+/// weakest links, far sources seen past other buildings, are most of the links and share their
+/// fraction over leaves of which some see the source and some do not, wrong the same way on many
+/// of them. On the 22k city the transport's own error on the walls went 0.46 -> 0.34 % of the
+/// radiosity (the Monte Carlo rows' is 0.18 %), the element RMS 0.90 -> 0.87 %; with rays only
+/// for links of at least 0.03 of the threshold, nothing gained. Why n grows as E^2: one binary
+/// ray per leaf is noise where one link is much of a leaf's light; on plates with a strip
+/// between them (the tests) a ray for every link took the leaf RMS at epsilon 0.5 from 3.4 % to
+/// 8.5 %, and with this rule it is 1.9 %.
 constexpr float kLeafRayShare = 0.005f;
+constexpr int kMaxLeafRays = 64;
+/// Source points a link's leaf rays leave from at least: neighbouring leaves take different
+/// ones, so that one point's shadow does not fall on all of them.
+constexpr int kLeafRaySources = 4;
 /// Rays per element side that decide whether it is enclosed (enclosed_power_share()), cast
 /// kEnclosureBatch at a time until one escapes. A side open over a fraction O of its
 /// (cosine-weighted) hemisphere passes for enclosed with probability (1 - O)^32: 19 % at O =
@@ -298,7 +304,7 @@ struct LinkHierarchy::Impl {
     std::uint8_t corner_count, has_back;
   };
   std::vector<SamplePatch> sample_patches;
-  /// The scene's radiosity scale (W/m^2) of the final gather's call: kLeafRayShare of it.
+  /// The scene's radiosity scale (W/m^2) of the final gather's call (kLeafRayShare).
   float leaf_ray_scale = 0.0f;
   /// Per cluster: the directions its moments are kept along (refresh_patch_data()).
   MomentBases bases;
@@ -980,14 +986,19 @@ struct LinkHierarchy::Impl {
     }
     /// Points of the source for the final gather's visibility rays (leaf_visibility()).
     struct SourcePoints {
-      std::array<glm::vec3, kLeafRaySources> point, normal;
-      std::array<bool, kLeafRaySources> two_sided{};
+      std::array<glm::vec3, kMaxLeafRays> point, normal;
+      std::array<bool, kMaxLeafRays> two_sided{};
       int count = 0;
+      int rays_per_leaf = 1;
     };
-    /// Up to kLeafRaySources points of the source, drawn by power, that may face the receiver.
-    SourcePoints source_points() {
+    /// Up to max(rays_per_leaf, kLeafRaySources) points of the source, drawn by power, that may
+    /// face the receiver.
+    SourcePoints source_points(int rays_per_leaf) {
       SourcePoints out;
-      for (int tries = 0; tries < kTriesPerRay * kLeafRaySources && out.count < kLeafRaySources; ++tries) {
+      out.rays_per_leaf = rays_per_leaf;
+      const int wanted = std::max(rays_per_leaf, kLeafRaySources);
+      RADIOSITY_ASSERT(wanted <= kMaxLeafRays);
+      for (int tries = 0; tries < kTriesPerRay * wanted && out.count < wanted; ++tries) {
         const auto k = static_cast<std::size_t>(out.count);
         m_.sample(h_, s_, true, rng_, out.point[k], out.normal[k], out.two_sided[k]);
         if (out.two_sided[k] || glm::dot(out.normal[k], receiver_centre_ - out.point[k]) + receiver_radius_ > 0.0f)
@@ -996,12 +1007,12 @@ struct LinkHierarchy::Impl {
       return out;
     }
     /// The final gather's visibility per leaf side (kernel_weight()): for each side k in
-    /// [begin, end) of `leaves` (below the receiver) with lit[k] > 0, one ray to its centroid
-    /// from one of the source's `points` (side k takes the first of them, from the k-th on,
-    /// that faces it); lit[k] becomes 0 where the ray is blocked (kept where it is clear or no
-    /// point faces it). A few points shared by all the leaves rather than one drawn per leaf:
-    /// the rays leave from the same few origins, so Embree's packets stay coherent, and no
-    /// cluster is searched per leaf. Each side's ray depends on k alone, not on the range.
+    /// [begin, end) of `leaves` (below the receiver) with lit[k] > 0, points.rays_per_leaf rays
+    /// to its centroid from the source's `points` (the first that face it from the k-th on);
+    /// lit[k] is scaled by the fraction of them that is clear (kept where no point faces it).
+    /// A few points shared by all the leaves rather than drawn per leaf: the rays leave from the
+    /// same few origins, so Embree's packets stay coherent, and no cluster is searched per
+    /// leaf. Each side's rays depend on k alone, not on the range.
     void leaf_visibility(const SourcePoints& points, const std::vector<LeafSide>& leaves, std::vector<Rgb>& lit,
                          std::size_t begin, std::size_t end) const {
       if (points.count == 0) return;
@@ -1010,19 +1021,26 @@ struct LinkHierarchy::Impl {
       leaf_of_ray.clear();
       for (std::size_t k = begin; k < end; ++k) {
         if (!(mean(lit[k]) > 0.0f)) continue;
-        for (int j = 0; j < points.count; ++j) {
-          const auto p = static_cast<std::size_t>((static_cast<int>(k % kLeafRaySources) + j) % points.count);
+        const auto first = static_cast<int>(k % static_cast<std::size_t>(points.count));
+        for (int j = 0, added = 0; j < points.count && added < points.rays_per_leaf; ++j) {
+          const auto p = static_cast<std::size_t>((first + j) % points.count);
           if (!add_ray(b, points.point[p], points.normal[p], points.two_sided[p], leaves[k].centroid, leaves[k].normal,
                        false))
             continue;
           leaf_of_ray.push_back(static_cast<std::uint32_t>(k));
-          break;
+          ++added;
         }
       }
       std::uint64_t rays = 0;
       cast(b, rays);
-      for (std::size_t k = 0; k < b.blocked.size(); ++k)
-        if (b.blocked[k] != 0) lit[leaf_of_ray[k]] = Rgb(0.0f);
+      // Rays per leaf, clear and cast: leaf_of_ray holds each leaf's rays together.
+      for (std::size_t first = 0; first < leaf_of_ray.size();) {
+        std::size_t last = first;
+        int clear = 0;
+        for (; last < leaf_of_ray.size() && leaf_of_ray[last] == leaf_of_ray[first]; ++last) clear += b.blocked[last] == 0;
+        lit[leaf_of_ray[first]] *= static_cast<float>(clear) / static_cast<float>(last - first);
+        first = last;
+      }
     }
 
    private:
@@ -2862,9 +2880,11 @@ struct LinkHierarchy::Impl {
     if (!(d2 > 0.0f)) return 0.0f;
     const glm::vec3 w = u / std::sqrt(d2);
     lit_by_leaf.resize(leaves.size());
+    // The visibility per leaf, by rays as many as the link's strength asks (kLeafRayShare).
     ShadowSampler shadows(*this, h, r, s, Stream::hierarchical_leaf_visibility);
-    ShadowSampler::SourcePoints points;
-    if (irradiance < kLeafRayShare * leaf_ray_scale) points = shadows.source_points();
+    const float strength = irradiance / (kLeafRayShare * leaf_ray_scale);
+    const int rays_per_leaf = static_cast<int>(std::clamp(std::ceil(strength * strength), 1.0f, float{kMaxLeafRays}));
+    const ShadowSampler::SourcePoints points = shadows.source_points(rays_per_leaf);
     // In parallel over the leaves where they are many: the top levels of the pass by levels
     // hold one or two receivers, each over a large part of the scene's leaves.
     parallel_for(threads, leaves.size(), kLeafBlock, [&](std::size_t begin, std::size_t end) {

@@ -104,9 +104,9 @@ class LinkHierarchy {
                               const std::vector<Rgb>& B, bool hold = false) const;
   /// The display's final gather (docs/HIERARCHICAL.md, "The final gather"): irradiance(), but
   /// the links into open nodes with children reach each leaf by the kernel evaluated there
-  /// (normalised to what the linear push delivers), not by the sweeps' linear push, and those
-  /// that bring less than a small share of `scale` (the scene's radiosity scale, W/m^2: the
-  /// oracle's threshold over epsilon) by one visibility ray from the source to each leaf too.
+  /// and its visibility from the source, by shadow rays to the leaf (normalised to what the
+  /// linear push delivers), not by the sweeps' linear push: the stronger a link for `scale`
+  /// (the scene's radiosity scale, W/m^2: the oracle's threshold over epsilon), the more rays.
   /// Builds the point-sampling records for its rays and releases them (not to be called
   /// concurrently with anything else on this object).
   std::vector<Rgb> final_gather(const PatchHierarchy& hierarchy, const RadiositySystem& system,
