@@ -2855,12 +2855,14 @@ struct LinkHierarchy::Impl {
     }
     return B * point_to_polygon_factor_fast(x, n, corner_points(h, es).data(), es.corner_count());
   }
-  /// The kernel push's weight of a link from `s` into the node of centroid `cr` whose leaf
+  /// The kernel push's weight of a link from `s` into node `r` of centroid `cr` whose leaf
   /// sides are `leaves`, which brings it `irradiance` (W/m^2, mean channel) as the linear push
   /// has it: on a side facing the source for an element (`facing` false), times each side's
-  /// max(0, -n . w) toward the centroids' direction w for a cluster. The weight is the power
-  /// that delivers over the sum of the leaves' area times point_kernel() (mean channel), so
-  /// that leaf side l takes weight x point_kernel(l) and the leaves together the link's power.
+  /// max(0, -n . w) toward the centroids' direction w for a cluster. Each leaf side is lit by
+  /// point_kernel() times its visible fraction from the source (by the final gather's rays,
+  /// kLeafRayShare, ShadowSampler::leaf_visibility()); the weight is the power the link
+  /// delivers over the sum of the leaves' area times that light (mean channel), so that leaf
+  /// side l takes weight x its light and the leaves together the link's power.
   /// 0 (the link is then pushed linearly) where no leaf is lit, or where a leaf would take
   /// more than kKernelPeak times the irradiance on the receiver's most facing side: near
   /// grazing the centroids' direction can show the source to sides that their own directions
@@ -2870,7 +2872,7 @@ struct LinkHierarchy::Impl {
   /// at the leaves against the point kernel at the centroid, within a factor of 2) also
   /// turned away the ground beside a wall lit by the wall above it, where the two
   /// legitimately differ (the 22k city's ground within 1.2 m of a wall +0.43 -> +0.50 %).
-  /// `lit_by_leaf` receives each leaf side's point_kernel().
+  /// `lit_by_leaf` receives each leaf side's light (point_kernel() times its visible fraction).
   float kernel_weight(const PatchHierarchy& h, const Values& v, NodeHandle r, NodeHandle s, const glm::vec3& cr,
                       const std::vector<LeafSide>& leaves, std::vector<Rgb>& lit_by_leaf, float irradiance,
                       bool facing) const {
