@@ -753,9 +753,10 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     }
     // The final gather: the irradiance of the radiosity kept, once, with the links as they
     // stand (those of its solve, or after a cancelled pass those restored, over any elements it
-    // split), each leaf taking the links into its ancestors by the kernel at the leaf (and the
-    // weak ones by a visibility ray to it) rather than the sweeps' linear push, and the radiosity it gives (B = E + rho H + tau H'): one
-    // sweep more, for the display (docs/HIERARCHICAL.md, "The final gather"). The passes'
+    // split), each leaf taking the links into its ancestors by the kernel at the leaf and
+    // shadow rays to it rather than the sweeps' linear push, and the radiosity it gives
+    // (B = E + rho H + tau H'): one sweep more, for the display (docs/HIERARCHICAL.md, "The
+    // final gather", "Visibility per leaf"). The passes'
     // solves leave it to here, each a gather fewer (the 246k city's three passes: 9 gathers
     // -> 7).
     if (solved) {
