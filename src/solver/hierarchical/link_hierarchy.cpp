@@ -304,8 +304,6 @@ struct LinkHierarchy::Impl {
     std::uint8_t corner_count, has_back;
   };
   std::vector<SamplePatch> sample_patches;
-  /// The scene's radiosity scale (W/m^2) of the final gather's call (kLeafRayShare).
-  float leaf_ray_scale = 0.0f;
   /// Per cluster: the directions its moments are kept along (refresh_patch_data()).
   MomentBases bases;
   /// Per cluster: its sides' area in its basis, as add_surface() adds power
@@ -2770,10 +2768,11 @@ struct LinkHierarchy::Impl {
   /// sweep is at most the largest emission plus rho_max times the largest before it: bounded
   /// for any rho < 1. Not by default: the estimates err both ways by a few per cent per leaf, so
   /// holding the high ones alone biases the irradiance low (a furnace's mean by -2.4 %).
+  /// `kernel_scale`: as gather_sides()'s.
   void gather(const PatchHierarchy& hierarchy, const RadiositySystem& sys, const Values& v,
-              std::vector<Rgb>& H, bool hold = false, bool kernel = false) const {
+              std::vector<Rgb>& H, bool hold = false, float kernel_scale = 0.0f) const {
     std::vector<Rgb> front, back, bound_front, bound_back;
-    gather_sides(hierarchy, v, sys.has_backs(), hold, front, back, bound_front, bound_back, nullptr, kernel);
+    gather_sides(hierarchy, v, sys.has_backs(), hold, front, back, bound_front, bound_back, nullptr, kernel_scale);
     H.resize(sys.unknowns());
     for (std::size_t u = 0; u < sys.unknowns(); ++u) {
       const bool is_front = u < sys.fronts();
@@ -2872,10 +2871,11 @@ struct LinkHierarchy::Impl {
   /// at the leaves against the point kernel at the centroid, within a factor of 2) also
   /// turned away the ground beside a wall lit by the wall above it, where the two
   /// legitimately differ (the 22k city's ground within 1.2 m of a wall +0.43 -> +0.50 %).
-  /// `lit_by_leaf` receives each leaf side's light (point_kernel() times its visible fraction).
+  /// `lit_by_leaf` receives each leaf side's light (point_kernel() times its visible fraction);
+  /// `scale` is the scene's radiosity scale (W/m^2) the rays are counted by.
   float kernel_weight(const PatchHierarchy& h, const Values& v, NodeHandle r, NodeHandle s, const glm::vec3& cr,
                       const std::vector<LeafSide>& leaves, std::vector<Rgb>& lit_by_leaf, float irradiance,
-                      bool facing) const {
+                      bool facing, float scale) const {
     if (!(irradiance > 0.0f)) return 0.0f;
     const glm::vec3 u = cr - centroid(h, s);
     const float d2 = glm::dot(u, u);
@@ -2884,7 +2884,7 @@ struct LinkHierarchy::Impl {
     lit_by_leaf.resize(leaves.size());
     // The visibility per leaf, by rays as many as the link's strength asks (kLeafRayShare).
     ShadowSampler shadows(*this, h, r, s, Stream::hierarchical_leaf_visibility);
-    const float strength = irradiance / (kLeafRayShare * leaf_ray_scale);
+    const float strength = irradiance / (kLeafRayShare * scale);
     const int rays_per_leaf = static_cast<int>(std::clamp(std::ceil(strength * strength), 1.0f, float{kMaxLeafRays}));
     const ShadowSampler::SourcePoints points = shadows.source_points(rays_per_leaf);
     // In parallel over the leaves where they are many: the top levels of the pass by levels
@@ -2910,8 +2910,8 @@ struct LinkHierarchy::Impl {
     if (!(weight * brightest <= kKernelPeak * irradiance * most_facing)) return 0.0f;
     return static_cast<float>(weight);
   }
-  /// The kernel push's pass (gather_sides() with `kernel`): `receive(i, true, leaves, lit)` for
-  /// every receiver `i` with links that `candidate` takes, level by level (clusters by depth,
+  /// The kernel push's pass (gather_sides() with a `kernel_scale`): `receive(i, true, leaves,
+  /// lit)` for every receiver `i` with links that `candidate` takes, level by level (clusters by depth,
   /// then elements with children by depth), each level in parallel. The nodes of one level
   /// hold disjoint leaves, so each leaf side takes its ancestors' links in one order, from the
   /// root down, at any thread count, and each link's kernel is evaluated once per leaf. The
@@ -2953,11 +2953,14 @@ struct LinkHierarchy::Impl {
   /// gather()'s work: the irradiance per element side (`back` empty without `backs`), pushed
   /// down to every leaf, and with `hold` the maximum principle's bound per element side.
   /// With `shares`, also the linear push's shares (the balancing's adjoint pushes back by them).
-  /// With `kernel`, the links into wholly open nodes with children are pushed by the kernel
-  /// instead (kernel_weight(), kernel_push()); not with `shares`.
+  /// With `kernel_scale` > 0 (the final gather: the scene's radiosity scale, W/m^2, for
+  /// kLeafRayShare; it needs prepare_sampling()), the links into wholly open nodes with
+  /// children are pushed by the kernel and the leaves' visibility instead (kernel_weight(),
+  /// kernel_push()); not with `shares`.
   void gather_sides(const PatchHierarchy& hierarchy, const Values& v, bool backs, bool hold, std::vector<Rgb>& front,
                     std::vector<Rgb>& back, std::vector<Rgb>& bound_front, std::vector<Rgb>& bound_back,
-                    PushShares* shares = nullptr, bool kernel = false) const {
+                    PushShares* shares = nullptr, float kernel_scale = 0.0f) const {
+    const bool kernel = kernel_scale > 0.0f;
     const std::uint32_t elements = linked_elements;
     RADIOSITY_ASSERT(hierarchy.elements().size() == elements);
     const std::uint32_t C = cluster_count();
@@ -3002,7 +3005,7 @@ struct LinkHierarchy::Impl {
       const bool by_kernel = by_levels && leaf_sides(hierarchy, r, leaves);
       auto to_leaves = [&](NodeHandle s, const glm::vec3& cr, float irradiance, bool facing) {
         if (!by_kernel) return false;
-        const float weight = kernel_weight(hierarchy, v, r, s, cr, leaves, lit, irradiance, facing);
+        const float weight = kernel_weight(hierarchy, v, r, s, cr, leaves, lit, irradiance, facing, kernel_scale);
         if (!(weight > 0.0f)) return false;
         for (std::size_t l = 0; l < leaves.size(); ++l)
           (leaves[l].back ? back : front)[leaves[l].element] += weight * lit[l];
@@ -3367,8 +3370,7 @@ std::vector<Rgb> LinkHierarchy::final_gather(const PatchHierarchy& hierarchy, co
   m.node_values(hierarchy, system, m.sent(system, B, scaled), values, hold);
   // The leaves' visibility rays draw source points by the power sent now.
   m.prepare_sampling(hierarchy, values);
-  m.leaf_ray_scale = scale;
-  m.gather(hierarchy, system, values, H, hold, true);
+  m.gather(hierarchy, system, values, H, hold, scale);
   m.release_sampling();
   if (hold) Impl::cap_delivered_power(system, B, H);
   Impl::to_open(H, m.side_exposures(system));

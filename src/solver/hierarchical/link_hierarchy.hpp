@@ -107,8 +107,9 @@ class LinkHierarchy {
   /// and its visibility from the source, by shadow rays to the leaf (normalised to what the
   /// linear push delivers), not by the sweeps' linear push: the stronger a link for `scale`
   /// (the scene's radiosity scale, W/m^2: the oracle's threshold over epsilon), the more rays.
-  /// Builds the point-sampling records for its rays and releases them (not to be called
-  /// concurrently with anything else on this object).
+  /// A `scale` of 0 (nothing emits: every radiosity is 0) gathers as irradiance() does. Builds
+  /// the point-sampling records for its rays and releases them (not to be called concurrently
+  /// with anything else on this object).
   std::vector<Rgb> final_gather(const PatchHierarchy& hierarchy, const RadiositySystem& system,
                                 const std::vector<Rgb>& B, float scale, bool hold = false);
 
