@@ -103,10 +103,11 @@ RayScene::RayScene(const std::vector<glm::vec3>& positions, const std::vector<st
   for (const auto& [property, width] : {std::pair{RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED, 16},
                                         std::pair{RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED, 8},
                                         std::pair{RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED, 4}}) {
-    if (rtcGetDeviceProperty(device, property) != 0) {
+    if (rtcGetDeviceProperty(device, property) == 0) continue;
+    if (packet_width_ == 1)
       packet_width_ = width;
-      break;
-    }
+    else
+      narrow_packets_ |= width;
   }
   if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
     release();
@@ -118,6 +119,7 @@ RayScene::RayScene(RayScene&& other) noexcept
     : device_(other.device_),
       scene_(other.scene_),
       packet_width_(other.packet_width_),
+      narrow_packets_(other.narrow_packets_),
       coincidence_(other.coincidence_),
       ids_(std::move(other.ids_)),
       indices_(std::move(other.indices_)),
@@ -132,6 +134,7 @@ RayScene& RayScene::operator=(RayScene&& other) noexcept {
     device_ = other.device_;
     scene_ = other.scene_;
     packet_width_ = other.packet_width_;
+    narrow_packets_ = other.narrow_packets_;
     coincidence_ = other.coincidence_;
     ids_ = std::move(other.ids_);
     indices_ = std::move(other.indices_);
@@ -288,7 +291,12 @@ void occluded_packets(RTCScene scene, std::size_t count, const glm::vec3* origin
 void RayScene::occluded(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
                         std::uint8_t* blocked) const {
   RTCScene scene = as_scene(scene_);
-  switch (packet_width_) {
+  int width = packet_width_;
+  if (count <= 4 && (narrow_packets_ & 4) != 0)
+    width = 4;
+  else if (count <= 8 && (narrow_packets_ & 8) != 0)
+    width = 8;
+  switch (width) {
     case 16: occluded_packets<16, RTCRay16>(scene, count, origin, dir, tnear, tfar, blocked, rtcOccluded16); return;
     case 8: occluded_packets<8, RTCRay8>(scene, count, origin, dir, tnear, tfar, blocked, rtcOccluded8); return;
     case 4: occluded_packets<4, RTCRay4>(scene, count, origin, dir, tnear, tfar, blocked, rtcOccluded4); return;
