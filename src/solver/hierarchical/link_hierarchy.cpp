@@ -577,33 +577,44 @@ struct LinkHierarchy::Impl {
     }
   };
   /// Appends the descendants of `n` `levels` down to `out` (a node without children stands for
-  /// itself).
-  void transport_ends(const PatchHierarchy& h, NodeHandle n, int levels, TransportEnds& out) const {
+  /// itself), and with `upper` those `levels` - 1 down to it: one walk for both, each in the
+  /// order of its own walk.
+  void transport_ends(const PatchHierarchy& h, NodeHandle n, int levels, TransportEnds& out,
+                      TransportEnds* upper = nullptr) const {
     std::array<NodeHandle, 4> kids{};
     const int k = levels > 0 ? children(h, n, kids) : 0;
     if (k == 0) {
-      if (is_cluster(n)) {
-        const std::uint32_t c = handle_index(n);
-        const std::array<float, 6>& m = area_moments[c];
-        const MomentBasis& b = bases.of(c);
-        if (b.axes) {
-          out.add(cluster_centroid[c], glm::vec3(m[0], m[2], m[4]), glm::vec3(m[1], m[3], m[5]));
-          return;
-        }
-        // An explicit basis: one end per direction, as an element of that normal and area at
-        // the centroid (the pairs' products then sum to the product of the sums).
-        for (int j = 0; j < b.count; ++j) {
-          const glm::vec3 an = m[static_cast<std::size_t>(j)] * b.directions[static_cast<std::size_t>(j)];
-          out.add(cluster_centroid[c], an, -an);
-        }
-      } else {
-        const Element& e = h.element(element_of(n));
-        const glm::vec3 an = e.area * side_normal(h, n);
-        out.add(e.centroid, an, -an);
-      }
+      add_transport_end(h, n, out);
+      if (upper) add_transport_end(h, n, *upper);
       return;
     }
-    for (int i = 0; i < k; ++i) transport_ends(h, kids[static_cast<std::size_t>(i)], levels - 1, out);
+    if (upper && levels == 1) {
+      add_transport_end(h, n, *upper);
+      upper = nullptr;
+    }
+    for (int i = 0; i < k; ++i) transport_ends(h, kids[static_cast<std::size_t>(i)], levels - 1, out, upper);
+  }
+  /// Appends node `n` itself to `out`.
+  void add_transport_end(const PatchHierarchy& h, NodeHandle n, TransportEnds& out) const {
+    if (!is_cluster(n)) {
+      const Element& e = h.element(element_of(n));
+      const glm::vec3 an = e.area * side_normal(h, n);
+      out.add(e.centroid, an, -an);
+      return;
+    }
+    const std::uint32_t c = handle_index(n);
+    const std::array<float, 6>& m = area_moments[c];
+    const MomentBasis& b = bases.of(c);
+    if (b.axes) {
+      out.add(cluster_centroid[c], glm::vec3(m[0], m[2], m[4]), glm::vec3(m[1], m[3], m[5]));
+      return;
+    }
+    // An explicit basis: one end per direction, as an element of that normal and area at the
+    // centroid (the pairs' products then sum to the product of the sums).
+    for (int j = 0; j < b.count; ++j) {
+      const glm::vec3 an = m[static_cast<std::size_t>(j)] * b.directions[static_cast<std::size_t>(j)];
+      out.add(cluster_centroid[c], an, -an);
+    }
   }
 
   /// point_transport() summed over the pairs of the nodes' descendants `levels` down (a node
@@ -614,10 +625,17 @@ struct LinkHierarchy::Impl {
   /// side's descendants are gathered once and then paired in a vectorised loop: a recursion
   /// over the pairs, looking each one up again for every partner, took 12 % of the 246k
   /// city's run.
-  float refined_transport(const PatchHierarchy& h, NodeHandle r, NodeHandle s, int levels) const {
-    TransportEnds re, se;
-    transport_ends(h, r, levels, re);
-    transport_ends(h, s, levels, se);
+  /// With `coarser`, also the same `levels` - 1 down, from the same walks.
+  float refined_transport(const PatchHierarchy& h, NodeHandle r, NodeHandle s, int levels,
+                          float* coarser = nullptr) const {
+    TransportEnds re, se, re_upper, se_upper;
+    transport_ends(h, r, levels, re, coarser ? &re_upper : nullptr);
+    transport_ends(h, s, levels, se, coarser ? &se_upper : nullptr);
+    if (coarser) *coarser = transport_sum(re_upper, se_upper);
+    return transport_sum(re, se);
+  }
+  /// point_transport() summed over the pairs of `re` and `se`.
+  static float transport_sum(const TransportEnds& re, const TransportEnds& se) {
     // Per source end, summed over the receiver ends; the sources' sums are added at the end
     // (a fixed order, so the result does not depend on the vector width).
     alignas(16) std::array<float, TransportEnds::kMax> acc{};
@@ -1412,8 +1430,9 @@ struct LinkHierarchy::Impl {
         return;
       }
       // Extrapolated from the last two levels (kExtrapolate).
-      const float fine = refined_transport(h, r, s, kCorrectionLevels);
-      const float extrapolated = fine + kExtrapolate * (fine - refined_transport(h, r, s, kCorrectionLevels - 1));
+      float coarser = 0.0f;
+      const float fine = refined_transport(h, r, s, kCorrectionLevels, &coarser);
+      const float extrapolated = fine + kExtrapolate * (fine - coarser);
       coefficient *= std::clamp(extrapolated / coarse, 0.25f, 4.0f);
     }
     if (!(coefficient > 0.0f)) return;
