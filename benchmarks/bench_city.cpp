@@ -227,8 +227,8 @@ int run(const Args& a, const rad::SolveOptions& opt, const char* label, bool pri
     std::printf("  rays: sky %.1f M (%.0f per element)", static_cast<double>(r.light_rays) * 1e-6,
                 static_cast<double>(r.light_rays) / static_cast<double>(std::max<std::size_t>(1, r.element_count)));
     if (hierarchical)
-      std::printf(", links %.1f M over %.2f M pairs examined", static_cast<double>(r.link_rays) * 1e-6,
-                  static_cast<double>(r.link_pairs_examined) * 1e-6);
+      std::printf(", links %.1f M over %.2f M pairs examined, final gather %.1f M", static_cast<double>(r.link_rays) * 1e-6,
+                  static_cast<double>(r.link_pairs_examined) * 1e-6, static_cast<double>(r.gather_rays) * 1e-6);
     std::printf("\n");
     std::printf("  group means B (W/m^2):");
     for (const char* group : {"ground", "streets", "walls", "roofs", "under_buildings"}) {

@@ -165,7 +165,8 @@ struct SolveReport {
   std::size_t form_factor_bytes = 0;     ///< memory held by form factors (or links) at the peak
   std::size_t link_count = 0;            ///< SolverMethod::hierarchical: links at the end (0 otherwise)
   std::size_t link_pairs_examined = 0;   ///< SolverMethod::hierarchical: node pairs the refinement oracle looked at
-  std::uint64_t link_rays = 0;           ///< SolverMethod::hierarchical: the links' visibility rays
+  std::uint64_t link_rays = 0;           ///< SolverMethod::hierarchical: the links' visibility rays (refinement)
+  std::uint64_t gather_rays = 0;         ///< SolverMethod::hierarchical: the final gather's visibility rays per leaf
   /// The solver that ran (never automatic), and, when SolveOptions::method was automatic, why
   /// (e.g. "the Gauss-Seidel rows could need 7742 MiB, over the memory budget of 4096 MiB");
   /// empty otherwise.

@@ -760,7 +760,10 @@ Solution Problem::Impl::solve_once(const std::vector<Rgb>* emission, bool last) 
     // solves leave it to here, each a gather fewer (the 246k city's three passes: 9 gathers
     // -> 7).
     if (solved) {
-      const std::vector<Rgb> H = links->final_gather(hierarchy, *system, current_B(), static_cast<float>(radiosity_scale()), held);
+      std::uint64_t gather_rays = 0;
+      const std::vector<Rgb> H = links->final_gather(hierarchy, *system, current_B(),
+                                                     static_cast<float>(radiosity_scale()), held, &gather_rays);
+      report.gather_rays += gather_rays;
       const std::vector<float> exposure = current_exposure();
       const std::vector<Rgb> source = system->exposed_source(exposure);
       for (std::size_t i = 0; i < system->unknowns(); ++i) {

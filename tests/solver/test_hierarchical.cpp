@@ -416,6 +416,8 @@ TEST_SUITE("solver") {
     // single seed to 1 %.
     const rad::Scene scene = rad::cornell_box();
     const rad::Solution gs = gauss_seidel_reference(scene, 10000.0f);  // 100 mm
+    CHECK(gs.report().gather_rays == 0);
+    CHECK(gs.report().link_rays == 0);
     for (float eps : {0.05f, 0.005f}) {
       CAPTURE(eps);
       std::vector<rad::Solution> seeds;
@@ -425,6 +427,7 @@ TEST_SUITE("solver") {
         CHECK(hr.report().link_count > 0);
         CHECK(hr.report().link_pairs_examined >= hr.report().link_count);  // every link was a pair looked at
         CHECK(hr.report().link_rays >= 2 * hr.report().link_count);         // a pilot and an estimate each
+        CHECK(hr.report().gather_rays > 0);  // the final gather's rays to the leaves below cluster receivers
         check_agreement(scene, gs, hr, 0.01, 0.01);
       }
       // The open front lets out about 31 % of the light in both.

@@ -88,6 +88,7 @@ Json stats(const Solution& solution, const SolveOptions* options, std::string_vi
   j["link_count"] = r.link_count;
   j["link_pairs_examined"] = r.link_pairs_examined;
   j["link_rays"] = r.link_rays;
+  j["gather_rays"] = r.gather_rays;
   j["light_rays"] = r.light_rays;
   j["method_used"] = method_name(r.method);
   j["method_choice"] = r.method_choice;

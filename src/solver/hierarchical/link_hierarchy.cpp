@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -285,6 +286,9 @@ struct LinkHierarchy::Impl {
   const char* memory_budget_field = "SolveOptions::memory_budget_bytes";
   bool balancing = true;  ///< LinkHierarchy::set_balancing()
   float ray_epsilon;
+  /// The final gather's visibility rays per leaf (ShadowSampler::leaf_visibility()), counted
+  /// by final_gather().
+  mutable std::atomic<std::uint64_t> leaf_rays{0};
   /// Per position of tree.order(): the area of the patches before it, for sampling a
   /// cluster's surface by area.
   std::vector<double> cumulative_area;
@@ -1049,6 +1053,7 @@ struct LinkHierarchy::Impl {
       }
       std::uint64_t rays = 0;
       cast(b, rays);
+      m_.leaf_rays.fetch_add(rays, std::memory_order_relaxed);
       // Rays per leaf, clear and cast: leaf_of_ray holds each leaf's rays together.
       for (std::size_t first = 0; first < leaf_of_ray.size();) {
         std::size_t last = first;
@@ -3380,9 +3385,12 @@ std::vector<Rgb> LinkHierarchy::irradiance(const PatchHierarchy& hierarchy, cons
 }
 
 std::vector<Rgb> LinkHierarchy::final_gather(const PatchHierarchy& hierarchy, const RadiositySystem& system,
-                                             const std::vector<Rgb>& B, float scale, bool hold) {
+                                             const std::vector<Rgb>& B, float scale, bool hold,
+                                             std::uint64_t* rays) {
   Impl& m = *impl_;
   std::vector<Rgb> H(system.unknowns(), Rgb(0.0f));
+  m.leaf_rays = 0;
+  if (rays) *rays = 0;
   if (!m.linked) return H;
   Impl::Values values;
   std::vector<Rgb> scaled;
@@ -3391,6 +3399,7 @@ std::vector<Rgb> LinkHierarchy::final_gather(const PatchHierarchy& hierarchy, co
   m.prepare_sampling(hierarchy, values);
   m.gather(hierarchy, system, values, H, hold, scale);
   m.release_sampling();
+  if (rays) *rays = m.leaf_rays.load();
   if (hold) Impl::cap_delivered_power(system, B, H);
   Impl::to_open(H, m.side_exposures(system));
   return H;

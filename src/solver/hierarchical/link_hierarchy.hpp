@@ -109,9 +109,10 @@ class LinkHierarchy {
   /// (the scene's radiosity scale, W/m^2: the oracle's threshold over epsilon), the more rays.
   /// A `scale` of 0 (nothing emits: every radiosity is 0) gathers as irradiance() does. Builds
   /// the point-sampling records for its rays and releases them (not to be called concurrently
-  /// with anything else on this object).
+  /// with anything else on this object). With `rays`, the visibility rays it cast.
   std::vector<Rgb> final_gather(const PatchHierarchy& hierarchy, const RadiositySystem& system,
-                                const std::vector<Rgb>& B, float scale, bool hold = false);
+                                const std::vector<Rgb>& B, float scale, bool hold = false,
+                                std::uint64_t* rays = nullptr);
 
   /// The share of the power that radiosity `B` (per unknown) sends from sides whose rays all
   /// meet receiving surfaces (kEnclosureRays each; estimated from sides drawn by power): near 1
