@@ -60,19 +60,18 @@ namespace radiosity::detail {
 
 double contour_factor(const glm::dvec3* r, int m, const glm::dvec3& n) {
   // F = 1/(2 pi) sum_i gamma_i n . (R_i x R_{i+1}) / |R_i x R_{i+1}|, gamma_i the angle between
-  // the unit vectors to consecutive vertices.
+  // the vectors to consecutive vertices: atan2(|R_i x R_{i+1}|, R_i . R_{i+1}), which, like the
+  // edge's direction, does not change when the vectors are scaled, so they are not normalised.
   double sum = 0.0;
   for (int i = 0; i < m; ++i) {
-    glm::dvec3 a = r[i], b = r[(i + 1) % m];
-    double la = glm::length(a), lb = glm::length(b);
-    if (la <= 0.0 || lb <= 0.0) continue;  // the point is on a vertex: that edge has no extent
-    a /= la;
-    b /= lb;
-    glm::dvec3 c = glm::cross(a, b);
-    double sin_gamma = glm::length(c);
-    if (sin_gamma <= 0.0) continue;
-    double gamma = std::atan2(sin_gamma, glm::dot(a, b));
-    sum += gamma * glm::dot(n, c) / sin_gamma;
+    const glm::dvec3& a = r[i];
+    const glm::dvec3& b = r[(i + 1) % m];
+    // The point on a vertex: that edge has no extent (its cross product is 0 too).
+    if (!(glm::dot(a, a) > 0.0) || !(glm::dot(b, b) > 0.0)) continue;
+    const glm::dvec3 c = glm::cross(a, b);
+    const double c_length = glm::length(c);
+    if (!(c_length > 0.0)) continue;
+    sum += std::atan2(c_length, glm::dot(a, b)) * glm::dot(n, c) / c_length;
   }
   double f = std::fabs(sum) / (2.0 * 3.14159265358979323846);
   return f > 1.0 ? 1.0 : f;
