@@ -68,8 +68,8 @@ class RayScene {
   /// than one ray at a time. The packets are the narrowest native size (4, 8 or 16 rays) that
   /// holds the batch, the widest for larger batches: a batch of 4 in a packet of 16 pays for 16
   /// lanes (the hierarchical links' pilots and most of their estimates are 4 rays: the 246k
-  /// city's link refinement took 0.86 times the time with the narrowest packet, measured
-  /// against the sky's rays in the same runs).
+  /// city's link refinement took 0.85-0.95 times the time with the narrowest packet, each run
+  /// measured against its sky's rays, five pairs alternated; docs/HIERARCHICAL.md).
   void occluded(std::size_t count, const glm::vec3* origin, const glm::vec3* dir, float tnear, float tfar,
                 std::uint8_t* blocked) const;
   /// The same answers as occluded() for `count` segments that go their own ways (sky
